@@ -1,0 +1,286 @@
+#include "common/scene_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "common/errors.h"
+
+namespace treeanim {
+
+namespace {
+
+std::string format_number(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// Numbers in JSON may be integers or floats; both are accepted where a number is asked for.
+bool as_finite_number(const Json& v, double* out) {
+  if (!v.is_number()) return false;
+  *out = v.get<double>();
+  return std::isfinite(*out);
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+  if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+  if (hi_open ? !(v < hi) : !(v <= hi)) return false;
+  return true;
+}
+
+std::string Range::describe() const {
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (!has_lo && !has_hi) return "a finite number";
+  if (has_lo && !has_hi) return std::string("a number ") + (lo_open ? "> " : ">= ") + format_number(lo);
+  if (!has_lo && has_hi) return std::string("a number ") + (hi_open ? "< " : "<= ") + format_number(hi);
+  return "a number in " + std::string(lo_open ? "(" : "[") + format_number(lo) + ", " +
+         format_number(hi) + (hi_open ? ")" : "]");
+}
+
+std::string describe_json(const Json& value) {
+  std::string text = value.dump();
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text;
+}
+
+std::string escape_pointer_token(const std::string& token) {
+  std::string out;
+  for (char c : token) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  size_t best_distance = std::numeric_limits<size_t>::max();
+  for (const std::string& c : candidates) {
+    const size_t d = edit_distance(word, c);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  // A suggestion must be closer than a rewrite: at most a third of the word, at least 2 edits.
+  const size_t allowed = std::max<size_t>(2, word.size() / 3);
+  return best_distance <= allowed ? best : std::string();
+}
+
+SceneObject::SceneObject(SceneReader* reader, Json* node, std::string pointer)
+    : reader_(reader), node_(node), pointer_(std::move(pointer)) {
+  reader_->register_object(pointer_);
+}
+
+std::string SceneObject::pointer_of(const std::string& key) const {
+  return pointer_ + "/" + escape_pointer_token(key);
+}
+
+void SceneObject::fail(const std::string& key, const std::string& message) const {
+  throw InputError(pointer_of(key) + ": " + message);
+}
+
+void SceneObject::fail_expected(const std::string& key, const std::string& expected) const {
+  const Json* value = find(key);
+  fail(key, "expected " + expected + ", got " + (value ? describe_json(*value) : "nothing"));
+}
+
+const Json* SceneObject::find(const std::string& key) const {
+  auto it = node_->find(key);
+  return it == node_->end() ? nullptr : &*it;
+}
+
+bool SceneObject::has(const std::string& key) const { return find(key) != nullptr; }
+
+void SceneObject::declare(const std::string& key) { reader_->register_key(pointer_, key); }
+
+std::optional<double> SceneObject::optional_number(const std::string& key, Range range) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) return std::nullopt;
+  double v = 0;
+  if (!as_finite_number(*value, &v) || !range.contains(v)) fail_expected(key, range.describe());
+  return v;
+}
+
+double SceneObject::number(const std::string& key, double fallback, Range range) {
+  if (auto v = optional_number(key, range)) return *v;
+  (*node_)[key] = fallback;
+  return fallback;
+}
+
+std::optional<long long> SceneObject::optional_integer(const std::string& key, long long lo,
+                                                       long long hi) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) return std::nullopt;
+  const std::string expected =
+      "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  double v = 0;
+  if (!as_finite_number(*value, &v) || std::floor(v) != v || v < double(lo) || v > double(hi))
+    fail_expected(key, expected);
+  return static_cast<long long>(v);
+}
+
+long long SceneObject::integer(const std::string& key, long long fallback, long long lo,
+                               long long hi) {
+  if (auto v = optional_integer(key, lo, hi)) return *v;
+  (*node_)[key] = fallback;
+  return fallback;
+}
+
+bool SceneObject::boolean(const std::string& key, bool fallback) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) {
+    (*node_)[key] = fallback;
+    return fallback;
+  }
+  if (!value->is_boolean()) fail_expected(key, "true or false");
+  return value->get<bool>();
+}
+
+std::optional<std::string> SceneObject::optional_string(const std::string& key) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) return std::nullopt;
+  if (!value->is_string()) fail_expected(key, "a string");
+  return value->get<std::string>();
+}
+
+std::string SceneObject::string(const std::string& key, const std::string& fallback) {
+  if (auto v = optional_string(key)) return *v;
+  (*node_)[key] = fallback;
+  return fallback;
+}
+
+std::string SceneObject::choice(const std::string& key, const std::string& fallback,
+                                const std::vector<std::string>& choices) {
+  const std::string v = string(key, fallback);
+  if (std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
+  std::string expected = "one of";
+  for (size_t i = 0; i < choices.size(); ++i) expected += (i ? ", \"" : " \"") + choices[i] + "\"";
+  const std::string near = closest_match(v, choices);
+  fail(key, "expected " + expected + ", got " + describe_json(*find(key)) +
+                (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+}
+
+std::optional<Eigen::Vector3d> SceneObject::optional_vector3(const std::string& key) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) return std::nullopt;
+  Eigen::Vector3d v;
+  bool ok = value->is_array() && value->size() == 3;
+  for (int i = 0; ok && i < 3; ++i) ok = as_finite_number((*value)[i], &v[i]);
+  if (!ok) fail_expected(key, "an array of 3 finite numbers");
+  return v;
+}
+
+Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector3d& fallback) {
+  if (auto v = optional_vector3(key)) return *v;
+  (*node_)[key] = Json::array({fallback.x(), fallback.y(), fallback.z()});
+  return fallback;
+}
+
+std::optional<std::filesystem::path> SceneObject::optional_path(const std::string& key) {
+  auto text = optional_string(key);
+  if (!text) return std::nullopt;
+  if (text->empty()) fail_expected(key, "a non-empty path");
+  std::filesystem::path p(*text);
+  return p.is_absolute() ? p : (reader_->scene_dir() / p).lexically_normal();
+}
+
+SceneObject SceneObject::object(const std::string& key) {
+  declare(key);
+  Json* value = node_->contains(key) ? &(*node_)[key] : nullptr;
+  if (!value || value->is_null()) {
+    (*node_)[key] = Json::object();
+    value = &(*node_)[key];
+  }
+  if (!value->is_object()) fail_expected(key, "an object");
+  return SceneObject(reader_, value, pointer_of(key));
+}
+
+std::vector<SceneObject> SceneObject::array_of_objects(const std::string& key) {
+  declare(key);
+  Json* value = node_->contains(key) ? &(*node_)[key] : nullptr;
+  if (!value || value->is_null()) {
+    (*node_)[key] = Json::array();
+    value = &(*node_)[key];
+  }
+  if (!value->is_array()) fail_expected(key, "an array of objects");
+  std::vector<SceneObject> out;
+  for (size_t i = 0; i < value->size(); ++i) {
+    Json& element = (*value)[i];
+    const std::string element_pointer = pointer_of(key) + "/" + std::to_string(i);
+    if (!element.is_object())
+      throw InputError(element_pointer + ": expected an object, got " + describe_json(element));
+    out.emplace_back(reader_, &element, element_pointer);
+  }
+  return out;
+}
+
+const Json* SceneObject::raw(const std::string& key) {
+  declare(key);
+  const Json* value = find(key);
+  return value && !value->is_null() ? value : nullptr;
+}
+
+SceneReader::SceneReader(Json& root, std::filesystem::path scene_dir)
+    : root_(root), scene_dir_(std::move(scene_dir)) {
+  if (!root_.is_object()) throw InputError(": expected a JSON object at the top level, got " + describe_json(root_));
+}
+
+SceneObject SceneReader::root() { return SceneObject(this, &root_, ""); }
+
+void SceneReader::register_object(const std::string& object_pointer) {
+  valid_keys_.try_emplace(object_pointer);
+}
+
+void SceneReader::register_key(const std::string& object_pointer, const std::string& key) {
+  auto& keys = valid_keys_[object_pointer];
+  if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+}
+
+void SceneReader::check_object(const Json& node, const std::string& pointer) const {
+  auto known = valid_keys_.find(pointer);
+  if (known == valid_keys_.end()) return;  // free-form (read raw by its stage)
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string child = pointer + "/" + escape_pointer_token(it.key());
+    const auto& keys = known->second;
+    if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
+      const std::string near = closest_match(it.key(), keys);
+      throw InputError(child + ": unknown key" +
+                       (near.empty() ? "" : " (did you mean " + pointer + "/" +
+                                                escape_pointer_token(near) + "?)"));
+    }
+    if (it->is_object()) check_object(*it, child);
+    if (it->is_array())
+      for (size_t i = 0; i < it->size(); ++i)
+        if ((*it)[i].is_object()) check_object((*it)[i], child + "/" + std::to_string(i));
+  }
+}
+
+void SceneReader::check_unknown_keys() const { check_object(root_, ""); }
+
+}  // namespace treeanim

@@ -1,0 +1,117 @@
+#pragma once
+// Typed, validated access to one JSON scene, for the options readers of every stage.
+//
+// Each read names the key, its default and its valid range. A missing key gets its default
+// written into the JSON, so after all readers ran the document is the *resolved* scene that
+// outputs record. Every key read (or declared optional) is registered as valid for its object;
+// SceneReader::check_unknown_keys() then reports the first key nobody asked for, with the
+// closest valid key: "/wind/sped: unknown key (did you mean /wind/speed?)".
+//
+// Messages: "<pointer>: expected <what>, got <value>". The caller prefixes the file name.
+#include <Eigen/Core>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace treeanim {
+
+using Json = nlohmann::ordered_json;
+
+// Inclusive or exclusive bounds of a numeric value.
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;  // true: value must be > lo
+  bool hi_open = false;  // true: value must be < hi
+  static Range any() { return {}; }
+  static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static Range non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Range between(double lo, double hi) { return {lo, hi, false, false}; }
+  static Range at_least(double lo) { return {lo, std::numeric_limits<double>::infinity(), false, false}; }
+  bool contains(double v) const;
+  std::string describe() const;  // "a number in [0, 1]", "a number > 0", ...
+};
+
+class SceneReader;
+
+// One JSON object of the scene (a section such as /wind, or an element of /outputs).
+class SceneObject {
+ public:
+  SceneObject(SceneReader* reader, Json* node, std::string pointer);
+
+  double number(const std::string& key, double fallback, Range range = Range::any());
+  std::optional<double> optional_number(const std::string& key, Range range = Range::any());
+  long long integer(const std::string& key, long long fallback, long long lo, long long hi);
+  std::optional<long long> optional_integer(const std::string& key, long long lo, long long hi);
+  bool boolean(const std::string& key, bool fallback);
+  std::string string(const std::string& key, const std::string& fallback);
+  std::optional<std::string> optional_string(const std::string& key);
+  // One of `choices`; the message lists them.
+  std::string choice(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& choices);
+  Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback);
+  std::optional<Eigen::Vector3d> optional_vector3(const std::string& key);
+  // A path string resolved against the scene file's folder (absolute paths kept).
+  std::optional<std::filesystem::path> optional_path(const std::string& key);
+
+  // Nested object; created as {} when missing. Its keys are checked for unknowns too.
+  SceneObject object(const std::string& key);
+  bool has(const std::string& key) const;
+  // Array whose elements must all be objects; [] when missing (and written as []).
+  std::vector<SceneObject> array_of_objects(const std::string& key);
+  // A value the caller parses itself (free-form maps, strings lists); nullptr when missing.
+  // Its content is not checked for unknown keys.
+  const Json* raw(const std::string& key);
+
+  // Declares `key` valid without reading it (read elsewhere, e.g. by another stage).
+  void declare(const std::string& key);
+  // "<pointer>/<key>" with JSON-pointer escaping.
+  std::string pointer_of(const std::string& key) const;
+  const std::string& pointer() const { return pointer_; }
+  // Throws InputError "<pointer>/<key>: <message>".
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  // Throws InputError "<pointer>/<key>: expected <expected>, got <value>".
+  [[noreturn]] void fail_expected(const std::string& key, const std::string& expected) const;
+
+ private:
+  const Json* find(const std::string& key) const;
+  SceneReader* reader_;
+  Json* node_;
+  std::string pointer_;
+};
+
+class SceneReader {
+ public:
+  // root: the scene document (modified in place to the resolved scene).
+  // scene_dir: folder that relative paths are resolved against.
+  SceneReader(Json& root, std::filesystem::path scene_dir);
+
+  SceneObject root();
+  const std::filesystem::path& scene_dir() const { return scene_dir_; }
+  // Throws InputError for the first key (in document order) no reader declared.
+  void check_unknown_keys() const;
+  // Called by SceneObject: marks key valid for the object at pointer.
+  void register_key(const std::string& object_pointer, const std::string& key);
+  void register_object(const std::string& object_pointer);
+
+ private:
+  void check_object(const Json& node, const std::string& pointer) const;
+  Json& root_;
+  std::filesystem::path scene_dir_;
+  std::map<std::string, std::vector<std::string>> valid_keys_;  // object pointer => keys
+};
+
+// Compact one-line rendering of a JSON value for messages (strings quoted, long values cut).
+std::string describe_json(const Json& value);
+// JSON-pointer escaping of one reference token ("~" => "~0", "/" => "~1").
+std::string escape_pointer_token(const std::string& token);
+// Levenshtein edit distance, for did-you-mean suggestions.
+size_t edit_distance(const std::string& a, const std::string& b);
+// The closest candidate to `word`, or "" when none is close enough to suggest.
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace treeanim

@@ -1,0 +1,64 @@
+#pragma once
+// Stage entry point of io/: every output of a bake, written on a writer thread behind a
+// bounded queue so writing never stalls the solver. Each sink writes to a temporary name
+// beside its target and renames it when complete; abort() removes every temporary.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/output_options.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+// What the sinks record about the bake besides the frames.
+struct BakeInfo {
+  std::string scene_json;      // resolved scene (defaults filled in)
+  std::string generator;       // "treeanim <version>"
+  double fps = 24;
+  long long frame_start = 0;   // first frame index written
+  long long frame_count = 0;   // frames the bake will hand to push()
+  int substeps = 1;
+  uint64_t seed = 0;
+};
+
+// One simulated frame, converted to float for output.
+struct FrameData {
+  long long frame = 0;                 // absolute frame index
+  double time = 0;                     // s
+  std::vector<float> positions;        // (V*3) m
+  std::vector<float> velocities;       // (V*3) m/s; empty unless some output asked for them
+  std::vector<uint8_t> leaf_attached;  // (L)
+};
+
+class OutputSet {
+ public:
+  // Resolves relative paths against out_dir (when not empty), checks every target (folder
+  // exists or can be made, writable, format limits such as 4 GiB GLB) before simulation.
+  // Throws InputError for bad options, OutputError naming the path for unwritable targets.
+  OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
+            const TreeModel& model, const BakeInfo& info);
+  ~OutputSet();  // abort()s when finish() was not reached
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  bool wants_velocities() const;
+  // Opens temporaries, writes headers and the rest mesh; starts the writer thread.
+  void begin();
+  // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.
+  void push(FrameData frame);
+  // Drains the queue, closes files, renames temporaries to their final names.
+  void finish();
+  // Stops the writer and removes every temporary. Never throws.
+  void abort() noexcept;
+  // Final paths (files, or the first file of a sequence pattern) for the summary line.
+  std::vector<std::filesystem::path> final_paths() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace treeanim

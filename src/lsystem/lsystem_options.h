@@ -1,0 +1,29 @@
+#pragma once
+// Scene section /lsystem (docs/scene.md). Owned by lsystem/; more fields may be added.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/scene_reader.h"
+
+namespace treeanim {
+
+struct LsystemOptions {
+  std::optional<std::filesystem::path> grammar;  // grammar file, resolved against the scene folder
+  std::string axiom;                             // inline grammar (when no file)
+  std::vector<std::string> productions;          // inline productions, one rule per string
+  std::vector<std::pair<std::string, double>> defines;  // override #define values
+  std::optional<int> iterations;                 // overrides "derivation length:"
+  uint64_t seed = 1;                             // stochastic productions, ran(), nran()
+  double step = 1.0;                             // length of an F without parameter (scene units)
+  std::optional<double> angle;                   // overrides "angle:" (degrees)
+  size_t max_modules = 20'000'000;               // derivation stops with an error beyond this
+};
+
+// /lsystem section => options. scene_seed is the top-level /seed (the default for lsystem.seed).
+LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed);
+
+}  // namespace treeanim

@@ -1,0 +1,51 @@
+#pragma once
+// Stage entry point of scene/: a scene file (+ --set overrides) => validated options of every
+// stage and the resolved scene JSON (defaults filled in) that outputs record.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/scene_reader.h"
+#include "io/output_options.h"
+#include "lsystem/lsystem_options.h"
+#include "sim/sim_options.h"
+#include "tree/tree_options.h"
+
+namespace treeanim {
+
+// Scene section /time.
+struct TimeOptions {
+  double fps = 24;          // frames per second
+  long long frames = 120;   // frames simulated (and written)
+  long long start = 0;      // index of the first frame; frame k is at time k / fps
+  int substeps = 4;         // solver steps per frame
+};
+
+struct Scene {
+  std::filesystem::path file;  // the scene file ("" when loaded from text)
+  Json resolved;               // the scene with every default filled in
+  uint64_t seed = 1;           // /seed, the default of every per-purpose seed
+  LsystemOptions lsystem;
+  TreeOptions tree;
+  SimOptions hsm;
+  WindOptions wind;
+  TimeOptions time;
+  std::vector<OutputOptions> outputs;
+};
+
+// Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a
+// string). Missing intermediate objects are created. Throws InputError on a malformed override.
+void apply_override(Json& document, const std::string& assignment);
+
+// Parses JSON text; syntax errors become InputError "name:line:column: ...".
+Json parse_scene_json(const std::string& text, const std::string& name);
+
+// Loads, overrides, validates. Errors: InputError "file: /pointer: message" (exit 2).
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+// Same from text; relative paths resolve against base_dir. `name` prefixes messages.
+Scene load_scene_text(const std::string& text, const std::string& name,
+                      const std::filesystem::path& base_dir,
+                      const std::vector<std::string>& overrides);
+
+}  // namespace treeanim

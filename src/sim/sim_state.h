@@ -1,0 +1,17 @@
+#pragma once
+// SimState: everything that changes during a bake (DESIGN.md; MuJoCo's mjData). Small enough
+// to checkpoint; the TreeModel it belongs to is read-only. sim/ may add fields.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace treeanim {
+
+struct SimState {
+  Eigen::Matrix3Xd positions;               // (3 x V) m
+  Eigen::Matrix3Xd velocities;              // (3 x V) m/s
+  std::vector<uint8_t> leaf_attached;       // (L) 1 while the leaf hangs on its branch
+  double time = 0;                          // s
+};
+
+}  // namespace treeanim

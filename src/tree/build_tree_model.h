@@ -1,0 +1,11 @@
+#pragma once
+#include "lsystem/skeleton.h"
+#include "tree/tree_model.h"
+#include "tree/tree_options.h"
+
+namespace treeanim {
+
+// skeleton (scene units) + tree options => immutable TreeModel (m, kg): mesh, clusters, masses.
+TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options);
+
+}  // namespace treeanim
