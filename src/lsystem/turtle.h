@@ -1,0 +1,22 @@
+#pragma once
+// The 3D turtle (lpfg conventions, DESIGN.md): module string => Skeleton.
+#include <Eigen/Core>
+
+#include "lsystem/module_string.h"
+#include "lsystem/skeleton.h"
+
+namespace treeanim {
+
+struct TurtleSettings {
+  double step = 1.0;                          // length of F/G/f/g without a parameter
+  double angle_degrees = 90.0;                // δ of + - & ^ \ / without a parameter
+  double width_factor = 0.707;                // '!' without a parameter multiplies the width by this
+  Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
+  double tropism_elasticity = 0.0;            // e; 0 = no tropism
+};
+
+// Initial frame H=(0,1,0) L=(-1,0,0) U=(0,0,1) at the origin; +(90)F(1) ends at (-1,0,0),
+// &(90)F(1) at (0,0,-1). word => skeleton (scene units).
+Skeleton interpret(const ModuleString& word, const TurtleSettings& settings);
+
+}  // namespace treeanim
