@@ -97,7 +97,7 @@ std::string SceneObject::pointer_of(const std::string& key) const {
 }
 
 void SceneObject::fail(const std::string& key, const std::string& message) const {
-  throw InputError(pointer_of(key) + ": " + message);
+  reader_->fail(pointer_of(key), message);
 }
 
 void SceneObject::fail_expected(const std::string& key, const std::string& expected) const {
@@ -234,7 +234,7 @@ std::vector<SceneObject> SceneObject::array_of_objects(const std::string& key) {
     Json& element = (*value)[i];
     const std::string element_pointer = pointer_of(key) + "/" + std::to_string(i);
     if (!element.is_object())
-      throw InputError(element_pointer + ": expected an object, got " + describe_json(element));
+      reader_->fail(element_pointer, "expected an object, got " + describe_json(element));
     out.emplace_back(reader_, &element, element_pointer);
   }
   return out;
@@ -246,9 +246,14 @@ const Json* SceneObject::raw(const std::string& key) {
   return value && !value->is_null() ? value : nullptr;
 }
 
-SceneReader::SceneReader(Json& root, std::filesystem::path scene_dir)
-    : root_(root), scene_dir_(std::move(scene_dir)) {
-  if (!root_.is_object()) throw InputError(": expected a JSON object at the top level, got " + describe_json(root_));
+SceneReader::SceneReader(Json& root, std::filesystem::path scene_dir, std::string source_name)
+    : root_(root), scene_dir_(std::move(scene_dir)), source_name_(std::move(source_name)) {
+  if (!root_.is_object()) fail("", "expected a JSON object at the top level, got " + describe_json(root_));
+}
+
+void SceneReader::fail(const std::string& pointer, const std::string& message) const {
+  const std::string where = pointer.empty() ? std::string("/") : pointer;
+  throw InputError((source_name_.empty() ? "" : source_name_ + ": ") + where + ": " + message);
 }
 
 SceneObject SceneReader::root() { return SceneObject(this, &root_, ""); }
@@ -270,9 +275,9 @@ void SceneReader::check_object(const Json& node, const std::string& pointer) con
     const auto& keys = known->second;
     if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
       const std::string near = closest_match(it.key(), keys);
-      throw InputError(child + ": unknown key" +
-                       (near.empty() ? "" : " (did you mean " + pointer + "/" +
-                                                escape_pointer_token(near) + "?)"));
+      fail(child, "unknown key" + (near.empty() ? std::string()
+                                                : " (did you mean " + pointer + "/" +
+                                                      escape_pointer_token(near) + "?)"));
     }
     if (it->is_object()) check_object(*it, child);
     if (it->is_array())

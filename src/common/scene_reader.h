@@ -88,10 +88,13 @@ class SceneReader {
  public:
   // root: the scene document (modified in place to the resolved scene).
   // scene_dir: folder that relative paths are resolved against.
-  SceneReader(Json& root, std::filesystem::path scene_dir);
+  // source_name: prefixes every message ("scene.json: /time/fps: ..."); may be empty.
+  SceneReader(Json& root, std::filesystem::path scene_dir, std::string source_name = "");
 
   SceneObject root();
   const std::filesystem::path& scene_dir() const { return scene_dir_; }
+  // Throws InputError "<source>: <pointer>: <message>".
+  [[noreturn]] void fail(const std::string& pointer, const std::string& message) const;
   // Throws InputError for the first key (in document order) no reader declared.
   void check_unknown_keys() const;
   // Called by SceneObject: marks key valid for the object at pointer.
@@ -102,6 +105,7 @@ class SceneReader {
   void check_object(const Json& node, const std::string& pointer) const;
   Json& root_;
   std::filesystem::path scene_dir_;
+  std::string source_name_;
   std::map<std::string, std::vector<std::string>> valid_keys_;  // object pointer => keys
 };
 

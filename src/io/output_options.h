@@ -1,5 +1,5 @@
 #pragma once
-// Scene /outputs elements (docs/scene.md). Owned by io/; fields are added as sinks need.
+// Scene /outputs elements (docs/scene-outputs.md). Owned by io/; fields are added as sinks need.
 #include <filesystem>
 #include <string>
 
@@ -11,9 +11,16 @@ struct OutputOptions {
   std::string format;              // "hdf5" | "obj" | "gltf" | "glb" | "pc2"
   std::filesystem::path path;      // as written in the scene; resolved by OutputSet
   int frame_step = 1;              // write every k-th frame
+  int compression = 0;             // hdf5: 0 none, 1..9 shuffle + deflate level
+  bool velocities = false;         // hdf5: also write /frames/velocities
+  std::string pointer;             // "/outputs/N", for messages about this element
 };
 
-// One element of /outputs => options.
+// The formats /outputs/N/format accepts.
+inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2"};
+
+// One element of /outputs => options. Keys that do not apply to the format are left
+// undeclared, so the scene reader reports them as unknown.
 OutputOptions read_output_options(SceneObject element);
 
 }  // namespace treeanim

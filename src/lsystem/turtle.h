@@ -11,12 +11,15 @@ struct TurtleSettings {
   double step = 1.0;                          // length of F/G/f/g without a parameter
   double angle_degrees = 90.0;                // δ of + - & ^ \ / without a parameter
   double width_factor = 0.707;                // '!' without a parameter multiplies the width by this
+  double initial_width = 1.0;                 // diameter before the first '!(w)' when the word uses '!' at all
   Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
   double tropism_elasticity = 0.0;            // e; 0 = no tropism
 };
 
 // Initial frame H=(0,1,0) L=(-1,0,0) U=(0,0,1) at the origin; +(90)F(1) ends at (-1,0,0),
-// &(90)F(1) at (0,0,-1). word => skeleton (scene units).
+// &(90)F(1) at (0,0,-1). word => skeleton (scene units). The symbol table is docs/turtle.md;
+// symbols the turtle does not know are structural and ignored. Accepts any word: a ']'
+// without its '[' and an unclosed '{' are ignored (the grammar checks brackets).
 Skeleton interpret(const ModuleString& word, const TurtleSettings& settings);
 
 }  // namespace treeanim

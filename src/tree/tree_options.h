@@ -1,8 +1,26 @@
 #pragma once
-// Scene section /tree (docs/scene.md). Owned by tree/; fields are added as the mesher needs.
+// Scene section /tree (docs/scene-tree.md). Owned by tree/; fields are added as the mesher needs.
+#include <filesystem>
+#include <optional>
+
 #include "common/scene_reader.h"
 
 namespace treeanim {
+
+// /tree/leaf: the shape instanced on every L / ~ module without a '{ . }' outline.
+struct LeafOptions {
+  double size = 0.08;           // m, leaf blade length (a custom mesh's largest extent)
+  double aspect = 0.5;          // blade width / length of the default quad
+  double petiole = 0.01;        // m, gap between the attachment point and the blade base
+  double areal_density = 0.15;  // kg/m^2, leaf mass per blade area
+  std::optional<std::filesystem::path> mesh;  // custom leaf mesh (any format assimp reads)
+};
+
+// /tree/cluster: how consecutive segments of one axis are merged into shape-matching clusters.
+struct ClusterOptions {
+  int segments_per_cluster = 1;  // segments of one axis per branch cluster (at most)
+  int target_vertices = 0;       // > 0: also close a cluster before it exceeds this many members
+};
 
 struct TreeOptions {
   double scale = 1.0;          // metres per scene unit
@@ -10,6 +28,10 @@ struct TreeOptions {
   double trunk_radius = 0.1;   // m, trunk base radius when the grammar sets no widths
   double min_radius = 0.002;   // m, no branch thinner
   double wood_density = 700;   // kg/m^3
+  double pipe_exponent = 2.0;  // k of the pipe model r_parent^k = sum r_child^k
+  double tip_taper = 0.5;      // top / base radius of a segment that ends an axis
+  LeafOptions leaf;
+  ClusterOptions cluster;
 };
 
 // /tree section => options.

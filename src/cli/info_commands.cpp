@@ -1,0 +1,59 @@
+#include <cstdio>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "cli/prepare_tree.h"
+
+namespace treeanim {
+
+namespace {
+
+void print_counts(const Json& summary) {
+  std::printf("modules %lld after %d iterations; %lld segments, %lld leaves\n",
+              summary["derivation"]["modules"].get<long long>(),
+              summary["derivation"]["iterations"].get<int>(),
+              summary["skeleton"]["segments"].get<long long>(),
+              summary["skeleton"]["leaves"].get<long long>());
+  std::printf("mesh %lld vertices, %lld triangles; %lld clusters, %lld memberships, %.3f kg\n",
+              summary["mesh"]["vertices"].get<long long>(),
+              summary["mesh"]["triangles"].get<long long>(),
+              summary["model"]["clusters"].get<long long>(),
+              summary["model"]["memberships"].get<long long>(),
+              summary["model"]["mass_kg"].get<double>());
+}
+
+}  // namespace
+
+int validate_command(const std::filesystem::path& scene_file,
+                     const std::vector<std::string>& overrides) {
+  const Scene scene = load_scene(scene_file, overrides);
+  const PreparedTree tree = prepare_tree(scene);
+  print_counts(tree_summary(scene, tree));
+  std::printf("%s: OK\n", scene_file.string().c_str());
+  return 0;
+}
+
+int info_command(const std::filesystem::path& scene_file, const std::vector<std::string>& overrides,
+                 bool as_json) {
+  const Scene scene = load_scene(scene_file, overrides);
+  const PreparedTree tree = prepare_tree(scene);
+  const Json summary = tree_summary(scene, tree);
+  if (as_json) {
+    std::cout << summary.dump(2) << "\n";
+    return 0;
+  }
+  print_counts(summary);
+  const Json& box_min = summary["skeleton"]["bbox_min"];
+  const Json& box_max = summary["skeleton"]["bbox_max"];
+  std::printf("skeleton length %.4g, bbox [%g %g %g] .. [%g %g %g] (scene units)\n",
+              summary["skeleton"]["total_length"].get<double>(), box_min[0].get<double>(),
+              box_min[1].get<double>(), box_min[2].get<double>(), box_max[0].get<double>(),
+              box_max[1].get<double>(), box_max[2].get<double>());
+  std::printf("bake: %lld frames x %d substeps; %.1f KiB of positions per frame, %.1f MiB in all\n",
+              scene.time.frames, scene.time.substeps,
+              summary["estimate"]["bytes_per_frame"].get<double>() / 1024.0,
+              summary["estimate"]["bytes_positions_total"].get<double>() / (1024.0 * 1024.0));
+  return 0;
+}
+
+}  // namespace treeanim

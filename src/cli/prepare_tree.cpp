@@ -1,0 +1,74 @@
+#include "cli/prepare_tree.h"
+
+#include <chrono>
+#include <limits>
+
+#include "tree/build_tree_model.h"
+
+namespace treeanim {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Json to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+PreparedTree prepare_tree(const Scene& scene) {
+  PreparedTree tree;
+  auto start = std::chrono::steady_clock::now();
+  tree.skeleton = grow_skeleton(scene.lsystem, &tree.growth);
+  tree.grow_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  tree.model = build_tree_model(tree.skeleton, scene.tree);
+  validate_tree_model(tree.model);
+  tree.model_seconds = seconds_since(start);
+  return tree;
+}
+
+Json tree_summary(const Scene& scene, const PreparedTree& tree) {
+  const Skeleton& skeleton = tree.skeleton;
+  const TreeModel& model = tree.model;
+
+  double total_length = 0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (size_t s = 0; s < skeleton.segment_count(); ++s) {
+    total_length += (skeleton.segment_end[s] - skeleton.segment_start[s]).norm();
+    for (const Eigen::Vector3d& p : {skeleton.segment_start[s], skeleton.segment_end[s]}) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  if (skeleton.segment_count() == 0) lo = hi = Eigen::Vector3d::Zero();
+
+  double mass = 0;
+  for (double m : model.vertex_mass) mass += m;
+  const long long bytes_per_frame = static_cast<long long>(model.vertex_count()) * 3 * 4;
+
+  Json summary;
+  summary["derivation"] = {{"modules", tree.growth.modules}, {"iterations", tree.growth.iterations}};
+  summary["skeleton"] = {{"segments", skeleton.segment_count()},
+                         {"leaves", skeleton.leaf_count()},
+                         {"total_length", total_length},
+                         {"bbox_min", to_json(lo)},
+                         {"bbox_max", to_json(hi)}};
+  summary["mesh"] = {{"vertices", model.vertex_count()}, {"triangles", model.triangle_count()}};
+  summary["model"] = {{"clusters", model.cluster_count()},
+                      {"memberships", model.membership_count()},
+                      {"leaf_clusters", model.leaf_count()},
+                      {"anchored_vertices",
+                       std::count(model.vertex_anchored.begin(), model.vertex_anchored.end(), 1)},
+                      {"mass_kg", mass}};
+  summary["estimate"] = {{"frames", scene.time.frames},
+                         {"substeps_total", scene.time.frames * scene.time.substeps},
+                         {"bytes_per_frame", bytes_per_frame},
+                         {"bytes_positions_total", bytes_per_frame * scene.time.frames}};
+  summary["timing"] = {{"grow_seconds", tree.grow_seconds}, {"model_seconds", tree.model_seconds}};
+  return summary;
+}
+
+}  // namespace treeanim

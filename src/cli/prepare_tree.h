@@ -1,0 +1,24 @@
+#pragma once
+// Shared front half of run, validate and info: scene => skeleton => tree model.
+#include "lsystem/lsystem.h"
+#include "scene/scene.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+struct PreparedTree {
+  GrowthStats growth;
+  Skeleton skeleton;       // scene units
+  TreeModel model;         // m, kg; validated
+  double grow_seconds = 0;   // derivation + turtle
+  double model_seconds = 0;  // mesh, clusters, masses
+};
+
+// scene => derived skeleton and validated TreeModel. Throws InputError.
+PreparedTree prepare_tree(const Scene& scene);
+
+// Counts and estimates of `info --json` (DESIGN keys: derivation.*, skeleton.*, mesh.*, model.*,
+// estimate.*).
+Json tree_summary(const Scene& scene, const PreparedTree& tree);
+
+}  // namespace treeanim

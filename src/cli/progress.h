@@ -1,0 +1,31 @@
+#pragma once
+// Progress of a bake on stderr: a redrawn bar with frames/s and ETA on a terminal, one line
+// about every 5% in a log (not a TTY), nothing when quiet.
+#include <chrono>
+#include <cstdio>
+
+namespace treeanim {
+
+enum class Verbosity { kQuiet, kNormal, kVerbose };
+
+class Progress {
+ public:
+  // total: frames the bake simulates; out: usually stderr.
+  Progress(long long total, Verbosity verbosity, std::FILE* out);
+  // Reports that `done` frames of `total` are complete.
+  void update(long long done);
+  // Ends the bar line (terminal) after the last update.
+  void finish();
+
+ private:
+  double elapsed() const;
+  long long total_;
+  std::FILE* out_;
+  bool enabled_;
+  bool terminal_;
+  int last_percent_step_ = -1;   // log mode: last 5% step printed
+  double last_draw_ = -1;        // terminal mode: seconds at the last redraw
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace treeanim

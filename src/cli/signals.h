@@ -1,0 +1,12 @@
+#pragma once
+// SIGINT / SIGTERM during a bake: the handler only records the signal; the run loop polls it
+// between frames, aborts the outputs (removing temporaries) and exits 130 / 143.
+
+namespace treeanim {
+
+// Installs handlers for SIGINT and SIGTERM (idempotent).
+void install_interrupt_handlers();
+// The signal number received since installation, or 0.
+int pending_signal();
+
+}  // namespace treeanim

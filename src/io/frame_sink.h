@@ -1,0 +1,67 @@
+#pragma once
+// FrameSink (DESIGN.md): one output format. OutputSet drives each sink from its own writer
+// thread: begin() once, write() for every selected frame in order, then finish() or abort().
+// Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/output_options.h"
+#include "io/outputs.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+// Which frames of the bake an output writes: frame_start, then every step-th frame.
+struct FrameSelection {
+  long long start = 0;  // first frame index of the bake
+  long long count = 0;  // frames the bake pushes
+  long long step = 1;   // write every step-th of them
+  bool wants(long long frame) const { return (frame - start) % step == 0; }
+  long long written() const { return (count + step - 1) / step; }
+};
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // Every file the sink will create, final names (checked and de-duplicated before simulating).
+  virtual std::vector<std::filesystem::path> targets() const = 0;
+  // Opens the temporaries and writes what does not change over frames.
+  virtual void begin() = 0;
+  // Appends one selected frame. Throws OutputError naming the path.
+  virtual void write(const FrameData& frame) = 0;
+  // Completes the files and renames every temporary to its final name.
+  virtual void finish() = 0;
+  // Closes and removes every temporary. Never throws.
+  virtual void abort() noexcept = 0;
+};
+
+// A frame-numbered file name: "<prefix><frame, zero-padded to width><suffix>".
+struct SequencePattern {
+  std::string prefix;  // folder and name up to the frame number
+  std::string suffix;  // after the frame number, e.g. ".obj"
+  int width = 4;       // zero padding of the frame number
+  std::filesystem::path frame(long long index) const;
+  std::filesystem::path rest() const;  // the number replaced by "rest"
+};
+
+// An output path => its sequence pattern. A path with one "%d" or "%0Nd" field keeps it;
+// any other path gets ".%04d<extension>" appended (after dropping a trailing `extension`).
+// Throws InputError "<pointer>/path: ..." for other '%' fields.
+SequencePattern sequence_pattern(const std::filesystem::path& path, const std::string& extension,
+                                 const std::string& pointer);
+
+// The sink for `options.format`; `path` is the output path resolved against the out folder.
+std::unique_ptr<FrameSink> make_hdf5_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_obj_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                         const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_gltf_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                         const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                         const TreeModel& model, const BakeInfo& info);
+
+}  // namespace treeanim

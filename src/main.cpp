@@ -1,0 +1,103 @@
+// treeanim command-line front end: parses arguments (CLI11), runs a subcommand and maps the
+// error types of common/errors.h to the exit codes of DESIGN.md.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.h"
+#include "common/errors.h"
+#include "treeanim_version.h"
+
+namespace {
+
+using namespace treeanim;
+
+int report(const char* kind, const std::exception& error, int code) {
+  std::fprintf(stderr, "treeanim: %s%s\n", kind, error.what());
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"treeanim " TREEANIM_VERSION
+               " - grows trees from L-systems and bakes their motion in wind with hierarchical "
+               "shape matching"};
+  app.set_version_flag("--version", "treeanim " TREEANIM_VERSION);
+  app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success, 2 bad input, 3 simulation failed, 4 output failed, 130/143 "
+      "interrupted.\nRun 'treeanim SUBCOMMAND --help' for examples.");
+
+  RunRequest run;
+  bool quiet = false, verbose = false;
+  CLI::App* run_app = app.add_subcommand("run", "Simulate a scene and write its outputs");
+  run_app->add_option("scene", run.scene, "Scene file (JSON)")->required();
+  run_app->add_option("-o,--out", run.out_dir,
+                      "Folder that relative output paths are resolved against (created if needed)");
+  run_app->add_option("--frames", run.frames,
+                      "Write only frames START:END (inclusive); the simulation still starts at "
+                      "time.start");
+  run_app->add_option("--threads", run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
+      ->check(CLI::Range(1, 1024));
+  run_app->add_option("--set", run.overrides,
+                      "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
+                      "JSON or a plain string; repeatable");
+  CLI::Option* quiet_flag = run_app->add_flag("-q,--quiet", quiet, "No progress or summary");
+  run_app->add_flag("-v,--verbose", verbose, "Stage timings and details")->excludes(quiet_flag);
+  run_app->footer(
+      "Examples:\n"
+      "  treeanim run configs/demo.json\n"
+      "  treeanim run configs/demo.json -o out/ --frames 0:47 --threads 2\n"
+      "  treeanim run scene.json --set lsystem.iterations=6 --set time.substeps=8 --quiet");
+
+  std::filesystem::path validate_scene;
+  std::vector<std::string> validate_overrides;
+  CLI::App* validate_app =
+      app.add_subcommand("validate", "Load the scene, derive the tree and build the model; no simulation");
+  validate_app->add_option("scene", validate_scene, "Scene file (JSON)")->required();
+  validate_app->add_option("--set", validate_overrides, "Override a scene value: PATH=VALUE");
+  validate_app->footer(
+      "Examples:\n"
+      "  treeanim validate configs/demo.json\n"
+      "  treeanim validate scene.json --set lsystem.iterations=8");
+
+  std::filesystem::path info_scene;
+  std::vector<std::string> info_overrides;
+  bool info_json = false;
+  CLI::App* info_app = app.add_subcommand("info", "Print counts (modules, segments, vertices, clusters) and estimates");
+  info_app->add_option("scene", info_scene, "Scene file (JSON)")->required();
+  info_app->add_option("--set", info_overrides, "Override a scene value: PATH=VALUE");
+  info_app->add_flag("--json", info_json, "Print one JSON object");
+  info_app->footer(
+      "Examples:\n"
+      "  treeanim info configs/table1-13548.json\n"
+      "  treeanim info configs/demo.json --json | jq .mesh.vertices");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+
+  try {
+    if (*run_app) {
+      run.verbosity = quiet ? Verbosity::kQuiet : verbose ? Verbosity::kVerbose : Verbosity::kNormal;
+      return run_command(run);
+    }
+    if (*validate_app) return validate_command(validate_scene, validate_overrides);
+    return info_command(info_scene, info_overrides, info_json);
+  } catch (const InputError& error) {
+    return report("error: ", error, kExitInput);
+  } catch (const SimulationError& error) {
+    return report("simulation failed: ", error, kExitSimulation);
+  } catch (const OutputError& error) {
+    return report("output failed: ", error, kExitOutput);
+  } catch (const std::bad_alloc& error) {
+    return report("out of memory: ", error, kExitSimulation);
+  } catch (const std::exception& error) {
+    // Not a documented failure: a bug. Report it rather than abort with a core dump.
+    return report("internal error: ", error, kExitSimulation);
+  }
+}
