@@ -1,21 +1,62 @@
 #pragma once
-// Scene sections /hsm and /wind (docs/scene.md). Owned by sim/; fields are added as needed.
+// Scene sections /hsm and /wind (docs/scene-hsm.md, docs/scene-wind.md). Owned by sim/.
+#include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/scene_reader.h"
 
 namespace treeanim {
 
+// How the solver's per-step rates are obtained (docs/solver.md, "Stiffness").
+enum class StiffnessMode : uint8_t {
+  kPhysical,  // frequencies from branch geometry, Young's modulus and mass, converted per step
+  kPerStep,   // the paper's alpha and k_d, used as given at every step
+};
+
 struct SimOptions {
   // Filled from /hsm by read_sim_options.
-  bool global_matching = true;
+  bool global_matching = true;           // paper Eq. 8 on/off
+  StiffnessMode stiffness = StiffnessMode::kPhysical;
+  double alpha = 0.5;                    // per-step local rate (kPerStep), [0, 1]
+  double k_d = 0.02;                     // per-step global rate (kPerStep), [0, 1]
+  double leaf_alpha = 1.0;               // per-step local rate of leaf clusters (both modes), [0, 1]
+  double youngs_modulus = 8e9;           // Pa, wood (kPhysical)
+  double global_scale = 1.0;             // multiplies the limb stiffness of the global term (kPhysical)
+  double damping_ratio = 0.1;            // structural damping ratio of the limb mode
+  double leaf_detach_force = 0;          // N; 0 = leaves never detach
+  Eigen::Vector3d gravity{0, -9.81, 0};  // m/s^2, acts on detached leaves only
+  bool sleep = true;                     // resting islands in calm air skip all work
+  double sleep_velocity = 1e-6;          // m/s, every vertex slower than this ...
+  double sleep_distance = 1e-6;          // m, ... and closer than this to rest => island sleeps
+  int rotation_iterations = 12;          // max iterations of the rotation extraction per step
+};
+
+// One key of the wind time series; between keys the wind vector speed*direction and the gust
+// amplitude are interpolated linearly, before the first / after the last key they are held.
+struct WindKey {
+  double time = 0;                       // s
+  double speed = 0;                      // m/s, >= 0
+  Eigen::Vector3d direction{1, 0, 0};    // unit vector (normalised when read)
+  double gust = 0;                       // m/s, amplitude of the temporal gusting along the wind
 };
 
 struct WindOptions {
   // Filled from /wind by read_wind_options (keys or a CSV file, turbulence, drag).
-  std::optional<std::filesystem::path> file;
+  std::optional<std::filesystem::path> file;  // the CSV the keys came from, if any
+  std::vector<WindKey> keys;                  // strictly increasing times; empty = calm
+  double air_density = 1.225;                 // kg/m^3
+  double branch_drag_coefficient = 1.2;       // Cd of a cylinder across the flow
+  double leaf_drag_coefficient = 0.6;         // Cd of a leaf (flat plate, partly streamlined)
+  double turbulence_intensity = 0.25;         // rms of each component / mean speed
+  double turbulence_length = 4.0;             // m, length scale of the eddies
+  double turbulence_frequency = 0.3;          // Hz, how fast the frozen field evolves in place
+  int turbulence_modes = 8;                   // sinusoidal modes summed
+  double gust_frequency = 0.2;                // Hz, typical gust rate
+  uint64_t seed = 1;                          // turbulence and gusts
 };
 
 // /hsm section => solver options.
@@ -23,5 +64,9 @@ SimOptions read_sim_options(SceneObject section);
 // /wind section => wind options. scene_seed is the top-level /seed (turbulence default).
 // A wind CSV is read here, so its errors (file:line) surface with the other input errors.
 WindOptions read_wind_options(SceneObject section, uint64_t scene_seed);
+
+// CSV text (header "time,speed,dx,dy,dz[,gust]") => keys. `name` prefixes errors
+// ("name:line: ..."). Throws InputError.
+std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name);
 
 }  // namespace treeanim

@@ -1,0 +1,311 @@
+// HDF5 bake (DESIGN.md "HDF5 bake layout", format_version 1): the model once, then
+// /frames/* extended by one frame per write(), one frame per chunk, so a bake streams to disk
+// and a reader can pull any frame with one chunk read.
+#include <hdf5.h>
+
+#include <array>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "common/errors.h"
+#include "io/frame_sink.h"
+#include "io/staged_files.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The Debian HDF5 library is not built thread-safe; sinks run on their own threads, so every
+// HDF5 call of every HDF5 sink holds this lock.
+std::mutex hdf5_lock;
+
+// The innermost message of HDF5's error stack (e.g. the errno text of a failed write).
+std::string hdf5_error_text() {
+  std::string text;
+  auto walk = [](unsigned, const H5E_error2_t* error, void* data) -> herr_t {
+    auto* out = static_cast<std::string*>(data);
+    if (out->empty() && error->desc) *out = error->desc;
+    return 0;
+  };
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk, &text);
+  H5Eclear2(H5E_DEFAULT);
+  return text;
+}
+
+// Owns one HDF5 identifier and closes it with the matching H5?close.
+class Handle {
+ public:
+  Handle() = default;
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Handle(Handle&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
+  Handle& operator=(Handle&& other) noexcept {
+    std::swap(id_, other.id_);
+    std::swap(close_, other.close_);
+    return *this;
+  }
+  ~Handle() { reset(); }
+  hid_t get() const { return id_; }
+  // Closes now; returns false when HDF5 reports a failure (a flush that did not reach disk).
+  bool reset() {
+    const bool ok = id_ < 0 || close_(id_) >= 0;
+    id_ = -1;
+    return ok;
+  }
+
+ private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+class Hdf5Sink final : public FrameSink {
+ public:
+  Hdf5Sink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
+      : options_(options), path_(std::move(path)), model_(model), info_(info) {}
+
+  std::vector<fs::path> targets() const override { return {path_}; }
+
+  void begin() override {
+    std::lock_guard lock(hdf5_lock);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become OutputError, not stderr noise
+    const fs::path temporary = staged_.stage(path_);
+    file_ = Handle(check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                         "create the file"), H5Fclose);
+    write_root_attributes();
+    write_string_dataset(file_.get(), "scene", info_.scene_json);
+    write_mesh();
+    write_model();
+    write_skeleton();
+    create_frame_datasets();
+  }
+
+  void write(const FrameData& frame) override {
+    std::lock_guard lock(hdf5_lock);
+    const hsize_t n = model_.vertex_count(), k = frames_written_;
+    append(time_.get(), {k}, {1}, H5T_NATIVE_DOUBLE, &frame.time);
+    append(positions_.get(), {k, n, 3}, {1, n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
+    if (options_.velocities)
+      append(velocities_.get(), {k, n, 3}, {1, n, 3}, H5T_NATIVE_FLOAT, frame.velocities.data());
+    if (leaf_attached_.get() >= 0)
+      append(leaf_attached_.get(), {k, model_.leaf_count()}, {1, model_.leaf_count()},
+             H5T_NATIVE_UINT8, frame.leaf_attached.data());
+    ++frames_written_;
+  }
+
+  void finish() override {
+    {
+      std::lock_guard lock(hdf5_lock);
+      bool ok = close_datasets();
+      ok = file_.reset() && ok;
+      if (!ok) fail("close the file");
+    }
+    staged_.commit();
+  }
+
+  void abort() noexcept override {
+    {
+      std::lock_guard lock(hdf5_lock);
+      close_datasets();
+      file_.reset();
+      H5Eclear2(H5E_DEFAULT);
+    }
+    staged_.discard();
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    const std::string detail = hdf5_error_text();
+    throw OutputError(path_.string() + ": HDF5 could not " + what +
+                      (detail.empty() ? "" : " (" + detail + ")"));
+  }
+  hid_t check(hid_t id, const std::string& what) const {
+    if (id < 0) fail(what);
+    return id;
+  }
+  void check_status(herr_t status, const std::string& what) const {
+    if (status < 0) fail(what);
+  }
+
+  // A variable-length UTF-8 string type (h5py reads it as str).
+  Handle string_type() const {
+    Handle type(check(H5Tcopy(H5T_C_S1), "make a string type"), H5Tclose);
+    check_status(H5Tset_size(type.get(), H5T_VARIABLE), "make a string type");
+    check_status(H5Tset_cset(type.get(), H5T_CSET_UTF8), "make a string type");
+    return type;
+  }
+
+  void write_attribute(const char* name, hid_t file_type, hid_t memory_type, const void* value) const {
+    Handle space(check(H5Screate(H5S_SCALAR), "make a scalar space"), H5Sclose);
+    Handle attribute(check(H5Acreate2(file_.get(), name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                           std::string("create attribute ") + name), H5Aclose);
+    check_status(H5Awrite(attribute.get(), memory_type, value), std::string("write attribute ") + name);
+  }
+  void write_string_attribute(const char* name, const std::string& value) const {
+    const Handle type = string_type();
+    const char* text = value.c_str();
+    write_attribute(name, type.get(), type.get(), &text);
+  }
+
+  void write_root_attributes() const {
+    const int32_t version = 1, substeps = info_.substeps;
+    const int64_t frame_start = info_.frame_start;
+    const uint64_t seed = info_.seed;
+    write_string_attribute("format", "treeanim");
+    write_attribute("format_version", H5T_STD_I32LE, H5T_NATIVE_INT32, &version);
+    write_string_attribute("generator", info_.generator);
+    write_attribute("fps", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &info_.fps);
+    write_attribute("frame_start", H5T_STD_I64LE, H5T_NATIVE_INT64, &frame_start);
+    write_attribute("substeps", H5T_STD_I32LE, H5T_NATIVE_INT32, &substeps);
+    write_string_attribute("units", "m");
+    write_string_attribute("up_axis", "Y");
+    write_attribute("seed", H5T_STD_U64LE, H5T_NATIVE_UINT64, &seed);
+  }
+
+  void write_string_dataset(hid_t group, const char* name, const std::string& value) const {
+    const Handle type = string_type();
+    Handle space(check(H5Screate(H5S_SCALAR), "make a scalar space"), H5Sclose);
+    Handle dataset(check(H5Dcreate2(group, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                         std::string("create /") + name), H5Dclose);
+    const char* text = value.c_str();
+    check_status(H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &text),
+                 std::string("write /") + name);
+  }
+
+  Handle create_group(const char* name) const {
+    return Handle(check(H5Gcreate2(file_.get(), name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                        std::string("create group ") + name), H5Gclose);
+  }
+
+  // A fixed-size dataset written at once; `data` holds dims' product elements of memory_type.
+  void write_array(hid_t group, const std::string& name, hid_t file_type, hid_t memory_type,
+                   std::vector<hsize_t> dims, const void* data) const {
+    Handle space(check(H5Screate_simple(int(dims.size()), dims.data(), nullptr), "make a space for " + name),
+                 H5Sclose);
+    Handle dataset(check(H5Dcreate2(group, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                                    H5P_DEFAULT), "create " + name), H5Dclose);
+    hsize_t total = 1;
+    for (hsize_t d : dims) total *= d;
+    if (total > 0)
+      check_status(H5Dwrite(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "write " + name);
+  }
+
+  void write_mesh() const {
+    const Handle group = create_group("/mesh");
+    const hsize_t n = model_.vertex_count();
+    std::vector<float> rest(model_.rest_positions.data(), model_.rest_positions.data() + 3 * n);
+    write_array(group.get(), "rest_positions", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {n, 3}, rest.data());
+    write_array(group.get(), "triangles", H5T_STD_U32LE, H5T_NATIVE_UINT32, {model_.triangle_count(), 3},
+                model_.triangles.data());
+  }
+
+  void write_model() const {
+    const Handle group = create_group("/model");
+    const hid_t g = group.get();
+    write_array(g, "mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {model_.vertex_count()}, model_.vertex_mass.data());
+    write_array(g, "anchored", H5T_STD_U8LE, H5T_NATIVE_UINT8, {model_.vertex_count()},
+                model_.vertex_anchored.data());
+    write_array(g, "cluster_offsets", H5T_STD_U32LE, H5T_NATIVE_UINT32, {model_.cluster_offsets.size()},
+                model_.cluster_offsets.data());
+    write_array(g, "cluster_members", H5T_STD_U32LE, H5T_NATIVE_UINT32, {model_.cluster_members.size()},
+                model_.cluster_members.data());
+    write_array(g, "cluster_kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, {model_.cluster_kind.size()},
+                model_.cluster_kind.data());
+  }
+
+  void write_skeleton() const {
+    const Handle group = create_group("/skeleton");
+    const hid_t g = group.get();
+    const size_t s = model_.segment_count();
+    std::vector<float> start(3 * s), end(3 * s), radius(2 * s);
+    for (size_t i = 0; i < s; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        start[3 * i + a] = float(model_.segment_start[i][a]);
+        end[3 * i + a] = float(model_.segment_end[i][a]);
+      }
+      radius[2 * i] = float(model_.segment_radius_base[i]);
+      radius[2 * i + 1] = float(model_.segment_radius_top[i]);
+    }
+    write_array(g, "segment_start", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {s, 3}, start.data());
+    write_array(g, "segment_end", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {s, 3}, end.data());
+    write_array(g, "segment_radius", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {s, 2}, radius.data());
+    write_array(g, "segment_parent", H5T_STD_I32LE, H5T_NATIVE_INT32, {s}, model_.segment_parent.data());
+    write_array(g, "segment_cluster", H5T_STD_U32LE, H5T_NATIVE_UINT32, {s}, model_.segment_cluster.data());
+  }
+
+  // An extendible dataset [0, frame_shape...] with one frame per chunk; shuffle + deflate when
+  // compression > 0.
+  Handle create_frame_dataset(hid_t group, const char* name, hid_t file_type, std::vector<hsize_t> frame_shape,
+                              hsize_t frames_per_chunk, bool compress) const {
+    std::vector<hsize_t> dims{0}, max_dims{H5S_UNLIMITED}, chunk{frames_per_chunk};
+    for (hsize_t d : frame_shape) {
+      dims.push_back(d);
+      max_dims.push_back(d);
+      chunk.push_back(d);
+    }
+    Handle space(check(H5Screate_simple(int(dims.size()), dims.data(), max_dims.data()), "make a frame space"),
+                 H5Sclose);
+    Handle properties(check(H5Pcreate(H5P_DATASET_CREATE), "make dataset properties"), H5Pclose);
+    check_status(H5Pset_chunk(properties.get(), int(chunk.size()), chunk.data()), std::string("chunk ") + name);
+    if (compress) {
+      check_status(H5Pset_shuffle(properties.get()), "enable shuffle");
+      check_status(H5Pset_deflate(properties.get(), unsigned(options_.compression)), "enable deflate");
+    }
+    return Handle(check(H5Dcreate2(group, name, file_type, space.get(), H5P_DEFAULT, properties.get(),
+                                   H5P_DEFAULT), std::string("create /frames/") + name), H5Dclose);
+  }
+
+  void create_frame_datasets() {
+    const Handle group = create_group("/frames");
+    const hid_t g = group.get();
+    const hsize_t n = model_.vertex_count();
+    const bool compress = options_.compression > 0;
+    // Times are tiny: 1024 per chunk keeps the chunk index small for long bakes.
+    time_ = create_frame_dataset(g, "time", H5T_IEEE_F64LE, {}, 1024, false);
+    positions_ = create_frame_dataset(g, "positions", H5T_IEEE_F32LE, {n, 3}, 1, compress);
+    if (options_.velocities)
+      velocities_ = create_frame_dataset(g, "velocities", H5T_IEEE_F32LE, {n, 3}, 1, compress);
+    if (model_.leaf_count() > 0)
+      leaf_attached_ = create_frame_dataset(g, "leaf_attached", H5T_STD_U8LE, {model_.leaf_count()}, 1, compress);
+  }
+
+  // Grows `dataset` to frame k + 1 and writes `count` (one frame) at `start`.
+  void append(hid_t dataset, std::vector<hsize_t> start, std::vector<hsize_t> count, hid_t memory_type,
+              const void* data) const {
+    std::vector<hsize_t> dims = count;
+    dims[0] = start[0] + 1;
+    check_status(H5Dset_extent(dataset, dims.data()), "extend a frame dataset");
+    Handle file_space(check(H5Dget_space(dataset), "get a frame space"), H5Sclose);
+    check_status(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+                 "select a frame");
+    Handle memory_space(check(H5Screate_simple(int(count.size()), count.data(), nullptr), "make a frame space"),
+                        H5Sclose);
+    check_status(H5Dwrite(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT, data),
+                 "write frame " + std::to_string(start[0]));
+  }
+
+  bool close_datasets() {
+    bool ok = time_.reset();
+    ok = positions_.reset() && ok;
+    ok = velocities_.reset() && ok;
+    return leaf_attached_.reset() && ok;
+  }
+
+  OutputOptions options_;
+  fs::path path_;
+  const TreeModel& model_;
+  BakeInfo info_;
+  StagedFiles staged_;
+  Handle file_, time_, positions_, velocities_, leaf_attached_;
+  hsize_t frames_written_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSink> make_hdf5_sink(const OutputOptions& options, const fs::path& path,
+                                          const TreeModel& model, const BakeInfo& info) {
+  return std::make_unique<Hdf5Sink>(options, path, model, info);
+}
+
+}  // namespace treeanim

@@ -1,0 +1,316 @@
+// The 3D turtle (lpfg conventions, docs/turtle.md): module string => Skeleton.
+//
+// One pass over the word with the turtle state in locals: no allocation per module (the
+// skeleton is reserved from symbol counts, the bracket stack grows to the deepest nesting
+// once), and the sin/cos of turn angles come from a small cache because grammars reuse a
+// handful of angles. Rotation signs are lpfg's "corrected rotation" ones, pinned by the
+// golden tests: + turns H toward L, & pitches H toward -U, \ rolls L toward -U.
+#include "lsystem/turtle.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace treeanim {
+namespace {
+
+using Eigen::Vector3d;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+// |V x H| below this means H is vertical: every L is then already horizontal, so '$' keeps it.
+constexpr double kVerticalTolerance = 1e-12;
+// |H x T| below this means H is parallel to T: no bending torque.
+constexpr double kTropismTolerance = 1e-12;
+// Material indices are clamped to [0, kMaxMaterial] so that any parameter converts safely.
+constexpr double kMaxMaterial = 1e6;
+
+// Everything '[' saves and ']' restores.
+struct State {
+  Vector3d position{0, 0, 0};
+  Vector3d heading{0, 1, 0};  // H
+  Vector3d left{-1, 0, 0};    // L
+  Vector3d up{0, 0, 1};       // U = H x L
+  double width = std::numeric_limits<double>::quiet_NaN();  // diameter, scene units
+  int32_t material = 0;
+  int32_t segment = -1;   // last segment drawn on this path: the parent of the next one
+  bool branched = false;  // a '[' was opened since `segment` was drawn
+};
+
+// A '{' not yet closed: the turtle state at the '{' (the leaf's base and frame) and where its
+// outline starts in the shared vertex buffer (nested polygons stack their vertices there).
+struct OpenPolygon {
+  State at_open;
+  size_t first_point = 0;
+};
+
+struct SinCos {
+  double c = 1.0;
+  double s = 0.0;
+};
+
+// angle (degrees) => cos, sin; 16 direct-mapped entries keyed by the angle's bits.
+class SinCosCache {
+ public:
+  SinCos get(double degrees) {
+    const uint64_t bits = std::bit_cast<uint64_t>(degrees);
+    Entry& e = entries_[(bits * 0x9E3779B97F4A7C15ull) >> 60];
+    if (e.bits != bits) e = {bits, {std::cos(degrees * kDegToRad), std::sin(degrees * kDegToRad)}};
+    return e.value;
+  }
+
+ private:
+  struct Entry {
+    uint64_t bits = 0;  // +0.0 degrees, whose value {1, 0} is the default below
+    SinCos value;
+  };
+  std::array<Entry, 16> entries_{};
+};
+
+// Rotates the orthonormal pair (a, b) in its plane by the angle (c, s): a' = c a + s b, b' = c b - s a.
+inline void rotate_pair(Vector3d& a, Vector3d& b, SinCos r) {
+  const Vector3d a0 = a;
+  a = r.c * a0 + r.s * b;
+  b = r.c * b - r.s * a0;
+}
+
+// v, unit axis k, angle (c, s) => v rotated right-handedly about k (Rodrigues).
+inline Vector3d rotate_about(const Vector3d& v, const Vector3d& k, SinCos r) {
+  return r.c * v + r.s * k.cross(v) + ((1.0 - r.c) * k.dot(v)) * k;
+}
+
+// frame => the nearest orthonormal right-handed frame keeping H's direction (rounding drift).
+inline void orthonormalise(State& t) {
+  t.heading.normalize();
+  t.left = (t.left - t.left.dot(t.heading) * t.heading).normalized();
+  t.up = t.heading.cross(t.left);
+}
+
+// '$' (ABOP p.57): L = V x H / |V x H| with V = (0,1,0) opposite to gravity, U = H x L.
+inline void roll_to_horizontal(State& t) {
+  const Vector3d left = Vector3d(0, 1, 0).cross(t.heading);
+  const double norm = left.norm();
+  if (norm < kVerticalTolerance) return;
+  t.left = left / norm;
+  t.up = t.heading.cross(t.left);
+}
+
+// Tropism after a drawn segment (ABOP p.58): rotate the frame about H x T by e |H x T|.
+inline void bend_toward(State& t, const Vector3d& tropism, double elasticity) {
+  const Vector3d axis = t.heading.cross(tropism);
+  const double norm = axis.norm();
+  if (norm < kTropismTolerance) return;
+  const Vector3d k = axis / norm;
+  const double angle = elasticity * norm;
+  const SinCos r{std::cos(angle), std::sin(angle)};
+  t.heading = rotate_about(t.heading, k, r);
+  t.left = rotate_about(t.left, k, r);
+  orthonormalise(t);
+}
+
+// parameter p => material index, rounded and clamped to [0, kMaxMaterial] (NaN => 0).
+inline int32_t material_index(double p) {
+  if (!(p > 0.0)) return 0;
+  return static_cast<int32_t>(std::lround(std::min(p, kMaxMaterial)));
+}
+
+// symbols, index of a '%' => index of the ']' closing its branch (or the word's size).
+size_t end_of_branch(const std::vector<char>& symbols, size_t cut) {
+  int depth = 0;
+  for (size_t j = cut + 1; j < symbols.size(); ++j) {
+    if (symbols[j] == '[') {
+      ++depth;
+    } else if (symbols[j] == ']') {
+      if (depth == 0) return j;
+      --depth;
+    }
+  }
+  return symbols.size();
+}
+
+class Turtle {
+ public:
+  Turtle(const ModuleString& word, const TurtleSettings& settings)
+      : word_(word),
+        settings_(settings),
+        default_turn_{std::cos(settings.angle_degrees * kDegToRad),
+                      std::sin(settings.angle_degrees * kDegToRad)},
+        bends_(settings.tropism_elasticity != 0.0) {
+    reserve_outputs();
+  }
+
+  // word => skeleton: one switch per module.
+  Skeleton run() {
+    const std::vector<char>& symbols = word_.symbols;
+    const size_t n = symbols.size();
+    for (size_t i = 0; i < n; ++i) {
+      switch (symbols[i]) {
+        case 'F': forward(i, /*draws=*/true, /*records=*/true); break;
+        case 'G': forward(i, /*draws=*/true, /*records=*/false); break;
+        case 'f': forward(i, /*draws=*/false, /*records=*/true); break;
+        case 'g': forward(i, /*draws=*/false, /*records=*/false); break;
+        case '+': rotate_pair(s_.heading, s_.left, turn(i, 1.0)); break;
+        case '-': rotate_pair(s_.heading, s_.left, turn(i, -1.0)); break;
+        case '&': rotate_pair(s_.up, s_.heading, turn(i, 1.0)); break;
+        case '^': rotate_pair(s_.up, s_.heading, turn(i, -1.0)); break;
+        case '\\': rotate_pair(s_.up, s_.left, turn(i, 1.0)); break;
+        case '/': rotate_pair(s_.up, s_.left, turn(i, -1.0)); break;
+        case '|':
+          s_.heading = -s_.heading;
+          s_.left = -s_.left;
+          break;
+        case '$': roll_to_horizontal(s_); break;
+        case '[':
+          stack_.push_back(s_);
+          s_.branched = true;
+          break;
+        case ']':
+          if (!stack_.empty()) {
+            s_ = stack_.back();
+            stack_.pop_back();
+          }
+          break;
+        case '!': s_.width = has_param(i) ? first_param(i) : s_.width * settings_.width_factor; break;
+        case '\'': s_.material = has_param(i) ? material_index(first_param(i)) : s_.material + 1; break;
+        case ',':
+          s_.material = has_param(i) ? material_index(first_param(i)) : std::max(s_.material - 1, 0);
+          break;
+        case 'L':
+        case '~': add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {}); break;
+        case '{': polygons_.push_back({s_, points_.size()}); break;
+        case '.':
+          if (!polygons_.empty()) points_.push_back(s_.position);
+          break;
+        case '}': close_polygon(); break;
+        case '%': i = end_of_branch(symbols, i) - 1; break;  // the loop's ++i lands on the ']'
+        default: break;  // structural module (A, B, X ...): nothing to draw
+      }
+    }
+    return std::move(out_);
+  }
+
+ private:
+  bool has_param(size_t i) const { return word_.param_offsets[i] != word_.param_offsets[i + 1]; }
+  double first_param(size_t i) const { return word_.params[word_.param_offsets[i]]; }
+
+  // module i, sign => cos/sin of its turn angle (its parameter, else the default δ).
+  SinCos turn(size_t i, double sign) {
+    const SinCos r = has_param(i) ? angles_.get(first_param(i)) : default_turn_;
+    return {r.c, sign * r.s};
+  }
+
+  // F G f g at module i. Inside '{ }' they only move (F and f recording a vertex, ABOP ch. 5);
+  // outside, F and G draw a segment and f and g move.
+  void forward(size_t i, bool draws, bool records) {
+    const double length = has_param(i) ? first_param(i) : settings_.step;
+    if (!polygons_.empty()) {
+      s_.position += length * s_.heading;
+      if (records) points_.push_back(s_.position);
+    } else if (draws) {
+      draw_segment(static_cast<uint32_t>(i), length);
+    } else {
+      s_.position += length * s_.heading;
+    }
+  }
+
+  // module index, length => one segment appended (parents precede children), then tropism.
+  void draw_segment(uint32_t module, double length) {
+    Skeleton& k = out_;
+    const int32_t parent = s_.segment;
+    const bool continues = parent >= 0 && !s_.branched && s_.position == k.segment_end[parent];
+    const int32_t order = parent < 0 ? 0 : k.segment_order[parent] + (s_.branched ? 1 : 0);
+    k.segment_start.push_back(s_.position);
+    s_.position += length * s_.heading;
+    k.segment_end.push_back(s_.position);
+    k.segment_up.push_back(s_.up);
+    k.segment_width.push_back(s_.width);
+    k.segment_parent.push_back(parent);
+    k.segment_continues_parent.push_back(continues ? 1 : 0);
+    k.segment_order.push_back(order);
+    k.segment_id.push_back(module);
+    k.segment_material.push_back(s_.material);
+    s_.segment = static_cast<int32_t>(k.segment_start.size() - 1);
+    s_.branched = false;
+    if (bends_) bend_toward(s_, settings_.tropism, settings_.tropism_elasticity);
+  }
+
+  // turtle state, scale, outline (empty: default leaf shape) => one leaf on the state's segment.
+  void add_leaf(const State& at, double scale, std::span<const Vector3d> outline) {
+    Skeleton& k = out_;
+    k.leaf_segment.push_back(at.segment);
+    k.leaf_position.push_back(at.position);
+    k.leaf_heading.push_back(at.heading);
+    k.leaf_left.push_back(at.left);
+    k.leaf_up.push_back(at.up);
+    k.leaf_scale.push_back(scale);
+    k.polygon_points.insert(k.polygon_points.end(), outline.begin(), outline.end());
+    k.leaf_polygon_offsets.push_back(static_cast<uint32_t>(k.polygon_points.size()));
+  }
+
+  // '}': the innermost open polygon becomes a leaf based at its '{' if it has an area
+  // (>= 3 vertices; fewer would read as "default leaf shape" downstream, so they are dropped).
+  void close_polygon() {
+    if (polygons_.empty()) return;
+    const OpenPolygon open = polygons_.back();
+    polygons_.pop_back();
+    const std::span<const Vector3d> outline(points_.data() + open.first_point,
+                                            points_.size() - open.first_point);
+    if (outline.size() >= 3) add_leaf(open.at_open, 1.0, outline);
+    points_.resize(open.first_point);
+  }
+
+  // Reserves the skeleton from symbol counts (F/G bound the segments, L ~ { the leaves) and
+  // starts widths at settings.initial_width when the word uses '!' (else they stay NaN).
+  void reserve_outputs() {
+    const std::vector<char>& symbols = word_.symbols;
+    const auto count = [&](char c) { return static_cast<size_t>(std::count(symbols.begin(), symbols.end(), c)); };
+    const size_t segments = count('F') + count('G');
+    const size_t leaves = count('L') + count('~') + count('{');
+    if (std::memchr(symbols.data(), '!', symbols.size()) != nullptr) s_.width = settings_.initial_width;
+    Skeleton& k = out_;
+    k.segment_start.reserve(segments);
+    k.segment_end.reserve(segments);
+    k.segment_up.reserve(segments);
+    k.segment_width.reserve(segments);
+    k.segment_parent.reserve(segments);
+    k.segment_continues_parent.reserve(segments);
+    k.segment_order.reserve(segments);
+    k.segment_id.reserve(segments);
+    k.segment_material.reserve(segments);
+    k.leaf_segment.reserve(leaves);
+    k.leaf_position.reserve(leaves);
+    k.leaf_heading.reserve(leaves);
+    k.leaf_left.reserve(leaves);
+    k.leaf_up.reserve(leaves);
+    k.leaf_scale.reserve(leaves);
+    k.leaf_polygon_offsets.reserve(leaves + 1);
+    k.leaf_polygon_offsets.push_back(0);
+  }
+
+  const ModuleString& word_;
+  const TurtleSettings& settings_;
+  const SinCos default_turn_;  // cos, sin of settings.angle_degrees
+  const bool bends_;           // tropism on
+  State s_;
+  std::vector<State> stack_;          // '[' states, innermost last
+  std::vector<OpenPolygon> polygons_; // open '{', innermost last
+  std::vector<Vector3d> points_;      // vertices of the open polygons, outer ones first
+  SinCosCache angles_;
+  Skeleton out_;
+};
+
+}  // namespace
+
+Skeleton interpret(const ModuleString& word, const TurtleSettings& settings) {
+  return Turtle(word, settings).run();
+}
+
+}  // namespace treeanim

@@ -1,0 +1,163 @@
+// End to end: the built treeanim binary, its exit codes, messages and outputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("treeanim-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+            "-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  }
+  Result run(const std::string& args) {
+    const std::string command = std::string(TREEANIM_BINARY) + " " + args + " >" +
+                                (dir_ / "stdout").string() + " 2>" + (dir_ / "stderr").string();
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir_ / "stdout"), slurp(dir_ / "stderr")};
+  }
+  fs::path dir_;
+};
+
+// Three unit segments straight up, one bake output.
+const char* kLine = R"({
+  "lsystem": {"axiom": "FFF", "iterations": 0},
+  "time": {"fps": 24, "frames": 5, "substeps": 2},
+  "wind": {"keys": [{"time": 0, "speed": 4, "direction": [1, 0, 0]}]},
+  "outputs": [{"format": "hdf5", "path": "bake.h5"}]
+})";
+
+TEST_F(Cli, VersionAndHelp) {
+  Result r = run("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("treeanim ", 0), 0u) << r.out;
+  r = run("run --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("Examples:"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("frobnicate x").code, 2);
+  EXPECT_EQ(run("run").code, 2);
+  EXPECT_EQ(run("run a.json --threads 0").code, 2);
+}
+
+TEST_F(Cli, MissingSceneExitsTwoWithThePath) {
+  const Result r = run("run " + (dir_ / "nope.json").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find((dir_ / "nope.json").string() + ": cannot read the scene file (no such file)"),
+            std::string::npos) << r.err;
+}
+
+TEST_F(Cli, BadSceneExitsTwoAndWritesNothing) {
+  const fs::path scene = write("bad.json", R"({"lsystem": {"axiom": "F"}, "time": {"fsp": 3},
+    "outputs": [{"format": "hdf5", "path": "bake.h5"}]})");
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/time/fsp: unknown key (did you mean /time/fps?)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(Cli, InfoJsonGivesExactSkeletonCounts) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("info --json " + scene.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto info = nlohmann::json::parse(r.out);
+  EXPECT_EQ(info["derivation"]["modules"], 3);
+  EXPECT_EQ(info["derivation"]["iterations"], 0);
+  EXPECT_EQ(info["skeleton"]["segments"], 3);
+  EXPECT_EQ(info["skeleton"]["leaves"], 0);
+  EXPECT_NEAR(info["skeleton"]["total_length"].get<double>(), 3.0, 1e-12);
+  EXPECT_NEAR(info["skeleton"]["bbox_max"][1].get<double>(), 3.0, 1e-12);
+  EXPECT_NEAR(info["skeleton"]["bbox_min"][1].get<double>(), 0.0, 1e-12);
+  EXPECT_GT(info["mesh"]["vertices"].get<long long>(), 0);
+  EXPECT_EQ(info["estimate"]["bytes_per_frame"], info["mesh"]["vertices"].get<long long>() * 12);
+  for (const char* key : {"triangles"}) EXPECT_TRUE(info["mesh"].contains(key));
+  for (const char* key : {"clusters", "memberships", "mass_kg"}) EXPECT_TRUE(info["model"].contains(key));
+}
+
+TEST_F(Cli, SetOverridesASceneValue) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("info --json " + scene.string() + " --set lsystem.axiom=FFFFF");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["skeleton"]["segments"], 5);
+}
+
+TEST_F(Cli, ValidatePrintsOk) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("validate " + scene.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(": OK"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, FramesOutsideTheSceneExitTwo) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() + " --frames 3:9");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--frames '3:9': expected START:END with 0 <= START <= END <= 4"),
+            std::string::npos) << r.err;
+}
+
+TEST_F(Cli, RunWritesTheBakeAndNoTemporaries) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() + " --threads 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("baked 5 frames"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "bake.h5"));
+  for (const auto& entry : fs::directory_iterator(dir_ / "out"))
+    EXPECT_EQ(entry.path().filename(), "bake.h5") << "left over: " << entry.path();
+}
+
+TEST_F(Cli, QuietPrintsNothing) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+}
+
+TEST_F(Cli, LogModePrintsAboutEveryFivePercent) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() +
+                       " --set time.frames=40");
+  ASSERT_EQ(r.code, 0) << r.err;
+  size_t lines = 0;
+  for (size_t at = r.err.find("progress:"); at != std::string::npos; at = r.err.find("progress:", at + 1)) ++lines;
+  EXPECT_GE(lines, 15u) << r.err;
+  EXPECT_LE(lines, 21u) << r.err;
+  EXPECT_NE(r.err.find("progress: 100%"), std::string::npos) << r.err;
+}
+
+}  // namespace
