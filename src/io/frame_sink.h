@@ -1,7 +1,9 @@
 #pragma once
-// FrameSink (DESIGN.md): one output format. OutputSet drives each sink from its own writer
-// thread: begin() once, write() for every selected frame in order, then finish() or abort().
+// FrameSink (DESIGN.md): one output format. OutputSet calls begin() once, write() for every
+// selected frame in order (on the sink's own writer thread), then finish() and, once every
+// sink finished, commit(); or abort() at any point.
 // Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -9,6 +11,7 @@
 
 #include "io/output_options.h"
 #include "io/outputs.h"
+#include "io/staged_files.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -27,14 +30,25 @@ class FrameSink {
   virtual ~FrameSink() = default;
   // Every file the sink will create, final names (checked and de-duplicated before simulating).
   virtual std::vector<std::filesystem::path> targets() const = 0;
+  // The files named in the run's summary (a sequence's first frame stands for the rest).
+  virtual std::vector<std::filesystem::path> summary_paths() const {
+    std::vector<std::filesystem::path> paths = targets();
+    paths.resize(std::min<size_t>(paths.size(), 1));
+    return paths;
+  }
   // Opens the temporaries and writes what does not change over frames.
   virtual void begin() = 0;
   // Appends one selected frame. Throws OutputError naming the path.
   virtual void write(const FrameData& frame) = 0;
-  // Completes the files and renames every temporary to its final name.
-  virtual void finish() = 0;
+  // Completes and closes the temporaries.
+  virtual void finish() {}
+  // Renames every temporary to its final name.
+  void commit() { staged_.commit(); }
   // Closes and removes every temporary. Never throws.
-  virtual void abort() noexcept = 0;
+  virtual void abort() noexcept { staged_.discard(); }
+
+ protected:
+  StagedFiles staged_;  // this sink's temporaries and their final names
 };
 
 // A frame-numbered file name: "<prefix><frame, zero-padded to width><suffix>".

@@ -20,7 +20,14 @@ namespace {
 
 // The Debian HDF5 library is not built thread-safe; sinks run on their own threads, so every
 // HDF5 call of every HDF5 sink holds this lock.
-std::mutex hdf5_lock;
+std::mutex hdf5_mutex;
+
+// Takes the lock and turns HDF5's own error printing off (failures become OutputError).
+std::unique_lock<std::mutex> hdf5_lock() {
+  std::unique_lock lock(hdf5_mutex);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  return lock;
+}
 
 // The innermost message of HDF5's error stack (e.g. the errno text of a failed write).
 std::string hdf5_error_text() {
@@ -68,8 +75,7 @@ class Hdf5Sink final : public FrameSink {
   std::vector<fs::path> targets() const override { return {path_}; }
 
   void begin() override {
-    std::lock_guard lock(hdf5_lock);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become OutputError, not stderr noise
+    const auto lock = hdf5_lock();
     const fs::path temporary = staged_.stage(path_);
     file_ = Handle(check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
                          "create the file"), H5Fclose);
@@ -82,31 +88,26 @@ class Hdf5Sink final : public FrameSink {
   }
 
   void write(const FrameData& frame) override {
-    std::lock_guard lock(hdf5_lock);
-    const hsize_t n = model_.vertex_count(), k = frames_written_;
-    append(time_.get(), {k}, {1}, H5T_NATIVE_DOUBLE, &frame.time);
-    append(positions_.get(), {k, n, 3}, {1, n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
-    if (options_.velocities)
-      append(velocities_.get(), {k, n, 3}, {1, n, 3}, H5T_NATIVE_FLOAT, frame.velocities.data());
+    const auto lock = hdf5_lock();
+    const hsize_t n = model_.vertex_count();
+    append(time_.get(), {}, H5T_NATIVE_DOUBLE, &frame.time);
+    append(positions_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
+    if (options_.velocities) append(velocities_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.velocities.data());
     if (leaf_attached_.get() >= 0)
-      append(leaf_attached_.get(), {k, model_.leaf_count()}, {1, model_.leaf_count()},
-             H5T_NATIVE_UINT8, frame.leaf_attached.data());
+      append(leaf_attached_.get(), {model_.leaf_count()}, H5T_NATIVE_UINT8, frame.leaf_attached.data());
     ++frames_written_;
   }
 
   void finish() override {
-    {
-      std::lock_guard lock(hdf5_lock);
-      bool ok = close_datasets();
-      ok = file_.reset() && ok;
-      if (!ok) fail("close the file");
-    }
-    staged_.commit();
+    const auto lock = hdf5_lock();
+    bool ok = close_datasets();
+    ok = file_.reset() && ok;
+    if (!ok) fail("close the file");
   }
 
   void abort() noexcept override {
     {
-      std::lock_guard lock(hdf5_lock);
+      const auto lock = hdf5_lock();
       close_datasets();
       file_.reset();
       H5Eclear2(H5E_DEFAULT);
@@ -270,11 +271,12 @@ class Hdf5Sink final : public FrameSink {
       leaf_attached_ = create_frame_dataset(g, "leaf_attached", H5T_STD_U8LE, {model_.leaf_count()}, 1, compress);
   }
 
-  // Grows `dataset` to frame k + 1 and writes `count` (one frame) at `start`.
-  void append(hid_t dataset, std::vector<hsize_t> start, std::vector<hsize_t> count, hid_t memory_type,
-              const void* data) const {
-    std::vector<hsize_t> dims = count;
-    dims[0] = start[0] + 1;
+  // Grows `dataset` [k, frame_shape...] by one frame and writes `data` (one frame) there.
+  void append(hid_t dataset, const std::vector<hsize_t>& frame_shape, hid_t memory_type, const void* data) const {
+    std::vector<hsize_t> start(frame_shape.size() + 1, 0), count{1}, dims{frames_written_ + 1};
+    start[0] = frames_written_;
+    count.insert(count.end(), frame_shape.begin(), frame_shape.end());
+    dims.insert(dims.end(), frame_shape.begin(), frame_shape.end());
     check_status(H5Dset_extent(dataset, dims.data()), "extend a frame dataset");
     Handle file_space(check(H5Dget_space(dataset), "get a frame space"), H5Sclose);
     check_status(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
@@ -296,7 +298,6 @@ class Hdf5Sink final : public FrameSink {
   fs::path path_;
   const TreeModel& model_;
   BakeInfo info_;
-  StagedFiles staged_;
   Handle file_, time_, positions_, velocities_, leaf_attached_;
   hsize_t frames_written_ = 0;
 };

@@ -1,8 +1,6 @@
 #include "io/output_file.h"
 
 #include <bit>
-#include <cstring>
-#include <vector>
 
 #include "common/errors.h"
 #include "io/staged_files.h"

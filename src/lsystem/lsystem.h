@@ -2,8 +2,11 @@
 // Stage entry point: L-system options => derived module string => turtle => Skeleton.
 #include <cstddef>
 
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
 #include "lsystem/lsystem_options.h"
 #include "lsystem/skeleton.h"
+#include "lsystem/turtle.h"
 
 namespace treeanim {
 
@@ -11,6 +14,17 @@ struct GrowthStats {
   size_t modules = 0;  // modules in the derived string (after decomposition)
   int iterations = 0;  // derivation steps applied
 };
+
+// options => grammar read from the file or the inline rules, scene defines applied.
+// Throws InputError (file:line:column, or a JSON pointer for a define the file lacks).
+Grammar load_grammar(const LsystemOptions& options);
+
+// options + grammar => derivation settings: the scene's iterations override "derivation
+// length:", the scene seed is mixed with the grammar's "seed:".
+DerivationSettings derivation_settings(const LsystemOptions& options, const Grammar& grammar);
+
+// options + grammar => turtle settings (scene values override the grammar's directives).
+TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar);
 
 // options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).
 // Throws InputError with file:line:column for grammar errors, and at the module cap.

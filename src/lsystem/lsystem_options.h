@@ -21,6 +21,10 @@ struct LsystemOptions {
   double step = 1.0;                             // length of an F without parameter (scene units)
   std::optional<double> angle;                   // overrides "angle:" (degrees)
   size_t max_modules = 20'000'000;               // derivation stops with an error beyond this
+  std::optional<double> width_factor;            // overrides "width factor:" ('!' without a parameter)
+  std::optional<Eigen::Vector3d> tropism;        // overrides T of "tropism:"
+  std::optional<double> tropism_elasticity;      // overrides e of "tropism:"
+  std::string inline_name = "<scene>/lsystem";   // names inline rules in messages (+ "/axiom", "/productions/3")
 };
 
 // /lsystem section => options. scene_seed is the top-level /seed (the default for lsystem.seed).

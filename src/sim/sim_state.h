@@ -12,6 +12,8 @@ struct SimState {
   Eigen::Matrix3Xd velocities;              // (3 x V) m/s
   std::vector<uint8_t> leaf_attached;       // (L) 1 while the leaf hangs on its branch
   double time = 0;                          // s
+  Eigen::Matrix4Xd cluster_rotations;       // (4 x C) unit quaternions (x, y, z, w), warm starts
+  std::vector<uint8_t> island_asleep;       // (I) 1: the island rests at its rest pose, no work
 };
 
 }  // namespace treeanim

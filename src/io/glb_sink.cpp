@@ -1,0 +1,288 @@
+// One animated GLB: the rest mesh, one morph target per written frame (displacements from the
+// rest pose) and an animation on the node's `weights`, one-hot per frame with LINEAR
+// interpolation, so a player blends neighbouring frames at in-between times. assimp 5.2 cannot
+// export morph-weight animation (assimp issue 5352), so the container is written here with
+// nlohmann_json, streamed: the JSON chunk's room is reserved up front (its numbers at their
+// longest) and filled in by finish(), the frames go straight to the BIN chunk.
+//
+// BIN layout (every part a multiple of 4 bytes): indices u32 [T*3], rest positions f32 [N*3],
+// UVs f32 [N*2], targets f32 [F][N*3], times f32 [F], weights f32 [F*F].
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "common/errors.h"
+#include "io/frame_sink.h"
+#include "io/glb_size.h"
+#include "io/obj_format.h"
+#include "io/output_file.h"
+#include "io/staged_files.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr uint32_t kGlbMagic = 0x46546C67;      // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;     // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;      // "BIN\0"
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+constexpr int kFloat = 5126, kUnsignedInt = 5125;
+
+// Per-axis bounds of a VEC3 accessor (glTF requires them on POSITION, morph targets included).
+struct Bounds {
+  std::array<float, 3> min{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                           std::numeric_limits<float>::max()};
+  std::array<float, 3> max{-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+                           -std::numeric_limits<float>::max()};
+  void add(const float* xyz) {
+    for (int a = 0; a < 3; ++a) {
+      min[a] = std::min(min[a], xyz[a]);
+      max[a] = std::max(max[a], xyz[a]);
+    }
+  }
+};
+
+// Everything the JSON chunk says, so it can be rendered with placeholders (to reserve room)
+// and for real (in finish()).
+struct GlbContent {
+  size_t vertices = 0, triangles = 0, frames = 0;
+  std::string generator;
+  std::optional<Bounds> rest;             // nullopt: render the longest placeholder numbers
+  std::vector<Bounds> targets;            // (frames) displacement bounds
+  std::vector<std::string> target_names;  // (frames) "frame_0001", ...
+  float time_min = 0, time_max = 0;
+  bool placeholder = false;
+};
+
+nlohmann::json bounds_json(const std::array<float, 3>& values, bool placeholder) {
+  // The longest text a double can print as, so real values never need more room.
+  constexpr double kLongest = -1.7976931348623157e308;
+  if (placeholder) return {kLongest, kLongest, kLongest};
+  return {double(values[0]), double(values[1]), double(values[2])};
+}
+
+uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames) {
+  const uint64_t n = vertices, f = frames;
+  return 12 * uint64_t(triangles) + 12 * n + 8 * n + 12 * n * f + 4 * f + 4 * f * f;
+}
+
+std::string render_json(const GlbContent& c) {
+  using nlohmann::json;
+  const uint64_t n = c.vertices, f = c.frames, t = c.triangles;
+  const uint64_t indices_bytes = 12 * t, position_bytes = 12 * n, uv_bytes = 8 * n, targets_bytes = 12 * n * f;
+  const uint64_t targets_offset = indices_bytes + position_bytes + uv_bytes;
+  const uint64_t times_offset = targets_offset + targets_bytes;
+
+  json views = json::array({
+      {{"buffer", 0}, {"byteOffset", 0}, {"byteLength", indices_bytes}, {"target", kElementArrayBuffer}},
+      {{"buffer", 0}, {"byteOffset", indices_bytes}, {"byteLength", position_bytes}, {"target", kArrayBuffer}},
+      {{"buffer", 0}, {"byteOffset", indices_bytes + position_bytes}, {"byteLength", uv_bytes},
+       {"target", kArrayBuffer}},
+  });
+  json accessors = json::array({
+      {{"bufferView", 0}, {"componentType", kUnsignedInt}, {"count", 3 * t}, {"type", "SCALAR"}},
+      {{"bufferView", 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"},
+       {"min", bounds_json(c.rest ? c.rest->min : std::array<float, 3>{}, c.placeholder)},
+       {"max", bounds_json(c.rest ? c.rest->max : std::array<float, 3>{}, c.placeholder)}},
+      {{"bufferView", 2}, {"componentType", kFloat}, {"count", n}, {"type", "VEC2"}},
+  });
+  json primitive = {{"attributes", {{"POSITION", 1}, {"TEXCOORD_0", 2}}}, {"indices", 0}, {"mode", 4}};
+  json mesh = {{"name", "tree"}};
+  json document = {
+      {"asset", {{"version", "2.0"}, {"generator", c.generator},
+                 {"extras", {{"units", "m"}, {"up_axis", "Y"}}}}},
+      {"scene", 0},
+      {"scenes", json::array({{{"nodes", json::array({0})}}})},
+      {"nodes", json::array({{{"mesh", 0}, {"name", "tree"}}})},
+  };
+  if (f > 0) {
+    // Several target accessors share one view: glTF then requires its byteStride.
+    views.push_back({{"buffer", 0}, {"byteOffset", targets_offset}, {"byteLength", targets_bytes},
+                     {"byteStride", 12}, {"target", kArrayBuffer}});
+    views.push_back({{"buffer", 0}, {"byteOffset", times_offset}, {"byteLength", 4 * f}});
+    views.push_back({{"buffer", 0}, {"byteOffset", times_offset + 4 * f}, {"byteLength", 4 * f * f}});
+    json targets = json::array();
+    for (uint64_t k = 0; k < f; ++k) {
+      const Bounds bounds = c.placeholder ? Bounds{} : c.targets[k];
+      targets.push_back({{"POSITION", accessors.size()}});
+      accessors.push_back({{"bufferView", 3}, {"byteOffset", 12 * n * k}, {"componentType", kFloat},
+                           {"count", n}, {"type", "VEC3"}, {"min", bounds_json(bounds.min, c.placeholder)},
+                           {"max", bounds_json(bounds.max, c.placeholder)}});
+    }
+    const size_t times_accessor = accessors.size();
+    const double longest = -1.7976931348623157e308;
+    accessors.push_back({{"bufferView", 4}, {"componentType", kFloat}, {"count", f}, {"type", "SCALAR"},
+                         {"min", json::array({c.placeholder ? longest : double(c.time_min)})},
+                         {"max", json::array({c.placeholder ? longest : double(c.time_max)})}});
+    accessors.push_back({{"bufferView", 5}, {"componentType", kFloat}, {"count", f * f}, {"type", "SCALAR"}});
+    primitive["targets"] = targets;
+    mesh["weights"] = json(std::vector<double>(f, 0.0));
+    mesh["extras"] = {{"targetNames", c.target_names}};
+    document["animations"] = json::array({{
+        {"name", "wind"},
+        {"samplers", json::array({{{"input", times_accessor}, {"output", times_accessor + 1},
+                                   {"interpolation", "LINEAR"}}})},
+        {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}})},
+    }});
+  }
+  mesh["primitives"] = json::array({primitive});
+  document["meshes"] = json::array({mesh});
+  document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f)}}});
+  document["bufferViews"] = views;
+  document["accessors"] = accessors;
+  std::string text = document.dump();
+  text.resize((text.size() + 3) / 4 * 4, ' ');  // chunks are 4-byte aligned; spaces pad JSON
+  return text;
+}
+
+std::vector<std::string> target_names(const FrameSelection& selection) {
+  std::vector<std::string> names;
+  for (long long k = 0; k < selection.written(); ++k) {
+    char name[40];
+    std::snprintf(name, sizeof name, "frame_%04lld", selection.start + k * selection.step);
+    names.push_back(name);
+  }
+  return names;
+}
+
+GlbContent placeholder_content(const TreeModel& model, const BakeInfo& info, const FrameSelection& selection) {
+  GlbContent content;
+  content.vertices = model.vertex_count();
+  content.triangles = model.triangle_count();
+  content.frames = size_t(selection.written());
+  content.generator = info.generator;
+  content.target_names = target_names(selection);
+  content.placeholder = true;
+  return content;
+}
+
+uint64_t glb_bytes(size_t json_bytes, const GlbContent& c) {
+  return 12 + 8 + json_bytes + 8 + bin_bytes(c.vertices, c.triangles, c.frames);
+}
+
+class GlbSink final : public FrameSink {
+ public:
+  GlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
+      : path_(std::move(path)), model_(model),
+        selection_{info.frame_start, info.frame_count, options.frame_step},
+        content_(placeholder_content(model, info, selection_)) {}
+
+  std::vector<fs::path> targets() const override { return {path_}; }
+
+  void begin() override {
+    reserved_json_ = render_json(content_).size();
+    rest_ = rest_positions_f32(model_);
+    file_.emplace(staged_.stage(path_), path_);
+    file_->write(std::string(12 + 8 + reserved_json_ + 8, '\0'));  // header and JSON, filled by finish()
+    for (uint32_t index : model_.triangles) file_->write_u32_le(index);
+    file_->write_f32_le(rest_.data(), rest_.size());
+    std::vector<float> uvs(2 * model_.vertex_count());
+    for (size_t v = 0; v < model_.vertex_count(); ++v) {
+      uvs[2 * v] = model_.uvs(0, long(v));
+      uvs[2 * v + 1] = 1.0f - model_.uvs(1, long(v));  // glTF's v runs down the image, OBJ's up
+    }
+    file_->write_f32_le(uvs.data(), uvs.size());
+    Bounds rest;
+    for (size_t i = 0; i < rest_.size(); i += 3) rest.add(&rest_[i]);
+    content_.rest = rest;
+  }
+
+  void write(const FrameData& frame) override {
+    displacement_.resize(rest_.size());
+    Bounds bounds;
+    for (size_t i = 0; i < rest_.size(); i += 3) {
+      for (int a = 0; a < 3; ++a) displacement_[i + a] = frame.positions[i + a] - rest_[i + a];
+      bounds.add(&displacement_[i]);
+    }
+    file_->write_f32_le(displacement_.data(), displacement_.size());
+    content_.targets.push_back(bounds);
+    times_.push_back(float(frame.time));
+  }
+
+  void finish() override {
+    const size_t f = content_.frames;
+    if (times_.size() != f)
+      throw OutputError(path_.string() + ": the animated GLB was laid out for " + std::to_string(f) +
+                        " frames but the bake delivered " + std::to_string(times_.size()));
+    file_->write_f32_le(times_.data(), f);
+    std::vector<float> weights(f);
+    for (size_t k = 0; k < f; ++k) {  // key k: target k fully on, all others off
+      std::fill(weights.begin(), weights.end(), 0.0f);
+      weights[k] = 1.0f;
+      file_->write_f32_le(weights.data(), f);
+    }
+    if (f > 0) {
+      content_.time_min = times_.front();
+      content_.time_max = times_.back();
+    }
+    content_.placeholder = false;
+    std::string json = render_json(content_);
+    json.resize(reserved_json_, ' ');
+    file_->seek(0);
+    file_->write_u32_le(kGlbMagic);
+    file_->write_u32_le(2);
+    file_->write_u32_le(uint32_t(glb_bytes(reserved_json_, content_)));
+    file_->write_u32_le(uint32_t(reserved_json_));
+    file_->write_u32_le(kChunkJson);
+    file_->write(json);
+    file_->write_u32_le(uint32_t(bin_bytes(content_.vertices, content_.triangles, f)));
+    file_->write_u32_le(kChunkBin);
+    file_->close();
+    file_.reset();
+  }
+
+  void abort() noexcept override {
+    file_.reset();
+    staged_.discard();
+  }
+
+ private:
+  fs::path path_;
+  const TreeModel& model_;
+  FrameSelection selection_;
+  GlbContent content_;
+  size_t reserved_json_ = 0;           // bytes of the JSON chunk
+  std::vector<float> rest_;            // (N*3) m, float rest pose the displacements are taken from
+  std::vector<float> displacement_;    // (N*3) m, scratch for one target
+  std::vector<float> times_;           // (frames written) s
+  std::optional<OutputFile> file_;
+};
+
+}  // namespace
+
+uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step) {
+  const FrameSelection selection{info.frame_start, info.frame_count, frame_step};
+  const GlbContent content = placeholder_content(model, info, selection);
+  return glb_bytes(render_json(content).size(), content);
+}
+
+std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs::path& path,
+                                         const TreeModel& model, const BakeInfo& info) {
+  const uint64_t bytes = animated_glb_bytes(model, info, options.frame_step);
+  if (bytes > kGlbMaxBytes) {
+    // The size grows with the frame count (quadratically through the one-hot weights).
+    long long fits = 0, too_many = info.frame_count;  // frame counts known to fit / not to fit
+    while (too_many - fits > 1) {
+      BakeInfo shorter = info;
+      shorter.frame_count = (fits + too_many) / 2;
+      (animated_glb_bytes(model, shorter, options.frame_step) <= kGlbMaxBytes ? fits : too_many) =
+          shorter.frame_count;
+    }
+    char size[32];
+    std::snprintf(size, sizeof size, "%.2f GiB", double(bytes) / double(1ull << 30));
+    throw OutputError(path.string() + ": the animated GLB would be " + size + " (" +
+                      std::to_string(model.vertex_count()) + " vertices x " +
+                      std::to_string((info.frame_count + options.frame_step - 1) / options.frame_step) +
+                      " frames), over glTF's 4 GiB GLB limit; at most " + std::to_string(fits) +
+                      " frames of this bake fit at frame_step " + std::to_string(options.frame_step) +
+                      " (raise frame_step, shorten the bake, or use hdf5/pc2)");
+  }
+  return std::make_unique<GlbSink>(options, path, model, info);
+}
+
+}  // namespace treeanim

@@ -1,0 +1,22 @@
+#pragma once
+// Wavefront OBJ written directly (not through assimp, whose exporter merges equal positions
+// and reorders vertices): vertex k of every file is vertex k of the TreeModel.
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+// The part every OBJ of a bake shares: "vt" lines (one per vertex) and "f v/vt" lines.
+std::string obj_shared_lines(const TreeModel& model);
+// TreeModel rest positions (double) => (V*3) float, as the sinks write them.
+std::vector<float> rest_positions_f32(const TreeModel& model);
+// Writes one OBJ: a comment line, "v" lines of `positions` (V*3 floats, shortest round-trip
+// text), then `shared`. Throws OutputError naming `target`.
+void write_obj_file(const std::filesystem::path& temporary, const std::filesystem::path& target,
+                    std::string_view comment, const std::vector<float>& positions, const std::string& shared);
+
+}  // namespace treeanim

@@ -1,0 +1,63 @@
+// OBJ sequence: "<name>.%04d.obj" per written frame plus "<name>.rest.obj", all with the
+// TreeModel's vertex order, the same "vt" and "f" lines, so a sequence loader (Houdini's $F4,
+// Blender's Mesh Sequence Cache) sees one topology.
+#include "common/errors.h"
+#include "io/frame_sink.h"
+#include "io/obj_format.h"
+#include "io/staged_files.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class ObjSink final : public FrameSink {
+ public:
+  ObjSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
+      : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
+        selection_{info.frame_start, info.frame_count, options.frame_step} {}
+
+  std::vector<fs::path> targets() const override {
+    std::vector<fs::path> paths{pattern_.rest()};  // the rest mesh first, then the frames
+    for (long long k = 0; k < selection_.written(); ++k)
+      paths.push_back(pattern_.frame(selection_.start + k * selection_.step));
+    return paths;
+  }
+
+  void begin() override {
+    shared_ = obj_shared_lines(model_);
+    const fs::path rest = pattern_.rest();
+    write_obj_file(staged_.stage(rest), rest, info_.generator + ", rest pose, metres, Y up",
+                   rest_positions_f32(model_), shared_);
+  }
+
+  void write(const FrameData& frame) override {
+    const fs::path target = pattern_.frame(frame.frame);
+    write_obj_file(staged_.stage(target), target,
+                   info_.generator + ", frame " + std::to_string(frame.frame) + ", metres, Y up",
+                   frame.positions, shared_);
+  }
+
+  std::vector<fs::path> summary_paths() const override {
+    std::vector<fs::path> paths = targets();
+    paths.resize(std::min<size_t>(paths.size(), 2));  // the rest mesh and the first frame
+    return paths;
+  }
+
+ private:
+  SequencePattern pattern_;
+  const TreeModel& model_;
+  BakeInfo info_;
+  FrameSelection selection_;
+  std::string shared_;  // "vt" and "f" lines, identical in every file
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSink> make_obj_sink(const OutputOptions& options, const fs::path& path,
+                                         const TreeModel& model, const BakeInfo& info) {
+  return std::make_unique<ObjSink>(options, path, model, info);
+}
+
+}  // namespace treeanim

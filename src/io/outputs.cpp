@@ -1,0 +1,232 @@
+// OutputSet: checks every target before the simulation, then runs each sink on its own
+// writer thread behind a bounded queue, so the bake takes about max(simulation, slowest sink).
+#include "io/outputs.h"
+
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+#include "common/errors.h"
+#include "io/frame_sink.h"
+#include "io/staged_files.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Frames a sink may lag behind the solver. Enough to absorb a slow frame (a compressed chunk,
+// a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
+constexpr size_t kQueueFrames = 8;
+
+std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,
+                                     const BakeInfo& info) {
+  if (options.format == "hdf5") return make_hdf5_sink(options, path, model, info);
+  if (options.format == "obj") return make_obj_sink(options, path, model, info);
+  if (options.format == "gltf") return make_gltf_sink(options, path, model, info);
+  if (options.format == "glb") return make_glb_sink(options, path, model, info);
+  if (options.format == "pc2") return make_pc2_sink(options, path, model, info);
+  throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
+}
+
+// One sink, its thread and its queue of frames still to write.
+struct Worker {
+  std::unique_ptr<FrameSink> sink;
+  FrameSelection selection;
+  fs::path first_path;  // for messages about failures that do not name a path themselves
+  std::thread thread;
+  std::mutex mutex;
+  std::condition_variable changed;  // queue, closing, stopping or error changed
+  std::deque<std::shared_ptr<const FrameData>> queue;
+  bool closing = false;              // no more frames will come: drain and return
+  bool stopping = false;             // abort: return without writing the rest
+  std::exception_ptr error;          // the sink's failure, rethrown by push() or finish()
+
+  // Writer thread: writes queued frames in order until closed, stopped or failed.
+  void run() {
+    for (;;) {
+      std::shared_ptr<const FrameData> frame;
+      {
+        std::unique_lock lock(mutex);
+        changed.wait(lock, [&] { return stopping || closing || !queue.empty(); });
+        if (stopping || queue.empty()) return;
+        frame = std::move(queue.front());
+        queue.pop_front();
+      }
+      changed.notify_all();
+      try {
+        sink->write(*frame);
+      } catch (...) {
+        fail(std::current_exception());
+        return;
+      }
+    }
+  }
+
+  // Records the first failure as an OutputError that names a path.
+  void fail(std::exception_ptr failure) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const OutputError&) {
+    } catch (const std::exception& e) {
+      failure = std::make_exception_ptr(OutputError(first_path.string() + ": " + e.what()));
+    }
+    {
+      std::lock_guard lock(mutex);
+      if (!error) error = failure;
+    }
+    changed.notify_all();
+  }
+
+  void rethrow_error() {
+    std::lock_guard lock(mutex);
+    if (error) std::rethrow_exception(error);
+  }
+};
+
+}  // namespace
+
+struct OutputSet::Impl {
+  const TreeModel& model;
+  std::vector<std::unique_ptr<Worker>> workers;
+  bool velocities = false;
+  bool has_hdf5 = false;
+  bool started = false;
+  bool done = false;  // finished or aborted
+
+  explicit Impl(const TreeModel& m) : model(m) {}
+};
+
+namespace {
+
+fs::path resolve(const fs::path& path, const fs::path& out_dir) {
+  return (path.is_relative() && !out_dir.empty() ? out_dir / path : path).lexically_normal();
+}
+
+// Every target is written by one output only, and every folder takes files.
+void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs) {
+  std::map<fs::path, size_t> writer;  // absolute target => output index
+  std::set<fs::path> checked_folders;
+  for (size_t i = 0; i < workers.size(); ++i) {
+    for (const fs::path& target : workers[i]->sink->targets()) {
+      const fs::path absolute = fs::absolute(target).lexically_normal();
+      const auto [it, inserted] = writer.emplace(absolute, i);
+      if (!inserted)
+        throw InputError(outputs[i].pointer + "/path: writes " + target.string() + ", which " +
+                         outputs[it->second].pointer + " writes too");
+      if (checked_folders.insert(absolute.parent_path()).second) check_writable_target(target);
+      else if (fs::is_directory(target))
+        throw OutputError(target.string() + ": a directory is in the way of the output file");
+    }
+  }
+}
+
+}  // namespace
+
+OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, const TreeModel& model,
+                     const BakeInfo& info)
+    : impl_(std::make_unique<Impl>(model)) {
+  for (const OutputOptions& options : outputs) {
+    if (options.frame_step < 1)
+      throw InputError(options.pointer + "/frame_step: expected an integer >= 1, got " +
+                       std::to_string(options.frame_step));
+    auto worker = std::make_unique<Worker>();
+    worker->sink = make_sink(options, resolve(options.path, out_dir), model, info);
+    worker->selection = {info.frame_start, info.frame_count, options.frame_step};
+    const auto targets = worker->sink->targets();
+    worker->first_path = targets.empty() ? resolve(options.path, out_dir) : targets.front();
+    impl_->velocities = impl_->velocities || options.velocities;
+    impl_->has_hdf5 = impl_->has_hdf5 || options.format == "hdf5";
+    impl_->workers.push_back(std::move(worker));
+  }
+  check_targets(impl_->workers, outputs);
+}
+
+OutputSet::~OutputSet() {
+  if (!impl_->done) abort();
+}
+
+bool OutputSet::wants_velocities() const { return impl_->velocities; }
+
+void OutputSet::begin() {
+  try {
+    for (auto& worker : impl_->workers) worker->sink->begin();
+  } catch (...) {
+    abort();
+    throw;
+  }
+  for (auto& worker : impl_->workers) worker->thread = std::thread(&Worker::run, worker.get());
+  impl_->started = true;
+}
+
+void OutputSet::push(FrameData frame) {
+  const size_t n = 3 * impl_->model.vertex_count();
+  if (frame.positions.size() != n || (impl_->velocities && frame.velocities.size() != n) ||
+      (impl_->has_hdf5 && frame.leaf_attached.size() != impl_->model.leaf_count()))
+    throw std::logic_error("OutputSet::push: frame " + std::to_string(frame.frame) +
+                           " does not match the model (positions " + std::to_string(frame.positions.size()) +
+                           ", velocities " + std::to_string(frame.velocities.size()) + ", leaf flags " +
+                           std::to_string(frame.leaf_attached.size()) + ")");
+  const auto shared = std::make_shared<const FrameData>(std::move(frame));
+  for (auto& worker : impl_->workers) {
+    if (!worker->selection.wants(shared->frame)) continue;
+    {
+      std::unique_lock lock(worker->mutex);
+      worker->changed.wait(lock, [&] { return worker->error || worker->queue.size() < kQueueFrames; });
+      if (!worker->error) worker->queue.push_back(shared);
+    }
+    worker->changed.notify_all();
+    worker->rethrow_error();
+  }
+}
+
+void OutputSet::finish() {
+  try {
+    for (auto& worker : impl_->workers) {
+      {
+        std::lock_guard lock(worker->mutex);
+        worker->closing = true;
+      }
+      worker->changed.notify_all();
+    }
+    for (auto& worker : impl_->workers)
+      if (worker->thread.joinable()) worker->thread.join();
+    for (auto& worker : impl_->workers) worker->rethrow_error();
+    // Every file complete before any is renamed: a failure here still leaves no output.
+    for (auto& worker : impl_->workers) worker->sink->finish();
+    for (auto& worker : impl_->workers) worker->sink->commit();
+  } catch (...) {
+    abort();
+    throw;
+  }
+  impl_->done = true;
+}
+
+void OutputSet::abort() noexcept {
+  for (auto& worker : impl_->workers) {
+    {
+      std::lock_guard lock(worker->mutex);
+      worker->stopping = true;
+    }
+    worker->changed.notify_all();
+  }
+  for (auto& worker : impl_->workers) {
+    if (worker->thread.joinable()) worker->thread.join();
+    worker->sink->abort();
+  }
+  impl_->done = true;
+}
+
+std::vector<fs::path> OutputSet::final_paths() const {
+  std::vector<fs::path> paths;
+  for (const auto& worker : impl_->workers)
+    for (const fs::path& path : worker->sink->summary_paths()) paths.push_back(path);
+  return paths;
+}
+
+}  // namespace treeanim

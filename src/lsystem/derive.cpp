@@ -1,0 +1,349 @@
+#include "lsystem/derive.h"
+
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/errors.h"
+
+namespace treeanim {
+
+namespace {
+
+// Keys of the random streams, so that the same (step, position) never shares draws between
+// purposes.
+enum Purpose : uint64_t { kAxiom = 1, kProduction = 2, kDecomposition = 3, kHomomorphism = 4 };
+
+constexpr int kMaxSlots = 64;  // formal parameters of one rule (the parser enforces it)
+
+class Deriver {
+ public:
+  Deriver(const Grammar& grammar, const DerivationSettings& settings)
+      : g_(grammar), settings_(settings) {}
+
+  ModuleString derive() {
+    ModuleString word;
+    word.clear();
+    emit_axiom(&word);
+    word = finish_step(std::move(word), 0);
+    ModuleString next;
+    for (step_ = 1; step_ <= settings_.iterations; ++step_) {
+      rewrite(word, &next);
+      std::swap(word, next);
+      word = finish_step(std::move(word), step_);
+    }
+    return word;
+  }
+
+  ModuleString homomorphism(const ModuleString& word) {
+    if (g_.homomorphism.empty()) return word;
+    step_ = settings_.iterations + 1;
+    ModuleString out;
+    expand_all(g_.homomorphism, word, kHomomorphism, &out);
+    return out;
+  }
+
+  // Adds the step and the rule to a runtime error of an expression.
+  [[noreturn]] void rethrow(const EvalError& error) const {
+    std::string where = "while deriving step " + std::to_string(step_);
+    if (step_ == 0) where = "while evaluating the axiom";
+    if (step_ > settings_.iterations) where = "while applying the homomorphism";
+    if (rule_) where += " (rule at " + std::to_string(rule_->pos.line) + ":" + std::to_string(rule_->pos.column) + ")";
+    throw InputError(g_.where(error.pos) + ": " + error.message + " " + where);
+  }
+
+ private:
+  // The axiom's modules, their parameters evaluated with the axiom's random stream.
+  void emit_axiom(ModuleString* out) {
+    RandomStream random = RandomStream::keyed(settings_.seed, kAxiom, 0, 0);
+    for (const SuccessorModule& m : g_.axiom) {
+      out->symbols.push_back(m.symbol);
+      for (uint32_t p = 0; p < m.arity; ++p)
+        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random));
+      out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+    }
+    check_cap(*out);
+  }
+
+  // After productions (or the axiom): decomposition, then cuts.
+  ModuleString finish_step(ModuleString word, int step) {
+    step_ = step;
+    if (!g_.decomposition.empty()) {
+      ModuleString out;
+      expand_all(g_.decomposition, word, kDecomposition, &out);
+      word = std::move(out);
+    }
+    if (g_.productions.any_cut || g_.decomposition.any_cut) cut_branches(&word);
+    return word;
+  }
+
+  void check_cap(const ModuleString& word) const {
+    if (word.size() <= settings_.max_modules) return;
+    const std::string when = step_ == 0 ? std::string("the axiom")
+                                        : "derivation step " + std::to_string(step_) + " of " +
+                                              std::to_string(settings_.iterations);
+    throw InputError(g_.sources.at(0) + ": " + when + " reached " + std::to_string(word.size()) +
+                     " modules, more than lsystem.max_modules = " + std::to_string(settings_.max_modules) +
+                     " (lower lsystem.iterations or raise lsystem.max_modules)");
+  }
+
+  static void copy_module(const ModuleString& in, size_t i, ModuleString* out) {
+    out->symbols.push_back(in.symbols[i]);
+    const uint32_t b = in.param_offsets[i], e = in.param_offsets[i + 1];
+    if (e > b) out->params.insert(out->params.end(), in.params.begin() + b, in.params.begin() + e);
+    out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+  }
+
+  // One parallel rewriting step: word => *next.
+  void rewrite(const ModuleString& word, ModuleString* next) {
+    next->clear();
+    next->symbols.reserve(word.size() * 2);
+    next->param_offsets.reserve(word.size() * 2 + 1);
+    next->params.reserve(word.params.size() * 2);
+    const RuleSet& set = g_.productions;
+    if (set.any_context) match_brackets(word);
+    word_ = &word;
+    double slots[kMaxSlots];
+    for (size_t i = 0; i < word.size(); ++i) {
+      const auto s = static_cast<unsigned char>(word.symbols[i]);
+      if (set.first_rule[s] == set.first_rule[s + 1]) {
+        copy_module(word, i, next);
+        continue;
+      }
+      RandomStream random = RandomStream::keyed(settings_.seed, kProduction, static_cast<uint64_t>(step_), i);
+      const Rule* rule = select(set, word.symbols[i], word.params_of(i), i, slots, random);
+      if (rule) emit_successor(set, *rule, slots, random, next);
+      else copy_module(word, i, next);
+      if (next->size() > settings_.max_modules) check_cap(*next);
+    }
+    word_ = nullptr;
+  }
+
+  // match_[k] for every bracket of word: the index of its partner.
+  void match_brackets(const ModuleString& word) {
+    match_.assign(word.size(), -1);
+    std::vector<int32_t> open;
+    for (size_t k = 0; k < word.size(); ++k) {
+      if (word.symbols[k] == '[') open.push_back(static_cast<int32_t>(k));
+      else if (word.symbols[k] == ']' && !open.empty()) {
+        match_[k] = open.back();
+        match_[static_cast<size_t>(open.back())] = static_cast<int32_t>(k);
+        open.pop_back();
+      }
+    }
+  }
+
+  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts apply),
+  // its formal parameters bound in slots; nullptr when none applies. The first applicable rule
+  // wins; when it has a probability, one of all applicable rules with a probability is drawn
+  // with weights proportional to them.
+  const Rule* select(const RuleSet& set, char symbol, std::span<const double> params, size_t index,
+                     double* slots, RandomStream& random) {
+    const auto s = static_cast<unsigned char>(symbol);
+    double total = 0;
+    size_t candidates = 0;
+    for (uint32_t k = set.first_rule[s]; k < set.first_rule[s + 1]; ++k) {
+      const Rule& rule = set.rules[set.rule_order[k]];
+      if (!applies(set, rule, params, index, slots, random)) continue;
+      if (!rule.probability.present()) {
+        if (candidates == 0) return &rule;
+        continue;
+      }
+      rule_ = &rule;
+      const double weight = evaluate(g_.program, rule.probability, slots, random);
+      if (weight < 0)
+        throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + std::to_string(weight)};
+      weights_.resize(candidates + 1);
+      chosen_.resize(candidates + 1);
+      weights_[candidates] = weight;
+      chosen_[candidates] = &rule;
+      ++candidates;
+      total += weight;
+    }
+    if (candidates == 0 || total <= 0) return nullptr;
+    const double draw = random.uniform() * total;
+    double sum = 0;
+    size_t pick = candidates - 1;
+    for (size_t c = 0; c < candidates; ++c) {
+      sum += weights_[c];
+      if (draw < sum && weights_[c] > 0) {
+        pick = c;
+        break;
+      }
+    }
+    const Rule* rule = chosen_[pick];
+    applies(set, *rule, params, index, slots, random);  // rebinds its formals
+    return rule;
+  }
+
+  // Symbol arity, contexts and condition of one rule; binds its formals into slots.
+  bool applies(const RuleSet& set, const Rule& rule, std::span<const double> params, size_t index,
+               double* slots, RandomStream& random) {
+    if (rule.arity != params.size()) return false;
+    for (size_t p = 0; p < params.size(); ++p) slots[rule.predecessor_slot + p] = params[p];
+    if (rule.left_end > rule.left_begin && !match_left(set, rule, index, slots)) return false;
+    if (rule.right_end > rule.right_begin && !match_right(set, rule, index, slots)) return false;
+    if (!rule.condition.present()) return true;
+    rule_ = &rule;
+    return evaluate(g_.program, rule.condition, slots, random) != 0.0;
+  }
+
+  static void bind(const ModuleString& word, size_t j, const PatternModule& pattern, double* slots) {
+    const std::span<const double> values = word.params_of(j);
+    for (size_t p = 0; p < values.size(); ++p) slots[pattern.first_slot + p] = values[p];
+  }
+
+  // Left context: walks left, skipping complete branches (']' ... '[') and climbing out of the
+  // current branch ('['), passing over ignored symbols.
+  bool match_left(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+    const ModuleString& w = *word_;
+    ptrdiff_t j = static_cast<ptrdiff_t>(index) - 1;
+    for (uint32_t p = rule.left_end; p-- > rule.left_begin;) {
+      const PatternModule& pattern = set.patterns[p];
+      for (;;) {
+        if (j < 0) return false;
+        const char c = w.symbols[static_cast<size_t>(j)];
+        if (c == ']') j = match_[static_cast<size_t>(j)] - 1;
+        else if (c == '[' || g_.context_skips[static_cast<unsigned char>(c)]) --j;
+        else break;
+      }
+      const auto k = static_cast<size_t>(j);
+      if (w.symbols[k] != pattern.symbol || w.params_of(k).size() != pattern.arity) return false;
+      bind(w, k, pattern, slots);
+      --j;
+    }
+    return true;
+  }
+
+  // Right context: walks right, skipping lateral branches and ignored symbols, failing at the
+  // end of the current branch (']'); pattern brackets enter a branch ('[') or leave it (']').
+  bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+    const ModuleString& w = *word_;
+    const size_t n = w.size();
+    size_t j = index + 1;
+    for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
+      const PatternModule& pattern = set.patterns[p];
+      if (pattern.symbol == ']') {
+        while (j < n && w.symbols[j] != ']') j = w.symbols[j] == '[' ? static_cast<size_t>(match_[j]) + 1 : j + 1;
+        if (j >= n) return false;
+        ++j;
+        continue;
+      }
+      for (;;) {
+        if (j >= n) return false;
+        const char c = w.symbols[j];
+        if (c == '[' && pattern.symbol != '[') j = static_cast<size_t>(match_[j]) + 1;
+        else if (c == ']') return false;
+        else if (c != '[' && g_.context_skips[static_cast<unsigned char>(c)]) ++j;
+        else break;
+      }
+      if (w.symbols[j] != pattern.symbol || w.params_of(j).size() != pattern.arity) return false;
+      bind(w, j, pattern, slots);
+      ++j;
+    }
+    return true;
+  }
+
+  void emit_successor(const RuleSet& set, const Rule& rule, const double* slots, RandomStream& random,
+                      ModuleString* out) {
+    rule_ = &rule;
+    for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m) {
+      const SuccessorModule& module = set.successor[m];
+      out->symbols.push_back(module.symbol);
+      for (uint32_t p = 0; p < module.arity; ++p)
+        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
+      out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+    }
+  }
+
+  // Context-free rules applied recursively (up to set.max_depth) to every module: word => *out.
+  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out) {
+    out->clear();
+    out->symbols.reserve(word.size());
+    out->param_offsets.reserve(word.size() + 1);
+    for (size_t i = 0; i < word.size(); ++i) {
+      RandomStream random = RandomStream::keyed(settings_.seed, purpose, static_cast<uint64_t>(step_), i);
+      const std::span<const double> params = word.params_of(i);
+      expand(set, word.symbols[i], params.data(), params.size(), 0, random, out);
+      if (out->size() > settings_.max_modules) check_cap(*out);
+    }
+  }
+
+  // One module (params must stay valid until bound) => its expansion appended to *out.
+  void expand(const RuleSet& set, char symbol, const double* params, size_t arity, int depth,
+              RandomStream& random, ModuleString* out) {
+    double slots[kMaxSlots];
+    const Rule* rule = depth < set.max_depth ? select(set, symbol, {params, arity}, 0, slots, random) : nullptr;
+    if (!rule) {
+      out->symbols.push_back(symbol);
+      out->params.insert(out->params.end(), params, params + arity);
+      out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+      return;
+    }
+    rule_ = rule;
+    for (uint32_t m = rule->successor_begin; m < rule->successor_end; ++m) {
+      const SuccessorModule& module = set.successor[m];
+      const size_t base = scratch_.size();
+      for (uint32_t p = 0; p < module.arity; ++p)
+        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
+      expand(set, module.symbol, scratch_.data() + base, module.arity, depth + 1, random, out);
+      scratch_.resize(base);
+      rule_ = rule;
+      if (out->size() > settings_.max_modules) check_cap(*out);
+    }
+  }
+
+  // '%' removes itself and the rest of its branch (up to, not including, the closing ']').
+  static void cut_branches(ModuleString* word) {
+    ModuleString out;
+    out.clear();
+    for (size_t i = 0; i < word->size(); ++i) {
+      if (word->symbols[i] != '%') {
+        copy_module(*word, i, &out);
+        continue;
+      }
+      int depth = 0;
+      size_t j = i + 1;
+      for (; j < word->size(); ++j) {
+        if (word->symbols[j] == '[') ++depth;
+        else if (word->symbols[j] == ']' && depth-- == 0) break;
+      }
+      i = j - 1;  // the loop's ++i lands on the ']' (kept) or the end
+    }
+    *word = std::move(out);
+  }
+
+  const Grammar& g_;
+  const DerivationSettings& settings_;
+  int step_ = 0;
+  const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
+  const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
+  std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere
+  std::vector<double> weights_;         // stochastic candidates' weights
+  std::vector<const Rule*> chosen_;     // stochastic candidates
+  std::vector<double> scratch_;         // parameter values of modules being expanded
+};
+
+}  // namespace
+
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings) {
+  Deriver deriver(grammar, settings);
+  try {
+    return deriver.derive();
+  } catch (const EvalError& error) {
+    deriver.rethrow(error);
+  }
+}
+
+ModuleString apply_homomorphism(const Grammar& grammar, const ModuleString& word,
+                                const DerivationSettings& settings) {
+  Deriver deriver(grammar, settings);
+  try {
+    return deriver.homomorphism(word);
+  } catch (const EvalError& error) {
+    deriver.rethrow(error);
+  }
+}
+
+}  // namespace treeanim

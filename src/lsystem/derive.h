@@ -1,0 +1,29 @@
+#pragma once
+// Derivation of a parsed grammar (docs/grammar.md): parallel rewriting with bracket-aware
+// contexts, stochastic choice, decomposition after every step, homomorphism on demand.
+#include <cstddef>
+#include <cstdint>
+
+#include "lsystem/grammar.h"
+#include "lsystem/module_string.h"
+
+namespace treeanim {
+
+struct DerivationSettings {
+  int iterations = 0;                // derivation steps
+  uint64_t seed = 0;                 // keys every random draw (with step and position)
+  size_t max_modules = 20'000'000;   // InputError as soon as a string grows past this
+};
+
+// grammar + settings => the word after settings.iterations steps; decomposition rules are
+// applied to the axiom and after every step, and '%' removes the rest of its branch.
+// Throws InputError at the module cap and on runtime errors (division by zero...), naming the
+// step and the production.
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings);
+
+// word => word with the homomorphism rules applied (what the turtle reads; the derivation
+// never sees it). Throws InputError like derive.
+ModuleString apply_homomorphism(const Grammar& grammar, const ModuleString& word,
+                                const DerivationSettings& settings);
+
+}  // namespace treeanim

@@ -1,0 +1,102 @@
+#pragma once
+// A parsed L-system grammar (docs/grammar.md): axiom, productions, decomposition and
+// homomorphism rules, with every expression compiled into one ExprProgram.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "lsystem/expression.h"
+#include "lsystem/module_string.h"
+
+namespace treeanim {
+
+// One module of a context pattern: a symbol with formal parameters, or '[' / ']' (right
+// contexts only).
+struct PatternModule {
+  char symbol = 0;
+  uint8_t arity = 0;         // formal parameters
+  uint16_t first_slot = 0;   // where its formals go in the rule's slot array
+};
+
+// One module of a successor: its actual parameters are Exprs in RuleSet::successor_params.
+struct SuccessorModule {
+  char symbol = 0;
+  uint8_t arity = 0;
+  uint32_t first_param = 0;  // index into RuleSet::successor_params
+  SourcePos pos;             // where it is written (arity diagnostics)
+};
+
+// [lc <] pred [> rc] [: condition] --> successor [: probability]
+struct Rule {
+  char predecessor = 0;
+  uint8_t arity = 0;
+  uint16_t predecessor_slot = 0;  // first slot of the predecessor's formals
+  uint16_t slot_count = 0;        // formals of lc, pred and rc together
+  uint32_t left_begin = 0, left_end = 0;    // RuleSet::patterns, in text order
+  uint32_t right_begin = 0, right_end = 0;  // RuleSet::patterns, in text order
+  uint32_t successor_begin = 0, successor_end = 0;  // RuleSet::successor
+  Expr condition;    // absent: always true
+  Expr probability;  // absent: deterministic
+  SourcePos pos;     // the rule's first character
+  bool has_context() const { return left_end > left_begin || right_end > right_begin; }
+};
+
+// The rules of one section, indexed by predecessor symbol.
+struct RuleSet {
+  std::vector<Rule> rules;                     // (R) in text order
+  std::vector<PatternModule> patterns;         // context modules of all rules
+  std::vector<SuccessorModule> successor;      // successor modules of all rules
+  std::vector<Expr> successor_params;          // actual parameter expressions
+  std::array<uint32_t, 257> first_rule{};      // CSR by (unsigned char) symbol into rule_order
+  std::vector<uint32_t> rule_order;            // (R) rule indices grouped by symbol, text order
+  int max_depth = 1;                           // decomposition / homomorphism recursion depth
+  bool any_context = false;                    // some rule has a left or right context
+  bool any_cut = false;                        // some successor contains '%'
+
+  // Builds first_rule / rule_order from rules.
+  void index();
+  bool empty() const { return rules.empty(); }
+};
+
+struct Grammar {
+  std::vector<std::string> sources;   // names of the texts (file path, or <scene>/lsystem/...)
+  ExprProgram program;                // code of every expression
+  std::vector<std::pair<std::string, double>> defines;  // resolved, scene overrides applied
+  std::vector<SuccessorModule> axiom;       // evaluated when derivation starts (ran() uses the seed)
+  std::vector<Expr> axiom_params;           // actual parameters of the axiom's modules
+  std::vector<std::string> file_defines;    // names given by #define (scene overrides checked against them)
+  std::optional<int> derivation_length;
+  std::optional<double> angle;        // degrees
+  std::optional<double> width_factor;
+  uint64_t seed = 0;
+  std::optional<Eigen::Vector3d> tropism;  // T of "tropism:"
+  double tropism_elasticity = 0.0;         // e of "tropism:"
+  std::array<bool, 256> context_skips{};   // symbols passed over when matching contexts
+  RuleSet productions;
+  RuleSet decomposition;
+  RuleSet homomorphism;
+
+  // "file:line:column" or "name:column" of a place.
+  std::string where(const SourcePos& pos) const;
+};
+
+// One text of a grammar: a whole file, or one inline rule (single_line: reported as name:column).
+struct GrammarText {
+  std::string name;
+  std::string text;
+  bool single_line = false;
+};
+
+// Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
+// given, is an inline axiom (another text, single line). Throws InputError
+// "name:line:column: message".
+Grammar parse_grammar(const std::vector<GrammarText>& texts,
+                      const std::vector<std::pair<std::string, double>>& define_overrides,
+                      const std::optional<GrammarText>& axiom_text = std::nullopt);
+
+}  // namespace treeanim

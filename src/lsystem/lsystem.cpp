@@ -1,0 +1,89 @@
+#include "lsystem/lsystem.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "common/errors.h"
+
+namespace treeanim {
+
+namespace {
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in || std::filesystem::is_directory(path))
+    throw InputError(path.string() + ": cannot read the grammar file (" +
+                     (std::filesystem::exists(path) ? "not a readable file" : "no such file") + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A scene define must replace a #define of the file: otherwise it is a typo that would
+// silently change nothing.
+void check_overrides(const LsystemOptions& options, const Grammar& grammar) {
+  for (const auto& [name, value] : options.defines) {
+    if (std::find(grammar.file_defines.begin(), grammar.file_defines.end(), name) != grammar.file_defines.end())
+      continue;
+    std::string known;
+    for (const std::string& d : grammar.file_defines) known += (known.empty() ? "" : ", ") + d;
+    throw InputError(options.grammar->string() + ": " + options.inline_name + "/defines/" + name +
+                     ": the grammar has no '#define " + name + "' (it defines: " +
+                     (known.empty() ? "nothing" : known) + ")");
+  }
+}
+
+}  // namespace
+
+Grammar load_grammar(const LsystemOptions& options) {
+  if (options.grammar) {
+    const std::vector<GrammarText> texts{{options.grammar->string(), read_file(*options.grammar), false}};
+    Grammar grammar = parse_grammar(texts, options.defines);
+    check_overrides(options, grammar);
+    return grammar;
+  }
+  std::vector<GrammarText> texts;
+  for (size_t i = 0; i < options.productions.size(); ++i)
+    texts.push_back({options.inline_name + "/productions/" + std::to_string(i), options.productions[i], true});
+  return parse_grammar(texts, options.defines, GrammarText{options.inline_name + "/axiom", options.axiom, true});
+}
+
+DerivationSettings derivation_settings(const LsystemOptions& options, const Grammar& grammar) {
+  DerivationSettings settings;
+  if (options.iterations) settings.iterations = *options.iterations;
+  else if (grammar.derivation_length) settings.iterations = *grammar.derivation_length;
+  else
+    throw InputError(grammar.sources.at(0) + ": the grammar has no 'derivation length:'; give the number of steps as " +
+                     options.inline_name.substr(std::string("<scene>").size()) + "/iterations");
+  // Seed 0 in the grammar leaves the scene seed as it is.
+  settings.seed = options.seed ^ (grammar.seed * 0x9e3779b97f4a7c15ULL);
+  settings.max_modules = options.max_modules;
+  return settings;
+}
+
+TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar) {
+  TurtleSettings turtle;
+  turtle.step = options.step;
+  turtle.angle_degrees = options.angle.value_or(grammar.angle.value_or(turtle.angle_degrees));
+  turtle.width_factor = options.width_factor.value_or(grammar.width_factor.value_or(turtle.width_factor));
+  if (grammar.tropism) {
+    turtle.tropism = *grammar.tropism;
+    turtle.tropism_elasticity = grammar.tropism_elasticity;
+  }
+  if (options.tropism) turtle.tropism = *options.tropism;
+  if (options.tropism_elasticity) turtle.tropism_elasticity = *options.tropism_elasticity;
+  return turtle;
+}
+
+Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
+  const Grammar grammar = load_grammar(options);
+  const DerivationSettings settings = derivation_settings(options, grammar);
+  const ModuleString word = derive(grammar, settings);
+  if (stats) {
+    stats->modules = word.size();
+    stats->iterations = settings.iterations;
+  }
+  return interpret(apply_homomorphism(grammar, word, settings), turtle_settings(options, grammar));
+}
+
+}  // namespace treeanim

@@ -1,0 +1,74 @@
+#include "lsystem/lsystem_options.h"
+
+#include <cctype>
+
+namespace treeanim {
+
+namespace {
+
+bool is_name(const std::string& text) {
+  if (text.empty() || !(std::isalpha(static_cast<unsigned char>(text[0])) || text[0] == '_')) return false;
+  for (char c : text)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+// /lsystem/productions: an array of strings (one rule or directive each).
+std::vector<std::string> read_productions(SceneObject& section) {
+  std::vector<std::string> out;
+  const Json* value = section.raw("productions");
+  if (!value) return out;
+  if (!value->is_array()) section.fail_expected("productions", "an array of strings (one production each)");
+  for (const Json& element : *value) {
+    if (!element.is_string()) section.fail_expected("productions", "an array of strings (one production each)");
+    out.push_back(element.get<std::string>());
+  }
+  return out;
+}
+
+// /lsystem/defines: {"name": number}; each value is range-checked as /lsystem/defines/name.
+std::vector<std::pair<std::string, double>> read_defines(SceneObject& section) {
+  std::vector<std::pair<std::string, double>> out;
+  const Json* value = section.raw("defines");
+  if (!value) return out;
+  if (!value->is_object()) section.fail_expected("defines", "an object of name: number");
+  std::vector<std::string> names;
+  for (auto it = value->begin(); it != value->end(); ++it) names.push_back(it.key());
+  SceneObject defines = section.object("defines");
+  for (const std::string& name : names) {
+    if (!is_name(name)) defines.fail(name, "expected a name of letters, digits and '_' (not starting with a digit)");
+    out.emplace_back(name, *defines.optional_number(name));
+  }
+  return out;
+}
+
+}  // namespace
+
+LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
+  LsystemOptions options;
+  options.inline_name = "<scene>" + section.pointer();
+  options.grammar = section.optional_path("grammar");
+  const std::optional<std::string> axiom = section.optional_string("axiom");
+  options.productions = read_productions(section);
+  if (options.grammar && axiom)
+    section.fail("axiom", "give either a grammar file (/lsystem/grammar) or an inline grammar (/lsystem/axiom), not both");
+  if (!options.grammar && !axiom)
+    section.fail("grammar", "expected a grammar file, or an inline grammar as /lsystem/axiom and /lsystem/productions");
+  if (options.grammar && !options.productions.empty())
+    section.fail("productions", "inline productions go with /lsystem/axiom, not with a grammar file (/lsystem/grammar)");
+  if (axiom) options.axiom = *axiom;
+  options.defines = read_defines(section);
+  if (auto n = section.optional_integer("iterations", 0, 10000)) options.iterations = static_cast<int>(*n);
+  options.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
+  options.step = section.number("step", 1.0, Range::positive());
+  options.angle = section.optional_number("angle");
+  options.max_modules = static_cast<size_t>(section.integer("max_modules", 20'000'000, 1, 1LL << 29));
+  options.width_factor = section.optional_number("width_factor", Range::positive());
+  options.tropism = section.optional_vector3("tropism");
+  if (options.tropism && options.tropism->norm() == 0.0)
+    section.fail_expected("tropism", "a non-zero direction [x, y, z]");
+  options.tropism_elasticity = section.optional_number("tropism_elasticity");
+  return options;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,20 @@
+#pragma once
+// Rotational part of a 3x3 deformation gradient, Müller et al. 2016, "A robust method to
+// extract the rotational part of deformations" (MIG '16).
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace treeanim {
+
+// A (any 3x3, e.g. a cluster's normalised A_pq) + warm start q => q updated in place to the
+// rotation R maximising tr(R^T A) locally, reached by at most `max_iterations` steps.
+//
+// Why this method and not a polar decomposition (SVD, or the paper's S^-1 from A^T A):
+// it works on the rotation directly, so R is a proper rotation (det +1) by construction, also
+// for inverted clusters (where the polar factor is a reflection); it needs no inverse, so a
+// planar leaf (rank 2) or a collinear two-ring cluster (rank 1) yields no NaN; where A leaves
+// the rotation undetermined (the spin about a collinear cluster's axis) it keeps the warm start,
+// so nothing jitters. Returns the iterations used.
+int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations);
+
+}  // namespace treeanim

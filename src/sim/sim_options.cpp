@@ -1,0 +1,171 @@
+#include "sim/sim_options.h"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "common/errors.h"
+
+namespace treeanim {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A direction vector => unit vector; zero or non-finite => nullopt.
+std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
+  const double n = v.norm();
+  if (!(n > 0) || !std::isfinite(n)) return std::nullopt;
+  return Eigen::Vector3d(v / n);
+}
+
+// One field of a CSV line => finite number; throws "name:line: column 'what': ...".
+double csv_number(const std::string& cell, const std::string& where, const std::string& column) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(cell, &used);
+  } catch (const std::logic_error&) {
+    used = 0;
+  }
+  while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
+  if (used == 0 || used != cell.size() || !std::isfinite(v))
+    throw InputError(where + ": column '" + column + "': expected a finite number, got '" + cell + "'");
+  return v;
+}
+
+// "a, b ,c" => {"a","b","c"} with surrounding blanks removed.
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) {
+    const size_t b = cell.find_first_not_of(" \t\r");
+    const size_t e = cell.find_last_not_of(" \t\r");
+    cells.push_back(b == std::string::npos ? std::string() : cell.substr(b, e - b + 1));
+  }
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+// Keys must have strictly increasing times: interpolation needs an order.
+void check_increasing(const std::vector<WindKey>& keys, size_t i, const std::string& where) {
+  if (i > 0 && !(keys[i].time > keys[i - 1].time))
+    throw InputError(where + ": time " + std::to_string(keys[i].time) +
+                     " must be greater than the previous key's time " +
+                     std::to_string(keys[i - 1].time));
+}
+
+}  // namespace
+
+SimOptions read_sim_options(SceneObject section) {
+  SimOptions o;
+  o.global_matching = section.boolean("global_matching", o.global_matching);
+  o.stiffness = section.choice("stiffness", "physical", {"physical", "per_step"}) == "physical"
+                    ? StiffnessMode::kPhysical
+                    : StiffnessMode::kPerStep;
+  o.alpha = section.number("alpha", o.alpha, Range::between(0, 1));
+  o.k_d = section.number("k_d", o.k_d, Range::between(0, 1));
+  o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
+  o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::positive());
+  o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
+  o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
+  o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::non_negative());
+  o.gravity = section.vector3("gravity", o.gravity);
+  o.sleep = section.boolean("sleep", o.sleep);
+  o.sleep_velocity = section.number("sleep_velocity", o.sleep_velocity, Range::positive());
+  o.sleep_distance = section.number("sleep_distance", o.sleep_distance, Range::positive());
+  o.rotation_iterations =
+      static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
+  return o;
+}
+
+std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name) {
+  std::vector<WindKey> keys;
+  std::stringstream stream(text);
+  std::string line;
+  size_t line_number = 0;
+  bool header_seen = false;
+  bool has_gust = false;
+  while (std::getline(stream, line)) {
+    ++line_number;
+    const std::string where = name + ":" + std::to_string(line_number);
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#')
+      continue;
+    const std::vector<std::string> cells = split_csv_line(line);
+    if (!header_seen) {
+      const std::vector<std::string> expected{"time", "speed", "dx", "dy", "dz", "gust"};
+      const bool five = cells.size() == 5 && std::equal(cells.begin(), cells.end(), expected.begin());
+      const bool six = cells.size() == 6 && std::equal(cells.begin(), cells.end(), expected.begin());
+      if (!five && !six)
+        throw InputError(where + ": expected the header 'time,speed,dx,dy,dz' or "
+                         "'time,speed,dx,dy,dz,gust', got '" + line + "'");
+      has_gust = six;
+      header_seen = true;
+      continue;
+    }
+    const size_t columns = has_gust ? 6 : 5;
+    if (cells.size() != columns)
+      throw InputError(where + ": expected " + std::to_string(columns) + " comma-separated values, got " +
+                       std::to_string(cells.size()));
+    WindKey key;
+    key.time = csv_number(cells[0], where, "time");
+    key.speed = csv_number(cells[1], where, "speed");
+    if (key.speed < 0) throw InputError(where + ": column 'speed': expected a number >= 0, got '" + cells[1] + "'");
+    const Eigen::Vector3d d(csv_number(cells[2], where, "dx"), csv_number(cells[3], where, "dy"),
+                            csv_number(cells[4], where, "dz"));
+    const auto direction = unit(d);
+    if (!direction) throw InputError(where + ": columns 'dx,dy,dz': the direction must not be zero");
+    key.direction = *direction;
+    if (has_gust) {
+      key.gust = csv_number(cells[5], where, "gust");
+      if (key.gust < 0) throw InputError(where + ": column 'gust': expected a number >= 0, got '" + cells[5] + "'");
+    }
+    keys.push_back(key);
+    check_increasing(keys, keys.size() - 1, where);
+  }
+  if (!header_seen) throw InputError(name + ":1: expected the header 'time,speed,dx,dy,dz[,gust]', the file is empty");
+  if (keys.empty()) throw InputError(name + ":" + std::to_string(line_number) + ": expected at least one data line after the header");
+  return keys;
+}
+
+WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
+  WindOptions o;
+  o.file = section.optional_path("file");
+  std::vector<SceneObject> key_objects = section.array_of_objects("keys");
+  if (o.file && !key_objects.empty())
+    section.fail("keys", "give either /wind/keys or /wind/file, not both");
+  for (size_t i = 0; i < key_objects.size(); ++i) {
+    SceneObject& k = key_objects[i];
+    WindKey key;
+    key.time = k.number("time", 0, Range::any());
+    key.speed = k.number("speed", 0, Range::non_negative());
+    const auto direction = unit(k.vector3("direction", key.direction));
+    if (!direction) k.fail("direction", "expected a non-zero vector");
+    key.direction = *direction;
+    key.gust = k.number("gust", 0, Range::non_negative());
+    o.keys.push_back(key);
+    check_increasing(o.keys, i, k.pointer_of("time"));
+  }
+  if (o.file) {
+    std::ifstream in(*o.file, std::ios::binary);
+    if (!in) section.fail("file", "cannot open wind file '" + o.file->string() + "'");
+    std::stringstream text;
+    text << in.rdbuf();
+    o.keys = parse_wind_csv(text.str(), o.file->string());
+  }
+  o.air_density = section.number("air_density", o.air_density, Range::non_negative());
+  o.branch_drag_coefficient = section.number("branch_drag_coefficient", o.branch_drag_coefficient, Range::between(0, 10));
+  o.leaf_drag_coefficient = section.number("leaf_drag_coefficient", o.leaf_drag_coefficient, Range::between(0, 10));
+  o.turbulence_intensity = section.number("turbulence_intensity", o.turbulence_intensity, Range::between(0, 10));
+  o.turbulence_length = section.number("turbulence_length", o.turbulence_length, {0, kInf, true, false});
+  o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::non_negative());
+  o.turbulence_modes = static_cast<int>(section.integer("turbulence_modes", o.turbulence_modes, 1, 64));
+  o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::non_negative());
+  o.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0,
+                                                 std::numeric_limits<long long>::max()));
+  return o;
+}
+
+}  // namespace treeanim

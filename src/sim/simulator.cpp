@@ -1,0 +1,553 @@
+#include "sim/simulator.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+
+#include "common/errors.h"
+#include "sim/rotation.h"
+#include "sim/stiffness.h"
+#include "sim/wind.h"
+
+namespace treeanim {
+
+namespace {
+
+constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr int kMaxModes = 64;  // read_wind_options caps turbulence_modes here
+
+// CSR offsets (n+1) + this thread's index and the thread count => the contiguous range of
+// rows [begin, end) holding an equal share of the entries. Balances clusters of very
+// different sizes (trunk rings, 4-vertex leaves); results never depend on the split.
+std::pair<size_t, size_t> balanced_range(const std::vector<uint32_t>& offsets, int thread, int threads) {
+  const size_t n = offsets.size() - 1;
+  const double total = offsets.back();
+  auto row_at = [&](int t) {
+    if (t == 0) return size_t(0);
+    if (t == threads) return n;
+    const double target = total * t / threads;
+    return size_t(std::lower_bound(offsets.begin(), offsets.end(), target) - offsets.begin());
+  };
+  return {std::min(row_at(thread), n), std::min(row_at(thread + 1), n)};
+}
+
+// Union-find root with path halving.
+uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+
+}  // namespace
+
+struct Simulator::Impl {
+  const TreeModel& model;
+  SimOptions options;
+  WindField wind;
+  double frame_dt;
+  int substeps;
+  double h;  // s, one substep
+  size_t V, C, M, L;
+
+  // --- per membership (M), in cluster_members order ---
+  std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
+  Eigen::Matrix3Xd member_offset;          // (3 x M) m, rest offset q = x0 - t0 from the cluster's rest centre
+  std::vector<double> member_match_weight; // (M) 1/m^2: w / sum(w |q|^2), A_pq normalised to order 1
+  std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
+  std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
+  Eigen::Matrix3Xd member_correction;      // (3 x M) m, alpha_c (g - x) of the current step
+
+  // --- per cluster (C) ---
+  Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
+  std::vector<double> cluster_alpha;       // (C) local rate per step
+  std::vector<uint32_t> cluster_island;    // (C) island id
+  std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
+  std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
+  Eigen::Matrix3Xd cluster_air;            // (3 x C) m/s, air velocity at the cluster this step
+
+  // --- per vertex (V) ---
+  std::vector<double> vertex_global;       // (V) global rate per step (0: off, anchored, flying)
+  std::vector<double> vertex_damping;      // (V) velocity factor per step
+  std::vector<double> vertex_drag;         // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  std::vector<double> vertex_inv_count;    // (V) 1 / number of active memberships (0: none)
+  std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
+  std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
+  std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
+  Eigen::Matrix3Xd vertex_drag_force;      // (3 x V) N, drag of the last step; only with detachment
+
+  // --- islands (I): clusters connected through shared non-anchored vertices ---
+  size_t I = 0;
+  std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
+  std::vector<uint32_t> island_vertices;        // non-anchored vertices, ascending per island
+
+  // --- leaves ---
+  std::vector<uint8_t> applied_attached;  // (L) detachments already applied to the arrays above
+  std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
+  bool detach_enabled;
+
+  // --- per-step scratch (no allocation in the step) ---
+  double turbulence_sin_b[kMaxModes], turbulence_cos_b[kMaxModes];
+
+  Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n);
+  void precompute_members();
+  void rebuild_cluster_rest(uint32_t c);
+  void precompute_drag(const WindOptions& w);
+  void precompute_islands();
+  void detach_leaf(SimState& state, size_t leaf);
+  void sync_detachments(SimState& state);
+  void step(SimState& state, double t, long long frame, int substep);
+  void sample_air(const SimState& state, const Eigen::Vector3d& base, double scale);
+  void predict(SimState& state, bool any_asleep);
+  bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre);
+  void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+  void match_clusters(SimState& state, long long frame, int substep);
+  void correct(SimState& state, bool any_asleep, long long frame, int substep);
+  void precompute_pins();
+  void check_detachments(SimState& state);
+  void check_sleep(SimState& state, double t);
+  bool cluster_awake(const SimState& state, size_t c) const {
+    return cluster_flying[c] || !state.island_asleep[cluster_island[c]];
+  }
+};
+
+Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n)
+    : model(m), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n),
+      V(m.vertex_count()), C(m.cluster_count()), M(m.membership_count()), L(m.leaf_count()),
+      detach_enabled(o.leaf_detach_force > 0 && m.leaf_count() > 0) {
+  if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
+  precompute_members();
+  const StepRates rates = compute_step_rates(model, options, h);
+  cluster_alpha = rates.cluster_alpha;
+  vertex_global = rates.vertex_global;
+  vertex_damping = rates.vertex_damping;
+  precompute_drag(w);
+  precompute_islands();
+  island_fell_asleep.assign(I, 0);
+  cluster_air.setZero(3, C);
+  cluster_flying.assign(C, 0);
+  vertex_flying.assign(V, 0);
+  applied_attached.assign(L, 1);
+  if (detach_enabled) vertex_drag_force.setZero(3, V);
+  // Spatial turbulence phases at the rest centres: the tree moves little against the
+  // length scale of the eddies, so they are evaluated once (flying leaves use their centre).
+  const int N = wind.mode_count();
+  cluster_turbulence_sin.resize(C * N);
+  cluster_turbulence_cos.resize(C * N);
+  for (size_t c = 0; c < C; ++c)
+    wind.spatial_phases(cluster_rest_centre.col(c), &cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N]);
+}
+
+// Model CSR => per-membership cluster ids, rest offsets, weights; per-vertex counts.
+void Simulator::Impl::precompute_members() {
+  member_cluster.resize(M);
+  for (size_t c = 0; c < C; ++c)
+    for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
+      member_cluster[s] = static_cast<uint32_t>(c);
+  member_offset.setZero(3, M);
+  member_match_weight.assign(M, 0);
+  member_centre_weight.assign(M, 0);
+  member_active.assign(M, 1);
+  member_correction.setZero(3, M);
+  cluster_rest_centre.setZero(3, C);
+  for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
+  vertex_inv_count.assign(V, 0);
+  vertex_air_cluster.assign(V, 0);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
+    vertex_inv_count[v] = end > begin ? 1.0 / double(end - begin) : 0.0;
+    vertex_air_cluster[v] = end > begin ? member_cluster[model.vertex_memberships[begin]] : 0;
+  }
+}
+
+// Active members of cluster c => its rest centre, rest offsets and normalised weights.
+// Weights are vertex masses; a cluster without mass (all members anchored or massless)
+// falls back to equal weights, so its shape is still defined.
+void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
+  const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
+  double total = 0;
+  for (uint32_t s = begin; s < end; ++s)
+    if (member_active[s]) total += model.vertex_mass[model.cluster_members[s]];
+  const bool uniform = !(total > 0);
+  auto weight = [&](uint32_t s) {
+    return !member_active[s] ? 0.0 : uniform ? 1.0 : model.vertex_mass[model.cluster_members[s]];
+  };
+  if (uniform) total = 0;
+  if (uniform)
+    for (uint32_t s = begin; s < end; ++s) total += weight(s);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (uint32_t s = begin; s < end; ++s)
+    centre += (weight(s) / total) * model.rest_positions.col(model.cluster_members[s]);
+  cluster_rest_centre.col(c) = centre;
+  double spread = 0;  // sum w |q|^2, kg m^2
+  for (uint32_t s = begin; s < end; ++s) {
+    member_offset.col(s) = member_active[s] ? Eigen::Vector3d(model.rest_positions.col(model.cluster_members[s]) - centre)
+                                            : Eigen::Vector3d::Zero();
+    spread += weight(s) * member_offset.col(s).squaredNorm();
+  }
+  // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
+  const double inv_spread = spread > 0 ? 1.0 / spread : 0.0;
+  for (uint32_t s = begin; s < end; ++s) {
+    member_match_weight[s] = total > 0 ? weight(s) * inv_spread : 0.0;
+    member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
+  }
+}
+
+// Drag areas and coefficients => per-vertex drag constants.
+void Simulator::Impl::precompute_drag(const WindOptions& w) {
+  vertex_drag.assign(V, 0);
+  for (size_t v = 0; v < V; ++v) {
+    const double mass = model.vertex_mass[v];
+    if (model.vertex_anchored[v] || !(mass > 0)) continue;
+    const double cd = model.vertex_leaf[v] >= 0 ? w.leaf_drag_coefficient : w.branch_drag_coefficient;
+    vertex_drag[v] = 0.5 * w.air_density * cd * model.vertex_drag_area[v] / mass;
+  }
+}
+
+// Clusters sharing a non-anchored vertex => one island (anchors hold, they do not couple).
+void Simulator::Impl::precompute_islands() {
+  std::vector<uint32_t> parent(C);
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (size_t v = 0; v < V; ++v) {
+    if (model.vertex_anchored[v]) continue;
+    const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
+    for (uint32_t s = begin + 1; s < end; ++s) {
+      const uint32_t a = find_root(parent, member_cluster[model.vertex_memberships[begin]]);
+      const uint32_t b = find_root(parent, member_cluster[model.vertex_memberships[s]]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<uint32_t> id_of_root(C, kNone);
+  cluster_island.resize(C);
+  I = 0;
+  for (size_t c = 0; c < C; ++c) {
+    const uint32_t r = find_root(parent, static_cast<uint32_t>(c));
+    if (id_of_root[r] == kNone) id_of_root[r] = static_cast<uint32_t>(I++);
+    cluster_island[c] = id_of_root[r];
+  }
+  vertex_island.assign(V, kNone);
+  island_vertex_offsets.assign(I + 1, 0);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t begin = model.vertex_cluster_offsets[v];
+    if (model.vertex_anchored[v] || begin == model.vertex_cluster_offsets[v + 1]) continue;
+    vertex_island[v] = cluster_island[member_cluster[model.vertex_memberships[begin]]];
+    ++island_vertex_offsets[vertex_island[v] + 1];
+  }
+  for (size_t i = 0; i < I; ++i) island_vertex_offsets[i + 1] += island_vertex_offsets[i];
+  island_vertices.resize(island_vertex_offsets[I]);
+  std::vector<uint32_t> fill(island_vertex_offsets.begin(), island_vertex_offsets.end() - 1);
+  for (size_t v = 0; v < V; ++v)
+    if (vertex_island[v] != kNone) island_vertices[fill[vertex_island[v]]++] = static_cast<uint32_t>(v);
+}
+
+// Releases leaf `leaf` from its branch (paper 4.2): the shared vertex stays with the side it
+// was built for (a leaf vertex leaves its branch clusters; a branch vertex leaves the leaf),
+// the clusters that lost a member get new rest data, and the leaf's vertices fly.
+void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
+  const uint32_t c = model.leaf_cluster[leaf];
+  const uint32_t a = model.leaf_attachment_vertex[leaf];
+  const bool goes_with_leaf = model.vertex_leaf[a] == static_cast<int32_t>(leaf);
+  for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
+    const uint32_t slot = model.vertex_memberships[s];
+    const uint32_t owner = member_cluster[slot];
+    if ((owner == c) == goes_with_leaf || !member_active[slot]) continue;
+    member_active[slot] = 0;
+    member_correction.col(slot).setZero();
+    rebuild_cluster_rest(owner);
+  }
+  uint32_t active = 0, first = kNone;
+  for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
+    const uint32_t slot = model.vertex_memberships[s];
+    if (!member_active[slot]) continue;
+    ++active;
+    if (first == kNone) first = member_cluster[slot];
+  }
+  vertex_inv_count[a] = active ? 1.0 / active : 0.0;
+  if (first != kNone) vertex_air_cluster[a] = first;
+  cluster_flying[c] = 1;
+  for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
+    const uint32_t v = model.cluster_members[s];
+    if (!member_active[s] || model.vertex_leaf[v] != static_cast<int32_t>(leaf) || model.vertex_anchored[v]) continue;
+    vertex_flying[v] = 1;
+    vertex_global[v] = 0;  // the rest pose no longer holds a flying leaf
+  }
+  applied_attached[leaf] = 0;
+  state.leaf_attached[leaf] = 0;
+}
+
+// state.leaf_attached => the arrays of this simulator (a state may come from a checkpoint).
+void Simulator::Impl::sync_detachments(SimState& state) {
+  for (size_t l = 0; l < L; ++l) {
+    if (state.leaf_attached[l] == applied_attached[l]) continue;
+    if (state.leaf_attached[l]) throw SimulationError("leaf " + std::to_string(l) + " was re-attached: leaves never re-attach");
+    detach_leaf(state, l);
+  }
+}
+
+// Wind at t => the air velocity at every awake cluster (at its rest centre; a flying leaf at
+// its centre of the last step).
+void Simulator::Impl::sample_air(const SimState& state, const Eigen::Vector3d& base, double scale) {
+  const int N = wind.mode_count();
+#pragma omp parallel for schedule(static)
+  for (size_t c = 0; c < C; ++c) {
+    if (!cluster_awake(state, c)) continue;
+    if (cluster_flying[c]) {
+      double sin_a[kMaxModes], cos_a[kMaxModes];
+      wind.spatial_phases(cluster_centre.col(c), sin_a, cos_a);
+      cluster_air.col(c) = base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, scale);
+    } else {
+      cluster_air.col(c) = base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
+                                                  turbulence_sin_b, turbulence_cos_b, scale);
+    }
+  }
+}
+
+// State + forces => predicted velocities v* (damping, drag, gravity, global term Eq. 8) in
+// state.velocities and predicted positions p = x + h v* in `predicted`.
+void Simulator::Impl::predict(SimState& state, bool any_asleep) {
+  const Eigen::Vector3d gravity_step = options.gravity * h;
+  const double inv_h = 1.0 / h;
+#pragma omp parallel
+  {
+    const auto [first, last] =
+        balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    for (size_t v = first; v < last; ++v) {
+      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;
+      const bool flying = vertex_flying[v];
+      if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
+      const Eigen::Vector3d x = state.positions.col(v);
+      const Eigen::Vector3d velocity = state.velocities.col(v);
+      // Quadratic drag integrated exactly over the step for constant air velocity:
+      // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
+      // the air velocity, whatever the wind speed or step.
+      const Eigen::Vector3d relative = cluster_air.col(vertex_air_cluster[v]) - velocity;
+      const double kuh = vertex_drag[v] * relative.norm() * h;
+      const Eigen::Vector3d drag_dv = relative * (kuh / (1 + kuh));
+      Eigen::Vector3d next = velocity * vertex_damping[v] + drag_dv;
+      if (flying) next += gravity_step;
+      else next += (vertex_global[v] * inv_h) * (model.rest_positions.col(v) - x);
+      state.velocities.col(v) = next;
+      predicted.col(v) = x + h * next;
+      if (detach_enabled) vertex_drag_force.col(v) = drag_dv * (model.vertex_mass[v] * inv_h);
+    }
+  }
+}
+
+// Shape match of cluster c on the predicted positions => its rotation (warm start updated),
+// centre and R; false when a value is not finite.
+bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre) {
+  const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
+  const Eigen::Vector3d t0 = cluster_rest_centre.col(c);
+  // Cluster-local coordinates: d = p - t0 is small wherever the tree stands. Since
+  // sum w q = 0, A_pq = sum w (p - t) q^T = sum w d q^T; each entry is summed as
+  // s (d_i q_j) so that A is exactly symmetric at the rest pose (R = I exactly there).
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (uint32_t s = begin; s < end; ++s) {
+    const Eigen::Vector3d d = predicted.col(model.cluster_members[s]) - t0;
+    const Eigen::Vector3d q = member_offset.col(s);
+    shift += member_centre_weight[s] * d;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) A(i, j) += member_match_weight[s] * (d[i] * q[j]);
+  }
+  centre = t0 + shift;
+  Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
+  extract_rotation(A, rotation, options.rotation_iterations);
+  state.cluster_rotations.col(c) = rotation.coeffs();
+  R = rotation.toRotationMatrix();
+  cluster_centre.col(c) = centre;
+  Eigen::Map<Eigen::Matrix3d>(&cluster_rotation_matrix(0, c)) = R;
+  return R.allFinite() && centre.allFinite();
+}
+
+// Goals g = R q + t of cluster c => per-membership corrections alpha_c (g - p).
+void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  const double alpha = cluster_alpha[c];
+  for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
+    const Eigen::Vector3d goal = R * member_offset.col(s) + t;
+    member_correction.col(s) = member_active[s]
+                                   ? Eigen::Vector3d(alpha * (goal - predicted.col(model.cluster_members[s])))
+                                   : Eigen::Vector3d::Zero();
+  }
+}
+
+// Predicted positions => corrections of every awake cluster: branches and free leaves first,
+// then the attached leaves, whose translation is pinned to their branch's goal for the shared
+// vertex (hierarchical: a 1 g leaf cannot drag its branch, nor drift off it in a gale).
+void Simulator::Impl::match_clusters(SimState& state, long long frame, int substep) {
+  uint32_t bad = kNone;
+#pragma omp parallel reduction(min : bad)
+  {
+    const auto [first, last] = balanced_range(model.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    for (size_t c = first; c < last; ++c) {
+      if (cluster_pin_slot[c] != kNone || !cluster_awake(state, c)) continue;
+      Eigen::Matrix3d R;
+      Eigen::Vector3d centre;
+      if (!fit_cluster(state, c, R, centre)) {
+        bad = std::min(bad, static_cast<uint32_t>(c));
+        continue;
+      }
+      write_corrections(c, R, centre);
+    }
+  }
+  if (bad == kNone && !pinned_leaf_clusters.empty()) {
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (size_t k = 0; k < pinned_leaf_clusters.size(); ++k) {
+      const uint32_t c = pinned_leaf_clusters[k];
+      if (cluster_pin_slot[c] == kNone || !cluster_awake(state, c)) continue;
+      Eigen::Matrix3d R;
+      Eigen::Vector3d centre;
+      if (!fit_cluster(state, c, R, centre)) {
+        bad = std::min(bad, c);
+        continue;
+      }
+      // The branch's goal for the shared vertex, and the same vertex's offset in the leaf.
+      const uint32_t pin = cluster_pin_slot[c];
+      const uint32_t branch = member_cluster[pin];
+      const Eigen::Vector3d anchor =
+          Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.col(pin) +
+          cluster_centre.col(branch);
+      write_corrections(c, R, anchor - R * member_offset.col(cluster_pin_own_slot[c]));
+    }
+  }
+  if (bad != kNone)
+    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                          std::to_string(bad) + ": the shape match produced a non-finite rotation or centre");
+}
+
+// Predicted state + averaged corrections => final velocities (Eq. 7) and positions.
+void Simulator::Impl::correct(SimState& state, bool any_asleep, long long frame, int substep) {
+  const double inv_h = 1.0 / h;
+  uint32_t bad = kNone;
+#pragma omp parallel reduction(min : bad)
+  {
+    const auto [first, last] =
+        balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    for (size_t v = first; v < last; ++v) {
+      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;
+      if (any_asleep && !vertex_flying[v] && state.island_asleep[vertex_island[v]]) continue;
+      // Average of the goals of the vertex's clusters, in membership order (never the sum).
+      Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+      for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
+        pull += member_correction.col(model.vertex_memberships[s]);
+      pull *= vertex_inv_count[v];
+      const Eigen::Vector3d next = state.velocities.col(v) + pull * inv_h;
+      const Eigen::Vector3d moved = predicted.col(v) + pull;
+      if (!moved.allFinite() || !next.allFinite()) {
+        bad = std::min(bad, static_cast<uint32_t>(v));
+        continue;
+      }
+      state.positions.col(v) = moved;
+      state.velocities.col(v) = next;
+    }
+  }
+  if (bad != kNone)
+    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                          std::to_string(vertex_air_cluster[bad]) + " (vertex " + std::to_string(bad) +
+                          "): non-finite position or velocity");
+}
+
+// Drag on each attached leaf => detach those past the threshold (in leaf order).
+void Simulator::Impl::check_detachments(SimState& state) {
+  for (size_t l = 0; l < L; ++l) {
+    if (!state.leaf_attached[l]) continue;
+    const uint32_t c = model.leaf_cluster[l];
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
+      const uint32_t v = model.cluster_members[s];
+      if (model.vertex_leaf[v] == static_cast<int32_t>(l)) force += vertex_drag_force.col(v);
+    }
+    if (force.norm() > options.leaf_detach_force) detach_leaf(state, l);
+  }
+}
+
+// End of a frame at time t: an awake island in calm air whose vertices all rest (slower than
+// sleep_velocity, closer than sleep_distance to rest) is put to sleep exactly at rest.
+void Simulator::Impl::check_sleep(SimState& state, double t) {
+  if (!wind.calm(t)) return;
+  const double v2 = options.sleep_velocity * options.sleep_velocity;
+  const double d2 = options.sleep_distance * options.sleep_distance;
+  for (size_t i = 0; i < I; ++i) {
+    if (state.island_asleep[i]) continue;
+    bool rests = true;
+    for (uint32_t k = island_vertex_offsets[i]; rests && k < island_vertex_offsets[i + 1]; ++k) {
+      const uint32_t v = island_vertices[k];
+      if (vertex_flying[v]) continue;
+      rests = state.velocities.col(v).squaredNorm() < v2 &&
+              (state.positions.col(v) - model.rest_positions.col(v)).squaredNorm() < d2;
+    }
+    if (!rests) continue;
+    state.island_asleep[i] = 1;
+    island_fell_asleep[i] = 1;
+    for (uint32_t k = island_vertex_offsets[i]; k < island_vertex_offsets[i + 1]; ++k) {
+      const uint32_t v = island_vertices[k];
+      if (vertex_flying[v]) continue;
+      state.positions.col(v) = model.rest_positions.col(v);
+      state.velocities.col(v).setZero();
+    }
+  }
+  // At the rest pose every rotation is the identity (exactly: A_pq is symmetric there).
+  for (size_t c = 0; c < C; ++c)
+    if (island_fell_asleep[cluster_island[c]] && !cluster_flying[c])
+      state.cluster_rotations.col(c) = Eigen::Quaterniond::Identity().coeffs();
+  std::fill(island_fell_asleep.begin(), island_fell_asleep.end(), 0);
+}
+
+// One substep starting at time t.
+void Simulator::Impl::step(SimState& state, double t, long long frame, int substep) {
+  bool any_asleep = false;
+  if (options.sleep) {
+    const bool calm = wind.calm(t);
+    for (size_t i = 0; i < I; ++i) {
+      if (!calm) state.island_asleep[i] = 0;
+      any_asleep = any_asleep || state.island_asleep[i];
+    }
+    const bool all_asleep = any_asleep && std::all_of(state.island_asleep.begin(), state.island_asleep.end(),
+                                                      [](uint8_t a) { return a != 0; });
+    if (all_asleep && std::none_of(cluster_flying.begin(), cluster_flying.end(), [](uint8_t f) { return f != 0; }))
+      return;
+  }
+  const Eigen::Vector3d base = wind.base(t);
+  const double scale = wind.temporal_phases(t, turbulence_sin_b, turbulence_cos_b);
+  sample_air(state, base, scale);
+  predict(state, any_asleep);
+  if (detach_enabled) check_detachments(state);
+  match_clusters(state, frame, substep);
+  correct(state, any_asleep, frame, substep);
+}
+
+Simulator::Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
+                     double frame_dt, int substeps)
+    : impl_(std::make_unique<Impl>(model, options, wind, frame_dt, substeps)) {}
+
+Simulator::~Simulator() = default;
+
+SimState Simulator::initial_state(double time) const {
+  const Impl& s = *impl_;
+  SimState state;
+  state.positions = s.model.rest_positions;
+  state.velocities.setZero(3, s.V);
+  state.leaf_attached.assign(s.L, 1);
+  state.time = time;
+  state.cluster_rotations.resize(4, s.C);
+  for (size_t c = 0; c < s.C; ++c) state.cluster_rotations.col(c) = Eigen::Quaterniond::Identity().coeffs();
+  // At rest in calm air there is nothing to do until the wind rises.
+  state.island_asleep.assign(s.I, s.options.sleep && s.wind.calm(time) ? 1 : 0);
+  return state;
+}
+
+void Simulator::advance_frame(SimState& state, long long frame) {
+  Impl& s = *impl_;
+  if (state.positions.cols() != static_cast<Eigen::Index>(s.V) || state.leaf_attached.size() != s.L ||
+      state.cluster_rotations.cols() != static_cast<Eigen::Index>(s.C) || state.island_asleep.size() != s.I)
+    throw SimulationError("frame " + std::to_string(frame) + ": the state does not belong to this tree model");
+  s.sync_detachments(state);
+  const double start = state.time;
+  for (int k = 0; k < s.substeps; ++k) s.step(state, start + k * s.h, frame, k);
+  state.time = start + s.frame_dt;
+  if (s.options.sleep) s.check_sleep(state, state.time);
+}
+
+}  // namespace treeanim

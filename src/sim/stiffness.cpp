@@ -1,0 +1,166 @@
+#include "sim/stiffness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "common/errors.h"
+
+namespace treeanim {
+
+namespace {
+
+// First root of the clamped-free beam equation cos(b)cosh(b) = -1: w1 = b^2 sqrt(EI / (mu L^4)).
+constexpr double kCantileverRoot = 1.8751040687119611;
+
+// Cantilever of radius r (m), length L (m), mass m (kg) => first bending frequency (rad/s).
+// A solid wood cylinder: I = pi r^4 / 4; mass per length m / L.
+double cantilever_frequency(double E, double r, double L, double m) {
+  if (!(r > 0 && L > 0 && m > 0)) return 0;
+  const double I = std::numbers::pi * r * r * r * r / 4;
+  return kCantileverRoot * kCantileverRoot * std::sqrt(E * I / (m * L * L * L));
+}
+
+// cluster_parent => clusters ordered parents first (depth ascending, then index).
+std::vector<uint32_t> parents_first(const TreeModel& model) {
+  const size_t C = model.cluster_count();
+  std::vector<int> depth(C, -1);
+  for (size_t c = 0; c < C; ++c) {
+    // Walk up to a known depth, then unwind; a walk longer than C means a cycle.
+    size_t steps = 0;
+    int32_t a = static_cast<int32_t>(c);
+    while (a >= 0 && depth[a] < 0) {
+      a = model.cluster_parent[a];
+      if (++steps > C) throw InputError("tree model: cluster_parent contains a cycle");
+    }
+    const int base = a >= 0 ? depth[a] : -1;
+    std::vector<int32_t> chain;
+    for (int32_t b = static_cast<int32_t>(c); b != a; b = model.cluster_parent[b]) chain.push_back(b);
+    for (size_t i = chain.size(); i-- > 0;) depth[chain[i]] = base + int(chain.size() - i);
+  }
+  std::vector<uint32_t> order(C);
+  for (size_t c = 0; c < C; ++c) order[c] = static_cast<uint32_t>(c);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return depth[a] < depth[b]; });
+  return order;
+}
+
+// Physical mode: segment (local) and limb frequencies of every cluster (docs/solver.md).
+void physical_frequencies(const TreeModel& model, const SimOptions& options, StepRates& rates) {
+  const size_t C = model.cluster_count();
+  const double E = options.youngs_modulus;
+  // Each vertex's mass is shared among its clusters, so subtree sums count it once.
+  std::vector<double> own_mass(C, 0);
+  for (size_t c = 0; c < C; ++c)
+    for (uint32_t m = model.cluster_offsets[c]; m < model.cluster_offsets[c + 1]; ++m) {
+      const uint32_t v = model.cluster_members[m];
+      const uint32_t k = model.vertex_cluster_offsets[v + 1] - model.vertex_cluster_offsets[v];
+      if (!model.vertex_anchored[v]) own_mass[c] += model.vertex_mass[v] / k;
+    }
+  const std::vector<uint32_t> order = parents_first(model);
+  // Children before parents: the limb hanging from c has the mass of its subtree and the
+  // length of its longest branch path (leaves add mass, not length).
+  std::vector<double> limb_mass(own_mass), limb_length(C, 0);
+  for (size_t i = C; i-- > 0;) {
+    const uint32_t c = order[i];
+    if (model.cluster_kind[c] == kClusterBranch) limb_length[c] += model.cluster_length[c];
+    const int32_t p = model.cluster_parent[c];
+    if (p < 0) continue;
+    limb_mass[p] += limb_mass[c];
+    limb_length[p] = std::max(limb_length[p], limb_length[c]);
+  }
+  // Parents before children: a cluster sways at most at the frequency of the softest limb
+  // between it and the ground (a twig on a swaying bough moves with the bough).
+  rates.cluster_frequency.assign(C, 0);
+  rates.cluster_limb_frequency.assign(C, 0);
+  for (uint32_t c : order) {
+    const int32_t p = model.cluster_parent[c];
+    const double parent = p >= 0 ? rates.cluster_limb_frequency[p] : std::numeric_limits<double>::infinity();
+    if (model.cluster_kind[c] == kClusterLeaf) {
+      rates.cluster_limb_frequency[c] = std::isfinite(parent) ? parent : 0;
+      continue;
+    }
+    const double r = model.cluster_radius[c];
+    rates.cluster_frequency[c] = cantilever_frequency(E, r, model.cluster_length[c], own_mass[c]);
+    const double limb = cantilever_frequency(E, r, limb_length[c], limb_mass[c]);
+    rates.cluster_limb_frequency[c] = std::min(parent, limb);
+  }
+}
+
+}  // namespace
+
+double global_rate(double omega, double h) {
+  const double wh = omega * h;
+  return wh < std::numbers::pi / 3 ? 2 * (1 - std::cos(wh)) : 1.0;
+}
+
+double local_rate(double omega, double h) {
+  const double wh = omega * h;
+  return wh < std::numbers::pi / 2 ? std::sin(wh) * std::sin(wh) : 1.0;
+}
+
+double global_frequency(double rate, double h) { return std::acos(1 - std::clamp(rate, 0.0, 4.0) / 2) / h; }
+
+double local_frequency(double rate, double h) { return std::asin(std::sqrt(std::clamp(rate, 0.0, 1.0))) / h; }
+
+StepRates compute_step_rates(const TreeModel& model, const SimOptions& options, double h) {
+  const size_t C = model.cluster_count(), V = model.vertex_count();
+  StepRates rates;
+  rates.cluster_alpha.assign(C, 0);
+  std::vector<double> cluster_global(C, 0);  // per-step global rate of each cluster's vertices
+  std::vector<double> cluster_damping_frequency(C, 0);
+  size_t branches = 0, capped = 0;
+  if (options.stiffness == StiffnessMode::kPhysical) {
+    physical_frequencies(model, options, rates);
+    for (size_t c = 0; c < C; ++c) {
+      const bool leaf = model.cluster_kind[c] == kClusterLeaf;
+      // A branch cluster without geometry (zero radius, length or mass) has no finite
+      // frequency: it gets the stiffest rate, like an unresolved one.
+      rates.cluster_alpha[c] = leaf ? options.leaf_alpha
+                               : rates.cluster_frequency[c] > 0 ? local_rate(rates.cluster_frequency[c], h)
+                                                                : 1.0;
+      if (!leaf) {
+        ++branches;
+        capped += rates.cluster_alpha[c] == 1.0;
+      }
+      const double w = rates.cluster_limb_frequency[c];
+      cluster_global[c] = global_rate(std::sqrt(options.global_scale) * w, h);
+      cluster_damping_frequency[c] = w;
+    }
+  } else {
+    rates.cluster_frequency.assign(C, 0);
+    rates.cluster_limb_frequency.assign(C, 0);
+    for (size_t c = 0; c < C; ++c) {
+      const bool leaf = model.cluster_kind[c] == kClusterLeaf;
+      rates.cluster_alpha[c] = leaf ? options.leaf_alpha : options.alpha;
+      cluster_global[c] = options.k_d;
+      // The frequency the per-step rates stand for at this h: of the global term when it is
+      // on, else of the local term.
+      cluster_damping_frequency[c] = options.global_matching && options.k_d > 0
+                                         ? global_frequency(options.k_d, h)
+                                         : local_frequency(rates.cluster_alpha[c], h);
+    }
+  }
+  rates.capped_fraction = branches ? double(capped) / double(branches) : 0;
+
+  // Per vertex: the mean over its clusters, in membership order (deterministic).
+  rates.vertex_global.assign(V, 0);
+  rates.vertex_damping.assign(V, 1);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
+    if (model.vertex_anchored[v] || begin == end) continue;
+    double global = 0, omega = 0;
+    for (uint32_t s = begin; s < end; ++s) {
+      const uint32_t c = static_cast<uint32_t>(
+          std::upper_bound(model.cluster_offsets.begin(), model.cluster_offsets.end(), model.vertex_memberships[s]) -
+          model.cluster_offsets.begin() - 1);
+      global += cluster_global[c];
+      omega += cluster_damping_frequency[c];
+    }
+    const double k = end - begin;
+    rates.vertex_global[v] = options.global_matching ? global / k : 0;
+    rates.vertex_damping[v] = std::exp(-2 * options.damping_ratio * (omega / k) * h);
+  }
+  return rates;
+}
+
+}  // namespace treeanim

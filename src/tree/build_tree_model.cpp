@@ -1,0 +1,137 @@
+#include "tree/build_tree_model.h"
+
+#include <algorithm>
+#include <string>
+
+#include "common/errors.h"
+#include "tree/tree_build_steps.h"
+
+namespace treeanim {
+namespace {
+
+// A vertex of a zero-length (or zero-area) cluster would otherwise get mass 0 and an infinite
+// inverse mass; this keeps it finite without visibly changing any real tree's mass.
+constexpr double kMinVertexMass = 1e-9;  // kg
+
+// Spreads `amount` equally over the members of cluster c that pass `keep` into `out`.
+template <class Keep>
+void spread(const TreeModel& model, size_t c, double amount, Keep&& keep, std::vector<double>& out) {
+  const auto first = model.cluster_members.begin() + model.cluster_offsets[c];
+  const auto last = model.cluster_members.begin() + model.cluster_offsets[c + 1];
+  const auto n = std::count_if(first, last, keep);
+  if (n == 0) return;
+  const double share = amount / double(n);
+  for (auto it = first; it != last; ++it)
+    if (keep(*it)) out[*it] += share;
+}
+
+// Anchors: the base ring of every root axis, and a leaf drawn before any segment (its
+// petiole has no branch to hang from, so it is fixed where it was drawn).
+void anchor(const SegmentTopology& topology, const BranchRings& rings, const LeafMeshes& leaves,
+            uint32_t sides, TreeModel& model) {
+  model.vertex_anchored.assign(model.vertex_count(), 0);
+  for (size_t s = 0; s < topology.starts_axis.size(); ++s)
+    if (model.segment_parent[s] < 0)
+      std::fill_n(model.vertex_anchored.begin() + rings.base_ring[s], sides, uint8_t(1));
+  for (size_t l = 0; l < leaves.attachment.size(); ++l)
+    if (model.cluster_parent[model.leaf_cluster[l]] < 0) model.vertex_anchored[leaves.attachment[l]] = 1;
+}
+
+// The Skeleton's array sizes and parents-first order, which every later step indexes by.
+void check_skeleton(const Skeleton& sk) {
+  const size_t S = sk.segment_count(), L = sk.leaf_count();
+  const bool segments_ok = sk.segment_end.size() == S && sk.segment_up.size() == S &&
+                           sk.segment_width.size() == S && sk.segment_parent.size() == S &&
+                           sk.segment_continues_parent.size() == S;
+  const bool leaves_ok = sk.leaf_segment.size() == L && sk.leaf_heading.size() == L &&
+                         sk.leaf_left.size() == L && sk.leaf_up.size() == L &&
+                         sk.leaf_scale.size() == L && sk.leaf_polygon_offsets.size() >= L + (L > 0);
+  if (!segments_ok || !leaves_ok) throw InputError("skeleton: array sizes disagree");
+  for (size_t s = 0; s < S; ++s)
+    if (sk.segment_parent[s] < -1 || sk.segment_parent[s] >= int32_t(s))
+      throw InputError("skeleton: segment_parent[" + std::to_string(s) + "] is not an earlier segment");
+  for (size_t l = 0; l < L; ++l)
+    if (sk.leaf_segment[l] < -1 || sk.leaf_segment[l] >= int32_t(S) ||
+        sk.leaf_polygon_offsets[l + 1] < sk.leaf_polygon_offsets[l] ||
+        sk.leaf_polygon_offsets[l + 1] > sk.polygon_points.size())
+      throw InputError("skeleton: leaf " + std::to_string(l) + " has a bad segment or polygon range");
+}
+
+}  // namespace
+
+void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
+                   const BranchRings& rings, const LeafMeshes& leaves, TreeModel& model) {
+  const size_t V = model.vertex_count(), C = model.cluster_count();
+  std::vector<double> volume(C, 0.0), area(C, 0.0);  // m^3 and projected m^2 per cluster
+  for (size_t s = 0; s < model.segment_count(); ++s) {
+    const double rb = model.segment_radius_base[s], rt = model.segment_radius_top[s];
+    const double l = topology.length[s];
+    volume[model.segment_cluster[s]] += truncated_cone_volume(rb, rt, l);
+    area[model.segment_cluster[s]] += (rb + rt) * l;  // 2 * mean radius * length
+  }
+  model.vertex_mass.assign(V, 0.0);
+  model.vertex_drag_area.assign(V, 0.0);
+  // Wood goes to branch vertices only: a petiole vertex in a branch cluster carries its
+  // leaf's mass, and takes it along when the leaf detaches.
+  const auto is_branch = [&](uint32_t v) { return model.vertex_leaf[v] < 0; };
+  const auto is_leaf = [&](uint32_t v) { return model.vertex_leaf[v] >= 0; };
+  for (size_t c = 0; c < C; ++c) {
+    if (model.cluster_kind[c] == kClusterBranch) {
+      spread(model, c, options.wood_density * volume[c], is_branch, model.vertex_mass);
+      spread(model, c, area[c], is_branch, model.vertex_drag_area);
+    } else {
+      const size_t l = size_t(model.cluster_leaf[c]);
+      spread(model, c, options.leaf.areal_density * leaves.area[l], is_leaf, model.vertex_mass);
+      spread(model, c, leaves.area[l], is_leaf, model.vertex_drag_area);
+    }
+  }
+  for (double& m : model.vertex_mass) m = std::max(m, kMinVertexMass);
+  anchor(topology, rings, leaves, uint32_t(options.ring_sides), model);
+  model.vertex_inv_mass.resize(V);
+  for (size_t v = 0; v < V; ++v) model.vertex_inv_mass[v] = model.vertex_anchored[v] ? 0.0 : 1.0 / model.vertex_mass[v];
+  model.cluster_mass.assign(C, 0.0);
+  for (size_t c = 0; c < C; ++c)
+    for (uint32_t i = model.cluster_offsets[c]; i < model.cluster_offsets[c + 1]; ++i) {
+      const uint32_t v = model.cluster_members[i];
+      if (!model.vertex_anchored[v]) model.cluster_mass[c] += model.vertex_mass[v];
+    }
+}
+
+TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options) {
+  check_skeleton(skeleton);
+  TreeModel model;
+  const SegmentTopology topology = segment_topology(skeleton, options.scale);
+  segment_radii(skeleton, topology, options, model);
+
+  // Leaf shape: loaded whenever a mesh is named, so a bad path is reported even on a bare tree.
+  const LeafTemplate shape = options.leaf.mesh ? load_leaf_template(options.leaf) : default_leaf_template(options.leaf);
+  MeshCounts counts;
+  counts.branch_vertices = branch_vertex_count(topology, options.ring_sides);
+  counts.branch_triangles = branch_triangle_count(topology, options.ring_sides);
+  counts.leaf_vertices = leaf_vertex_count(skeleton, shape);
+  counts.leaf_triangles = leaf_triangle_count(skeleton, shape);
+  const size_t V = counts.branch_vertices + counts.leaf_vertices;
+  model.rest_positions.resize(3, Eigen::Index(V));
+  model.uvs.resize(2, Eigen::Index(V));
+  model.vertex_segment.resize(V);
+  model.vertex_leaf.resize(V);
+  model.triangles.resize(3 * (counts.branch_triangles + counts.leaf_triangles));
+
+  const BranchRings rings = build_branch_mesh(skeleton, topology, options, model);
+  const LeafMeshes leaves = build_leaf_meshes(skeleton, options, shape, counts, model);
+
+  model.segment_start.resize(skeleton.segment_count());
+  model.segment_end.resize(skeleton.segment_count());
+  for (size_t s = 0; s < skeleton.segment_count(); ++s) {
+    model.segment_start[s] = skeleton.segment_start[s] * options.scale;
+    model.segment_end[s] = skeleton.segment_end[s] * options.scale;
+  }
+  model.segment_parent = skeleton.segment_parent;
+
+  build_clusters(skeleton, topology, options, rings, leaves, model);
+  assign_masses(topology, options, rings, leaves, model);
+  validate_tree_model(model);
+  return model;
+}
+
+}  // namespace treeanim

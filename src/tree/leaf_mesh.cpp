@@ -1,0 +1,216 @@
+// Leaf meshes: the default quad, a custom mesh read with assimp, or the grammar's '{ . }' outlines.
+#include <Eigen/Geometry>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "common/errors.h"
+#include "tree/tree_build_steps.h"
+
+namespace treeanim {
+namespace {
+
+// Leaf l uses its '{ . }' outline when it has a polygon (fewer than 3 points enclose no area and
+// fall back to the instanced shape).
+uint32_t outline_points(const Skeleton& skeleton, size_t l) {
+  const uint32_t n = skeleton.leaf_polygon_offsets[l + 1] - skeleton.leaf_polygon_offsets[l];
+  return n >= 3 ? n : 0;
+}
+
+// Area of a triangle mesh given as positions (3 x n) and triangles => m^2.
+double mesh_area(const Eigen::Matrix3Xd& p, const std::vector<uint32_t>& triangles) {
+  double area = 0;
+  for (size_t t = 0; t < triangles.size(); t += 3) {
+    const Eigen::Vector3d a = p.col(triangles[t]);
+    area += 0.5 * (p.col(triangles[t + 1]) - a).cross(p.col(triangles[t + 2]) - a).norm();
+  }
+  return area;
+}
+
+// Appends one assimp mesh's triangles and vertices to the template being assembled.
+void append_ai_mesh(const aiMesh& mesh, std::vector<Eigen::Vector3d>& points,
+                    std::vector<Eigen::Vector2f>& uvs, std::vector<uint32_t>& triangles) {
+  const uint32_t first = uint32_t(points.size());
+  for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
+    const aiVector3D& v = mesh.mVertices[i];
+    points.emplace_back(v.x, v.y, v.z);
+    const bool has_uv = mesh.HasTextureCoords(0);
+    uvs.emplace_back(has_uv ? mesh.mTextureCoords[0][i].x : 0.f,
+                     has_uv ? mesh.mTextureCoords[0][i].y : 0.f);
+  }
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices != 3) continue;  // points and lines of the file carry no area
+    for (unsigned k = 0; k < 3; ++k) triangles.push_back(first + face.mIndices[k]);
+  }
+}
+
+}  // namespace
+
+LeafTemplate default_leaf_template(const LeafOptions& options) {
+  const double len = options.size, half_w = 0.5 * options.size * options.aspect;
+  const double y0 = options.petiole;
+  LeafTemplate t;
+  t.positions.resize(3, 4);
+  // base, right, tip, left: counter-clockwise seen from +z (the turtle's U).
+  t.positions.col(0) << 0, y0, 0;
+  t.positions.col(1) << half_w, y0 + 0.5 * len, 0;
+  t.positions.col(2) << 0, y0 + len, 0;
+  t.positions.col(3) << -half_w, y0 + 0.5 * len, 0;
+  t.uvs.resize(2, 4);
+  t.uvs << 0.5f, 1.f, 0.5f, 0.f,
+           0.f, 0.5f, 1.f, 0.5f;
+  t.triangles = {0, 1, 2, 0, 2, 3};
+  t.attachment = 0;
+  t.area = len * half_w;
+  t.length = len;
+  return t;
+}
+
+LeafTemplate load_leaf_template(const LeafOptions& options) {
+  const std::string file = options.mesh->string();
+  Assimp::Importer importer;
+  // Normals and colours are dropped before joining so that vertices split only for shading
+  // merge back: the simulation wants one particle per surface point.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                  aiComponent_COLORS | aiComponent_BONEWEIGHTS |
+                                  aiComponent_ANIMATIONS | aiComponent_LIGHTS |
+                                  aiComponent_CAMERAS | aiComponent_MATERIALS);
+  const aiScene* scene = importer.ReadFile(
+      file, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                aiProcess_JoinIdenticalVertices);
+  if (!scene || !scene->mRootNode)
+    throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2f> uvs;
+  LeafTemplate t;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) append_ai_mesh(*scene->mMeshes[m], points, uvs, t.triangles);
+  if (t.triangles.empty()) throw InputError(file + ": leaf mesh has no triangles");
+  t.positions.resize(3, Eigen::Index(points.size()));
+  t.uvs.resize(2, Eigen::Index(uvs.size()));
+  for (size_t i = 0; i < points.size(); ++i) {
+    t.positions.col(Eigen::Index(i)) = points[i];
+    t.uvs.col(Eigen::Index(i)) = uvs[i];
+  }
+  const double extent = (t.positions.rowwise().maxCoeff() - t.positions.rowwise().minCoeff()).maxCoeff();
+  if (!(extent > 0)) throw InputError(file + ": leaf mesh has zero extent");
+  t.positions *= options.size / extent;
+  t.positions.row(1).array() += options.petiole;
+  const Eigen::Vector3d petiole_base(0, options.petiole, 0);
+  Eigen::Index nearest = 0;
+  (t.positions.colwise() - petiole_base).colwise().squaredNorm().minCoeff(&nearest);
+  t.attachment = uint32_t(nearest);
+  t.area = mesh_area(t.positions, t.triangles);
+  t.length = t.positions.row(1).maxCoeff() - t.positions.row(1).minCoeff();
+  return t;
+}
+
+size_t leaf_vertex_count(const Skeleton& skeleton, const LeafTemplate& shape) {
+  size_t n = 0;
+  for (size_t l = 0; l < skeleton.leaf_count(); ++l) {
+    const uint32_t outline = outline_points(skeleton, l);
+    n += outline ? outline : size_t(shape.positions.cols());
+  }
+  return n;
+}
+
+size_t leaf_triangle_count(const Skeleton& skeleton, const LeafTemplate& shape) {
+  size_t n = 0;
+  for (size_t l = 0; l < skeleton.leaf_count(); ++l) {
+    const uint32_t outline = outline_points(skeleton, l);
+    n += outline ? outline - 2 : shape.triangles.size() / 3;
+  }
+  return n;
+}
+
+namespace {
+
+// The turtle frame of leaf l as a rotation from the leaf frame (+y => H, -x => L, +z => U).
+Eigen::Matrix3d leaf_frame(const Skeleton& skeleton, size_t l) {
+  Eigen::Matrix3d r;
+  r.col(0) = -skeleton.leaf_left[l];
+  r.col(1) = skeleton.leaf_heading[l];
+  r.col(2) = skeleton.leaf_up[l];
+  return r;
+}
+
+// Instance of `shape` at leaf l, from vertex `first` and triangle slot `tri` on.
+void write_instance(const Skeleton& skeleton, const TreeOptions& options, const LeafTemplate& shape,
+                    size_t l, uint32_t first, uint32_t*& tri, TreeModel& model) {
+  const Eigen::Matrix3d frame = leaf_frame(skeleton, l) * skeleton.leaf_scale[l];
+  const Eigen::Vector3d origin = skeleton.leaf_position[l] * options.scale;
+  const Eigen::Index n = shape.positions.cols();
+  model.rest_positions.middleCols(first, n) = (frame * shape.positions).colwise() + origin;
+  model.uvs.middleCols(first, n) = shape.uvs;
+  for (uint32_t i : shape.triangles) *tri++ = first + i;
+}
+
+// Outline of leaf l (n >= 3 points) fan-triangulated from its first point, wound so that its
+// front faces the turtle's U. => area (m^2); attachment = the point nearest the leaf position.
+double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
+                     uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
+  const uint32_t p0 = skeleton.leaf_polygon_offsets[l];
+  const Eigen::Vector3d origin = skeleton.leaf_position[l] * options.scale;
+  const Eigen::Matrix3d to_leaf = leaf_frame(skeleton, l).transpose();
+  Eigen::Vector3d newell = Eigen::Vector3d::Zero();
+  double nearest = std::numeric_limits<double>::infinity();
+  attachment = first;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = skeleton.polygon_points[p0 + i] * options.scale;
+    const Eigen::Vector3d q = skeleton.polygon_points[p0 + (i + 1) % n] * options.scale;
+    newell += p.cross(q);
+    model.rest_positions.col(first + i) = p;
+    const Eigen::Vector3d local = to_leaf * (p - origin);
+    model.uvs.col(first + i) = Eigen::Vector2f(float(local.x()), float(local.y()));
+    const double d = (p - origin).squaredNorm();
+    if (d < nearest) nearest = d, attachment = first + i;
+  }
+  const bool flip = newell.dot(skeleton.leaf_up[l]) < 0;
+  for (uint32_t i = 1; i + 1 < n; ++i) {
+    *tri++ = first;
+    *tri++ = first + (flip ? i + 1 : i);
+    *tri++ = first + (flip ? i : i + 1);
+  }
+  return 0.5 * newell.norm();
+}
+
+}  // namespace
+
+LeafMeshes build_leaf_meshes(const Skeleton& skeleton, const TreeOptions& options,
+                             const LeafTemplate& shape, const MeshCounts& counts, TreeModel& model) {
+  const size_t L = skeleton.leaf_count();
+  LeafMeshes leaves;
+  leaves.vertex_offsets.resize(L + 1);
+  leaves.attachment.resize(L);
+  leaves.area.resize(L);
+  leaves.length.resize(L);
+  uint32_t next = uint32_t(counts.branch_vertices);
+  uint32_t* tri = model.triangles.data() + 3 * counts.branch_triangles;
+  for (size_t l = 0; l < L; ++l) {
+    leaves.vertex_offsets[l] = next;
+    const uint32_t outline = outline_points(skeleton, l);
+    if (outline) {
+      leaves.area[l] = write_outline(skeleton, options, l, outline, next, tri, leaves.attachment[l], model);
+      const Eigen::Matrix2Xf uv = model.uvs.middleCols(next, outline);
+      leaves.length[l] = double(uv.row(1).maxCoeff() - uv.row(1).minCoeff());
+      next += outline;
+    } else {
+      write_instance(skeleton, options, shape, l, next, tri, model);
+      const double s = skeleton.leaf_scale[l];
+      leaves.area[l] = shape.area * s * s;
+      leaves.length[l] = shape.length * s;
+      leaves.attachment[l] = next + shape.attachment;
+      next += uint32_t(shape.positions.cols());
+    }
+    std::fill(model.vertex_segment.begin() + leaves.vertex_offsets[l], model.vertex_segment.begin() + next, -1);
+    std::fill(model.vertex_leaf.begin() + leaves.vertex_offsets[l], model.vertex_leaf.begin() + next, int32_t(l));
+  }
+  leaves.vertex_offsets[L] = next;
+  return leaves;
+}
+
+}  // namespace treeanim

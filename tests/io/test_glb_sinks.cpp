@@ -1,0 +1,130 @@
+// Animated GLB parsed back byte by byte (header, chunks, accessors, targets, one-hot weights)
+// and the assimp glTF sequence read back through assimp's importer.
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "io/glb_size.h"
+#include "io_test_support.h"
+
+namespace treeanim {
+namespace {
+
+using test::small_frame;
+using test::small_info;
+using test::small_model;
+
+struct Glb {
+  nlohmann::json json;
+  std::string bin;
+};
+
+uint32_t u32_at(const std::string& bytes, size_t offset) {
+  uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + offset, 4);
+  return v;
+}
+
+Glb parse_glb(const std::filesystem::path& path) {
+  const std::string bytes = test::read_file(path);
+  Glb glb;
+  EXPECT_EQ(u32_at(bytes, 0), 0x46546C67u);
+  EXPECT_EQ(u32_at(bytes, 4), 2u);
+  EXPECT_EQ(u32_at(bytes, 8), bytes.size());
+  const uint32_t json_length = u32_at(bytes, 12);
+  EXPECT_EQ(u32_at(bytes, 16), 0x4E4F534Au);
+  EXPECT_EQ(json_length % 4, 0u);
+  glb.json = nlohmann::json::parse(bytes.substr(20, json_length));
+  const size_t bin_header = 20 + json_length;
+  EXPECT_EQ(u32_at(bytes, bin_header + 4), 0x004E4942u);
+  glb.bin = bytes.substr(bin_header + 8, u32_at(bytes, bin_header));
+  EXPECT_EQ(bin_header + 8 + glb.bin.size(), bytes.size());
+  return glb;
+}
+
+// Accessor `index` of a float glTF, as floats.
+std::vector<float> accessor_floats(const Glb& glb, size_t index) {
+  const auto& accessor = glb.json["accessors"][index];
+  const auto& view = glb.json["bufferViews"][accessor["bufferView"].get<size_t>()];
+  const size_t components = accessor["type"] == "VEC3" ? 3 : accessor["type"] == "VEC2" ? 2 : 1;
+  std::vector<float> values(accessor["count"].get<size_t>() * components);
+  const size_t offset = view.value("byteOffset", size_t(0)) + accessor.value("byteOffset", size_t(0));
+  std::memcpy(values.data(), glb.bin.data() + offset, 4 * values.size());
+  return values;
+}
+
+class GlbSinks : public test::TempFolder {};
+
+TEST_F(GlbSinks, AnimatedGlbHasOneMorphTargetPerFrame) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info(5, 1);
+  test::bake({test::output("glb", "anim.glb", 2)}, dir_, m, info);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"anim.glb"}));
+  EXPECT_EQ(std::filesystem::file_size(dir_ / "anim.glb"), animated_glb_bytes(m, info, 2));
+  const Glb glb = parse_glb(dir_ / "anim.glb");
+  const auto& primitive = glb.json["meshes"][0]["primitives"][0];
+  const std::vector<float> rest = accessor_floats(glb, primitive["attributes"]["POSITION"]);
+  EXPECT_EQ(rest, test::rest_f32(m));
+  const std::vector<float> uv = accessor_floats(glb, primitive["attributes"]["TEXCOORD_0"]);
+  for (long v = 0; v < 6; ++v) {
+    EXPECT_EQ(uv[size_t(2 * v)], m.uvs(0, v));
+    EXPECT_EQ(uv[size_t(2 * v + 1)], 1.0f - m.uvs(1, v));
+  }
+  std::vector<uint32_t> indices(9);
+  std::memcpy(indices.data(), glb.bin.data(), 36);
+  EXPECT_EQ(indices, m.triangles);
+
+  const std::vector<long long> frames{1, 3, 5};
+  ASSERT_EQ(primitive["targets"].size(), frames.size());
+  EXPECT_EQ(glb.json["meshes"][0]["extras"]["targetNames"],
+            nlohmann::json({"frame_0001", "frame_0003", "frame_0005"}));
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const size_t accessor = primitive["targets"][k]["POSITION"];
+    const std::vector<float> displacement = accessor_floats(glb, accessor);
+    const FrameData frame = small_frame(m, frames[k]);
+    for (size_t i = 0; i < displacement.size(); ++i) {
+      EXPECT_EQ(displacement[i], frame.positions[i] - rest[i]);
+      EXPECT_LE(displacement[i], glb.json["accessors"][accessor]["max"][i % 3].get<float>());
+      EXPECT_GE(displacement[i], glb.json["accessors"][accessor]["min"][i % 3].get<float>());
+    }
+  }
+  const auto& sampler = glb.json["animations"][0]["samplers"][0];
+  EXPECT_EQ(sampler["interpolation"], "LINEAR");
+  EXPECT_EQ(glb.json["animations"][0]["channels"][0]["target"]["path"], "weights");
+  const std::vector<float> times = accessor_floats(glb, sampler["input"]);
+  EXPECT_EQ(times, (std::vector<float>{float(1 / 24.0), float(3 / 24.0), float(5 / 24.0)}));
+  const std::vector<float> weights = accessor_floats(glb, sampler["output"]);
+  ASSERT_EQ(weights.size(), 9u);
+  for (size_t key = 0; key < 3; ++key)
+    for (size_t target = 0; target < 3; ++target) EXPECT_EQ(weights[3 * key + target], key == target ? 1.0f : 0.0f);
+}
+
+TEST_F(GlbSinks, AssimpSequenceKeepsVerticesAndFaces) {
+  const TreeModel m = small_model();
+  test::bake({test::output("gltf", "gltf/tree.%03d.glb")}, dir_, m, small_info(2, 0));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"gltf", "gltf/tree.000.glb", "gltf/tree.001.glb"}));
+  for (long long f : {0, 1}) {
+    Assimp::Importer importer;
+    const std::string path = (dir_ / ("gltf/tree.00" + std::to_string(f) + ".glb")).string();
+    const aiScene* scene = importer.ReadFile(path, 0);
+    ASSERT_NE(scene, nullptr) << importer.GetErrorString();
+    ASSERT_EQ(scene->mNumMeshes, 1u);
+    const aiMesh* mesh = scene->mMeshes[0];
+    ASSERT_EQ(mesh->mNumVertices, 6u);
+    const FrameData frame = small_frame(m, f);
+    for (unsigned v = 0; v < 6; ++v) {
+      EXPECT_EQ(mesh->mVertices[v].x, frame.positions[3 * v]);
+      EXPECT_EQ(mesh->mVertices[v].y, frame.positions[3 * v + 1]);
+      EXPECT_EQ(mesh->mVertices[v].z, frame.positions[3 * v + 2]);
+      EXPECT_EQ(mesh->mTextureCoords[0][v].x, m.uvs(0, v));
+      EXPECT_EQ(mesh->mTextureCoords[0][v].y, m.uvs(1, v));  // assimp flips v back on import
+    }
+    ASSERT_EQ(mesh->mNumFaces, 3u);
+    for (unsigned t = 0; t < 3; ++t)
+      for (unsigned c = 0; c < 3; ++c) EXPECT_EQ(mesh->mFaces[t].mIndices[c], m.triangles[3 * t + c]);
+  }
+}
+
+}  // namespace
+}  // namespace treeanim

@@ -1,0 +1,317 @@
+// Turtle interpretation (docs/turtle.md): golden positions, rotations against the analytical
+// rotation, '$', tropism, brackets, parent links, leaves, polygons, '%', widths, materials.
+// Words are built with ModuleString::push so these tests do not depend on the grammar parser.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lsystem/turtle.h"
+
+namespace treeanim {
+namespace {
+
+using Eigen::Vector3d;
+
+constexpr double kTol = 1e-12;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// "F(1)[+(90,2)F]" => modules: one character each, numeric parameters in parentheses.
+ModuleString word(const std::string& text) {
+  ModuleString w;
+  w.clear();
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char symbol = text[i];
+    std::vector<double> params;
+    if (i + 1 < text.size() && text[i + 1] == '(') {
+      const char* p = text.c_str() + i + 2;
+      while (*p != ')') {
+        char* end = nullptr;
+        params.push_back(std::strtod(p, &end));
+        p = (*end == ',') ? end + 1 : end;
+      }
+      i = static_cast<size_t>(p - text.c_str());
+    }
+    w.push(symbol, params);
+  }
+  return w;
+}
+
+Skeleton draw(const std::string& text, const TurtleSettings& settings = {}) {
+  return interpret(word(text), settings);
+}
+
+void expect_near(const Vector3d& actual, const Vector3d& expected, double tol = kTol) {
+  EXPECT_LE((actual - expected).norm(), tol) << "actual " << actual.transpose() << " expected "
+                                             << expected.transpose();
+}
+
+struct Frame {
+  Vector3d h, l, u;
+};
+
+Frame leaf_frame(const Skeleton& k, size_t leaf) {
+  return {k.leaf_heading[leaf], k.leaf_left[leaf], k.leaf_up[leaf]};
+}
+
+void expect_orthonormal_right_handed(const Frame& f) {
+  EXPECT_NEAR(f.h.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(f.l.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(f.h.dot(f.l), 0.0, 1e-12);
+  expect_near(f.h.cross(f.l), f.u, 1e-12);
+}
+
+TEST(Turtle, GoldenPositions) {
+  expect_near(draw("+(90)F(1)").segment_end[0], {-1, 0, 0});
+  expect_near(draw("&(90)F(1)").segment_end[0], {0, 0, -1});
+  const Skeleton k = draw("F(1)");
+  expect_near(k.segment_start[0], {0, 0, 0});
+  expect_near(k.segment_end[0], {0, 1, 0});
+  expect_near(k.segment_up[0], {0, 0, 1});
+}
+
+// Each turn symbol is a right-handed rotation of the whole frame about one of its own axes.
+struct TurnCase {
+  char symbol;
+  int axis;     // 0 H, 1 L, 2 U: the rotation axis, taken before the turn
+  double sign;  // +1: right-handed by the angle, -1: by minus the angle
+};
+
+void PrintTo(const TurnCase& c, std::ostream* os) { *os << "'" << c.symbol << "'"; }
+
+class TurnSymbol : public ::testing::TestWithParam<TurnCase> {};
+
+TEST_P(TurnSymbol, MatchesAnalyticalRotationFromAnArbitraryFrame) {
+  const TurnCase c = GetParam();
+  const std::string setup = "+(31)&(47)/(13)";  // leaves the initial, axis-aligned frame
+  for (const char* angle : {"(23)", "(-71)", ""}) {
+    TurtleSettings settings;
+    settings.angle_degrees = 17.0;
+    const double degrees = *angle == '\0' ? 17.0 : std::strtod(angle + 1, nullptr);
+    const Skeleton k = draw(setup + "L" + c.symbol + angle + "L", settings);
+    ASSERT_EQ(k.leaf_count(), 2u);
+    const Frame before = leaf_frame(k, 0);
+    const Frame after = leaf_frame(k, 1);
+    const Vector3d axis = c.axis == 0 ? before.h : c.axis == 1 ? before.l : before.u;
+    const Eigen::AngleAxisd rotation(c.sign * degrees * kDeg, axis);
+    expect_near(after.h, rotation * before.h);
+    expect_near(after.l, rotation * before.l);
+    expect_near(after.u, rotation * before.u);
+    expect_orthonormal_right_handed(after);
+  }
+}
+
+// + turns H toward L (about U), & pitches H toward -U (about L), \ rolls L toward -U (about H).
+INSTANTIATE_TEST_SUITE_P(AllSix, TurnSymbol,
+                         ::testing::Values(TurnCase{'+', 2, 1.0}, TurnCase{'-', 2, -1.0},
+                                           TurnCase{'&', 1, 1.0}, TurnCase{'^', 1, -1.0},
+                                           TurnCase{'\\', 0, -1.0}, TurnCase{'/', 0, 1.0}),
+                         [](const auto& info) { return std::to_string(info.index); });
+
+TEST(Turtle, TurnAroundIsHalfTurnAboutUpIgnoringItsParameter) {
+  const Skeleton k = draw("&(30)+(20)L|L|(45)L");
+  const Frame before = leaf_frame(k, 0);
+  const Eigen::AngleAxisd half(std::numbers::pi, before.u);
+  for (size_t leaf : {1u, 2u}) {
+    const Frame f = leaf_frame(k, leaf);
+    const Frame expected = leaf == 1 ? Frame{half * before.h, half * before.l, half * before.u} : before;
+    expect_near(f.h, expected.h);
+    expect_near(f.l, expected.l);
+    expect_near(f.u, expected.u);
+  }
+}
+
+TEST(Turtle, DefaultAngleAndStepFromSettings) {
+  TurtleSettings settings;
+  settings.angle_degrees = 30.0;
+  settings.step = 2.5;
+  const Skeleton k = draw("+F", settings);
+  expect_near(k.segment_end[0], 2.5 * Vector3d(-std::sin(30 * kDeg), std::cos(30 * kDeg), 0));
+}
+
+TEST(Turtle, RollToHorizontalLeavesLeftHorizontalForRandomFrames) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-180.0, 180.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::string turns = "+(" + std::to_string(angle(rng)) + ")&(" + std::to_string(angle(rng)) +
+                              ")/(" + std::to_string(angle(rng)) + ")";
+    const Skeleton k = draw(turns + "L$L");
+    const Frame before = leaf_frame(k, 0);
+    const Frame after = leaf_frame(k, 1);
+    EXPECT_NEAR(after.l.y(), 0.0, 1e-12) << turns;
+    EXPECT_GE(after.u.y(), 0.0) << turns;  // L = V x H makes U point upward
+    expect_near(after.h, before.h);        // a pure roll
+    expect_orthonormal_right_handed(after);
+  }
+}
+
+TEST(Turtle, RollToHorizontalKeepsFrameWhenHeadingIsVertical) {
+  const Skeleton k = draw("/(40)L$L");  // H = (0,1,0) = V: every L is already horizontal
+  expect_near(k.leaf_left[1], k.leaf_left[0], 0.0);
+  expect_near(k.leaf_up[1], k.leaf_up[0], 0.0);
+}
+
+TEST(Turtle, TropismRotatesHeadingAboutHCrossTByElasticityTimesItsNorm) {
+  TurtleSettings settings;
+  settings.tropism = {0.5, 0, 0};
+  settings.tropism_elasticity = 0.3;
+  const Skeleton k = draw("F(1)F(1)F(1)", settings);
+  // H = (0,1,0), T = (0.5,0,0): |H x T| = 0.5, so H turns by 0.15 rad toward +x.
+  expect_near(k.segment_end[0], {0, 1, 0});
+  const Vector3d h1(std::sin(0.15), std::cos(0.15), 0);
+  expect_near(k.segment_end[1] - k.segment_start[1], h1);
+  // Second bend: |H1 x T| = 0.5 cos(0.15).
+  const double second = 0.15 + 0.3 * 0.5 * std::cos(0.15);
+  expect_near(k.segment_end[2] - k.segment_start[2], {std::sin(second), std::cos(second), 0});
+}
+
+TEST(Turtle, TropismBendsTowardT) {
+  TurtleSettings settings;
+  settings.tropism = Vector3d(-0.61, 0.77, -0.19);
+  settings.tropism_elasticity = 0.4;
+  const Skeleton k = draw("&(70)/(20)FFFFFFFFL", settings);
+  const Vector3d t = settings.tropism.normalized();
+  double previous = -2.0;
+  for (size_t s = 0; s < k.segment_count(); ++s) {
+    const double alignment = (k.segment_end[s] - k.segment_start[s]).normalized().dot(t);
+    EXPECT_GT(alignment, previous) << "segment " << s;
+    previous = alignment;
+  }
+  expect_orthonormal_right_handed(leaf_frame(k, 0));
+}
+
+TEST(Turtle, ZeroElasticityOrHeadingAlongTDoesNotBend) {
+  TurtleSettings settings;
+  settings.tropism = {1, 0, 0};
+  settings.tropism_elasticity = 0.0;
+  expect_near(draw("FFF", settings).segment_end[2], {0, 3, 0}, 0.0);
+  settings.tropism = {0, 2, 0};  // parallel to H: no torque
+  settings.tropism_elasticity = 0.5;
+  expect_near(draw("FFF", settings).segment_end[2], {0, 3, 0}, 0.0);
+}
+
+TEST(Turtle, BracketsRestorePositionFrameWidthAndMaterial) {
+  const Skeleton k = draw("!(3)'F(1)[+(40)F(2)&(10)!(1)'(4)F(1)L]F(1)");
+  ASSERT_EQ(k.segment_count(), 4u);
+  expect_near(k.segment_start[3], {0, 1, 0});
+  expect_near(k.segment_end[3], {0, 2, 0});
+  EXPECT_EQ(k.segment_width[3], 3.0);
+  EXPECT_EQ(k.segment_material[3], 1);
+  EXPECT_EQ(k.segment_width[2], 1.0);
+  EXPECT_EQ(k.segment_material[2], 4);
+  expect_near(k.segment_up[3], {0, 0, 1});
+}
+
+TEST(Turtle, UnmatchedClosingBracketIsIgnored) {
+  const Skeleton k = draw("F]F");
+  expect_near(k.segment_end[1], {0, 2, 0});
+}
+
+struct Topology {
+  std::vector<int32_t> parent;
+  std::vector<uint8_t> continues;
+  std::vector<int32_t> order;
+  std::vector<uint32_t> id;
+};
+
+void expect_topology(const std::string& text, const Topology& expected) {
+  const Skeleton k = draw(text);
+  EXPECT_EQ(k.segment_parent, expected.parent) << text;
+  EXPECT_EQ(k.segment_continues_parent, expected.continues) << text;
+  EXPECT_EQ(k.segment_order, expected.order) << text;
+  EXPECT_EQ(k.segment_id, expected.id) << text;
+}
+
+TEST(Turtle, ParentContinuationAndOrder) {
+  // Modules: F [ + F ] F => ids 0 3 5.
+  expect_topology("F[+F]F", {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 3, 5}});
+  // F [ + F [ - F ] ] F => ids 0 3 6 9.
+  expect_topology("F[+F[-F]]F", {{-1, 0, 1, 0}, {0, 0, 0, 1}, {0, 1, 2, 0}, {0, 3, 6, 9}});
+  // A move breaks continuity but not the axis; structural modules change nothing; G draws.
+  expect_topology("FfFAXG", {{-1, 0, 1}, {0, 0, 1}, {0, 0, 0}, {0, 2, 5}});
+  // A branch drawn before any segment has no parent.
+  expect_topology("[F]F", {{-1, -1}, {0, 0}, {0, 0}, {1, 3}});
+}
+
+TEST(Turtle, LeavesAttachToTheCurrentSegment) {
+  const Skeleton k = draw("LF(2)[+(90)L(0.5)]F[&~(2)]");
+  ASSERT_EQ(k.leaf_count(), 3u);
+  EXPECT_EQ(k.leaf_segment, (std::vector<int32_t>{-1, 0, 1}));
+  EXPECT_EQ(k.leaf_scale, (std::vector<double>{1.0, 0.5, 2.0}));
+  expect_near(k.leaf_position[1], {0, 2, 0});
+  expect_near(k.leaf_heading[1], {-1, 0, 0});
+  expect_near(k.leaf_left[1], {0, -1, 0});
+  expect_near(k.leaf_up[1], {0, 0, 1});
+  expect_near(k.leaf_position[2], {0, 3, 0});
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0, 0, 0, 0}));
+  EXPECT_TRUE(k.polygon_points.empty());
+}
+
+TEST(Turtle, PolygonBecomesALeafWithItsOutline) {
+  // '.' records; inside { } G moves silently, F and f move and record, and nothing is drawn.
+  const Skeleton k = draw("F(1)[{.G(1)+(90)F(1)+(90)f(1)}]L");
+  ASSERT_EQ(k.segment_count(), 1u);
+  ASSERT_EQ(k.leaf_count(), 2u);
+  EXPECT_EQ(k.leaf_segment[0], 0);
+  expect_near(k.leaf_position[0], {0, 1, 0});
+  expect_near(k.leaf_heading[0], {0, 1, 0});
+  EXPECT_EQ(k.leaf_scale[0], 1.0);
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0, 3, 3}));
+  ASSERT_EQ(k.polygon_points.size(), 3u);
+  expect_near(k.polygon_points[0], {0, 1, 0});
+  expect_near(k.polygon_points[1], {-1, 2, 0});
+  expect_near(k.polygon_points[2], {-1, 1, 0});
+}
+
+TEST(Turtle, NestedPolygonsKeepTheirOwnOutlinesAndDegenerateOnesAreDropped) {
+  const Skeleton k = draw("{.f(1)[{.+(90)G(1).-(90)G(1).}]-(90)f(1)}{.g.}");
+  ASSERT_EQ(k.leaf_count(), 2u);
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0, 3, 6}));
+  // The inner one closes first.
+  expect_near(k.polygon_points[0], {0, 1, 0});
+  expect_near(k.polygon_points[1], {-1, 1, 0});
+  expect_near(k.polygon_points[2], {-1, 2, 0});
+  expect_near(k.leaf_position[0], {0, 1, 0});
+  expect_near(k.polygon_points[3], {0, 0, 0});
+  expect_near(k.polygon_points[4], {0, 1, 0});
+  expect_near(k.polygon_points[5], {1, 1, 0});
+  expect_near(k.leaf_position[1], {0, 0, 0});
+}
+
+TEST(Turtle, CutSkipsTheRestOfTheBranch) {
+  const Skeleton k = draw("F[+F%F[F]L]F");
+  ASSERT_EQ(k.segment_count(), 3u);
+  EXPECT_EQ(k.leaf_count(), 0u);
+  EXPECT_EQ(k.segment_parent, (std::vector<int32_t>{-1, 0, 0}));
+  EXPECT_EQ(k.segment_continues_parent[2], 1);  // the ']' after the cut still restored the state
+  EXPECT_EQ(draw("F%FF").segment_count(), 1u);  // a cut on the trunk ends the word
+}
+
+TEST(Turtle, WidthIsNaNWithoutBangThenSetOrScaled) {
+  for (const double w : draw("FF[F]").segment_width) EXPECT_TRUE(std::isnan(w));
+  TurtleSettings settings;
+  settings.width_factor = 0.5;
+  settings.initial_width = 4.0;
+  EXPECT_EQ(draw("F!F!(0.3)F!F[!F]F", settings).segment_width,
+            (std::vector<double>{4.0, 2.0, 0.3, 0.15, 0.075, 0.15}));
+}
+
+TEST(Turtle, MaterialIncrementsDecrementsAndSets) {
+  EXPECT_EQ(draw("F'F'(5)F,F,(0)F,F'(2.6)F").segment_material,
+            (std::vector<int32_t>{0, 1, 5, 4, 0, 0, 3}));
+}
+
+TEST(Turtle, EmptyWordGivesAnEmptySkeleton) {
+  const Skeleton k = draw("");
+  EXPECT_EQ(k.segment_count(), 0u);
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0}));
+}
+
+}  // namespace
+}  // namespace treeanim

@@ -1,0 +1,117 @@
+// Leaves: default quad, '{ . }' outlines, custom meshes through assimp.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "common/errors.h"
+#include "tree/build_tree_model.h"
+#include "tree_test_util.h"
+
+namespace treeanim {
+namespace {
+
+const std::filesystem::path kLeafObj = std::filesystem::path(TREEANIM_SOURCE_DIR) / "tests/data/leaf_hexagon.obj";
+
+// Vertices of leaf l, in order.
+std::vector<uint32_t> leaf_vertices(const TreeModel& m, int l) {
+  std::vector<uint32_t> out;
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (m.vertex_leaf[v] == l) out.push_back(v);
+  return out;
+}
+
+// Sum of the unnormalised normals of the triangles of leaf l.
+Eigen::Vector3d leaf_normal(const TreeModel& m, int l) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    const uint32_t a = m.triangles[3 * t], b = m.triangles[3 * t + 1], c = m.triangles[3 * t + 2];
+    if (m.vertex_leaf[a] != l) continue;
+    n += (m.rest_positions.col(b) - m.rest_positions.col(a)).cross(m.rest_positions.col(c) - m.rest_positions.col(a));
+  }
+  return n;
+}
+
+TEST(TreeLeaves, DefaultQuadFollowsTheTurtleFrame) {
+  TreeOptions o;
+  o.leaf.size = 0.1;
+  o.leaf.aspect = 0.5;
+  o.leaf.petiole = 0.02;
+  const Skeleton sk = test::small_tree();
+  const TreeModel m = build_tree_model(sk, o);
+  ASSERT_EQ(m.leaf_count(), 3u);
+  for (int l = 0; l < 3; ++l) {
+    const auto vs = leaf_vertices(m, l);
+    ASSERT_EQ(vs.size(), 4u);
+    const double s = sk.leaf_scale[l];
+    const Eigen::Vector3d p = sk.leaf_position[l], h = sk.leaf_heading[l], left = sk.leaf_left[l];
+    // base, right (-L), tip, left (+L)
+    EXPECT_LT((m.rest_positions.col(vs[0]) - (p + 0.02 * s * h)).norm(), 1e-12);
+    EXPECT_LT((m.rest_positions.col(vs[1]) - (p + 0.07 * s * h - 0.025 * s * left)).norm(), 1e-12);
+    EXPECT_LT((m.rest_positions.col(vs[2]) - (p + 0.12 * s * h)).norm(), 1e-12);
+    EXPECT_LT((m.rest_positions.col(vs[3]) - (p + 0.07 * s * h + 0.025 * s * left)).norm(), 1e-12);
+    EXPECT_EQ(m.leaf_attachment_vertex[l], vs[0]);
+    EXPECT_GT(leaf_normal(m, l).dot(sk.leaf_up[l]), 0);  // the front faces U
+  }
+}
+
+TEST(TreeLeaves, PolygonOutlineIsFanTriangulatedFacingUp) {
+  test::SkeletonBuilder b;
+  const int s = b.segment({0, 0, 0}, {0, 1, 0}, -1, false);
+  const Eigen::Vector3d h(1, 0, 0), left(0, 0, -1);  // U = H x L = (0, 1, 0)
+  // Wound clockwise seen from U, so the mesher has to flip it.
+  const std::vector<Eigen::Vector3d> outline = {{0.1, 1, 0}, {0.3, 1, -0.1}, {0.5, 1, 0}, {0.3, 1, 0.1}, {0.2, 1, 0.08}};
+  b.leaf(s, {0, 1, 0}, h, left, 1.0, outline);
+  const TreeModel m = build_tree_model(b.sk, TreeOptions{});
+  const auto vs = leaf_vertices(m, 0);
+  ASSERT_EQ(vs.size(), 5u);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(Eigen::Vector3d(m.rest_positions.col(vs[i])), outline[i]);
+  size_t leaf_triangles = 0;
+  for (size_t t = 0; t < m.triangle_count(); ++t) leaf_triangles += m.vertex_leaf[m.triangles[3 * t]] == 0;
+  EXPECT_EQ(leaf_triangles, 3u);
+  EXPECT_GT(leaf_normal(m, 0).dot(b.sk.leaf_up[0]), 0);
+  EXPECT_EQ(m.leaf_attachment_vertex[0], vs[0]);  // nearest the leaf position (0, 1, 0)
+}
+
+TEST(TreeLeaves, CustomObjMeshIsInstancedOnEveryLeaf) {
+  TreeOptions o;
+  o.leaf.mesh = kLeafObj;
+  o.leaf.size = 0.1;  // the hexagon is 2 long: scale 0.05
+  o.leaf.petiole = 0.0;
+  const Skeleton sk = test::small_tree();
+  const TreeModel m = build_tree_model(sk, o);
+  // OBJ corners in the leaf frame: x towards -L, y along H, z along U.
+  const std::vector<Eigen::Vector3d> corners = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 1.5, 0}, {0, 2, 0}, {-0.5, 1.5, 0}, {-0.5, 0.5, 0}};
+  ASSERT_EQ(m.leaf_count(), 3u);
+  for (int l = 0; l < 3; ++l) {
+    const auto vs = leaf_vertices(m, l);
+    ASSERT_EQ(vs.size(), 6u) << "assimp's per-face vertices must be joined";
+    const double s = 0.05 * sk.leaf_scale[l];
+    const Eigen::Vector3d p = sk.leaf_position[l];
+    for (const Eigen::Vector3d& c : corners) {
+      const Eigen::Vector3d expected = p + s * (-c.x() * sk.leaf_left[l] + c.y() * sk.leaf_heading[l] + c.z() * sk.leaf_up[l]);
+      double nearest = 1e9;
+      for (uint32_t v : vs) nearest = std::min(nearest, (m.rest_positions.col(v) - expected).norm());
+      EXPECT_LT(nearest, 1e-7) << "leaf " << l;
+    }
+    EXPECT_LT((m.rest_positions.col(m.leaf_attachment_vertex[l]) - p).norm(), 1e-12);
+    EXPECT_GT(leaf_normal(m, l).dot(sk.leaf_up[l]), 0);
+    size_t leaf_triangles = 0;
+    for (size_t t = 0; t < m.triangle_count(); ++t) leaf_triangles += m.vertex_leaf[m.triangles[3 * t]] == l;
+    EXPECT_EQ(leaf_triangles, 4u);
+  }
+}
+
+TEST(TreeLeaves, UnreadableMeshIsAnInputErrorNamingTheFile) {
+  TreeOptions o;
+  o.leaf.mesh = std::filesystem::path(TREEANIM_SOURCE_DIR) / "tests/data/no_such_leaf.obj";
+  try {
+    build_tree_model(test::small_tree(), o);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_leaf.obj: cannot read leaf mesh"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace treeanim
