@@ -1,5 +1,6 @@
 #include "lsystem/derive.h"
 
+#include <algorithm>
 #include <span>
 #include <string>
 #include <utility>
@@ -98,9 +99,11 @@ class Deriver {
   // One parallel rewriting step: word => *next.
   void rewrite(const ModuleString& word, ModuleString* next) {
     next->clear();
-    next->symbols.reserve(word.size() * 2);
-    next->param_offsets.reserve(word.size() * 2 + 1);
-    next->params.reserve(word.params.size() * 2);
+    // Strings usually grow by a small factor per step; never reserve past the cap.
+    const size_t expected = std::min(word.size() * 2, settings_.max_modules + 1);
+    next->symbols.reserve(expected);
+    next->param_offsets.reserve(expected + 1);
+    next->params.reserve(std::min(word.params.size() * 2, expected * 4));
     const RuleSet& set = g_.productions;
     if (set.any_context) match_brackets(word);
     word_ = &word;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "common/scene_reader.h"
@@ -54,10 +55,12 @@ std::string plural(int n, const char* word) {
 }
 
 // The candidate `word` is most likely a typo of, or "" (at most one edit per three letters,
-// so that short names are not "corrected" into unrelated ones).
+// and never a whole rewrite, so that one-letter names are not "corrected" into others).
 std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
   const std::string near = closest_match(word, candidates);
-  if (near.empty() || edit_distance(word, near) > std::max<size_t>(1, word.size() / 3)) return "";
+  if (near.empty()) return "";
+  const size_t distance = edit_distance(word, near);
+  if (distance >= word.size() || distance > std::max<size_t>(1, word.size() / 3)) return "";
   return near;
 }
 
@@ -197,13 +200,16 @@ class Compiler {
       else return;
     }
   }
+  // Every parenthesis, call and unary operator nests the recursion one level deeper.
   void parse_unary() {
     skip_space();
     const size_t where = pos_;
+    if (++nesting_ > kMaxNesting) fail(where, "expression too deeply nested");
     if (accept("-")) { parse_unary(); emit(Op::kNeg, 0, where); }
     else if (accept("+")) parse_unary();
     else if (peek() == '!' && peek(1) != '=') { ++pos_; parse_unary(); emit(Op::kNot, 0, where); }
     else parse_power();
+    --nesting_;
   }
   // '^' binds tighter than unary minus (-2^2 = -4) and groups to the right (2^3^2 = 2^9).
   void parse_power() {
@@ -249,7 +255,8 @@ class Compiler {
       pos_ += 2;
       while (std::isdigit(static_cast<unsigned char>(peek()))) ++pos_;
     }
-    const double value = std::stod(std::string(text_.substr(start, pos_ - start)));
+    // strtod, not stod: an overflow gives inf (reported below) instead of an exception.
+    const double value = std::strtod(std::string(text_.substr(start, pos_ - start)).c_str(), nullptr);
     if (!std::isfinite(value)) fail(start, "number out of range");
     emit_constant(value, start);
   }
@@ -325,7 +332,9 @@ class Compiler {
   size_t pos_;
   SourcePos line_;
   const ExprScope& scope_;
-  int depth_ = 0;
+  int depth_ = 0;    // operand stack depth after the code emitted so far
+  int nesting_ = 0;  // recursion depth of parse_unary (bounds the parser's own stack)
+  static constexpr int kMaxNesting = 256;
 };
 
 [[noreturn]] void eval_fail(const ExprProgram& program, uint32_t instruction, const char* message) {

@@ -5,22 +5,40 @@
 namespace treeanim {
 
 int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations) {
-  // The angular step is the torque sum_i r_i x a_i of the columns, over |sum_i r_i . a_i|:
-  // a Newton-like step on tr(R^T A). The 1e-9 guards a zero denominator; A is normalised by
-  // the caller (order 1 for any cluster size), so the constant is scale-free. Convergence
-  // tolerance 1e-9 rad is far below any visible angle and above round-off noise, so a settled
-  // cluster stops after one iteration.
+  // Müller et al. step: the torque sum_i r_i x a_i of the columns (the gradient of
+  // tr(R^T A) over a rotation increment), divided by |tr(R^T A)| + 1e-9. That step is slow
+  // about the long axis of an elongated cluster (a branch segment: 1% per iteration at a
+  // 100:1 aspect), so where the second-order model is convex we take the Newton step with
+  // its Hessian (tr(M) I - sym(M)), M = A R^T, instead; Müller's step stays the fallback far
+  // from the optimum (e.g. an inverted cluster). A is normalised by the caller (order 1 for
+  // any cluster size), so the constants are scale-free. 1e-9 rad is far below any visible
+  // angle and above round-off, so a settled cluster stops after one iteration; a step is at
+  // most 1 rad (trust region) so noise in a degenerate direction cannot spin a cluster.
   constexpr double kEps = 1e-9;
+  constexpr double kMaxStep = 1.0;
   int iteration = 0;
   for (; iteration < max_iterations; ++iteration) {
     const Eigen::Matrix3d R = q.toRotationMatrix();
     const Eigen::Vector3d torque =
         R.col(0).cross(A.col(0)) + R.col(1).cross(A.col(1)) + R.col(2).cross(A.col(2));
-    const double alignment =
-        std::abs(R.col(0).dot(A.col(0)) + R.col(1).dot(A.col(1)) + R.col(2).dot(A.col(2)));
-    const Eigen::Vector3d omega = torque * (1.0 / (alignment + kEps));
-    const double angle = omega.norm();
+    const Eigen::Matrix3d M = A * R.transpose();
+    const double trace = M.trace();
+    Eigen::Matrix3d H = -0.5 * (M + M.transpose());
+    H.diagonal().array() += trace * (1 + kEps);
+    // Sylvester's criterion: H positive definite => the Newton step is an ascent step.
+    const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
+    const double det = H.determinant();
+    Eigen::Vector3d omega;
+    if (trace > 0 && H(0, 0) > 0 && minor2 > 0 && det > 0)
+      omega = H.inverse() * torque;
+    else
+      omega = torque * (1.0 / (std::abs(trace) + kEps));
+    double angle = omega.norm();
     if (!(angle >= kEps)) break;  // also stops on NaN: the caller checks the result
+    if (angle > kMaxStep) {
+      omega *= kMaxStep / angle;
+      angle = kMaxStep;
+    }
     q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle)) * q;
     q.normalize();
   }

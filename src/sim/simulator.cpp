@@ -67,6 +67,11 @@ struct Simulator::Impl {
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
   std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
   Eigen::Matrix3Xd cluster_air;            // (3 x C) m/s, air velocity at the cluster this step
+  Eigen::Matrix3Xd cluster_centre;         // (3 x C) m, centre t of the last fit
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of the last fit, column-major
+  std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
+  std::vector<uint32_t> cluster_pin_own_slot;  // (C) attached leaf: membership of the shared vertex in the leaf
+  std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
 
   // --- per vertex (V) ---
   std::vector<double> vertex_global;       // (V) global rate per step (0: off, anchored, flying)
@@ -77,6 +82,7 @@ struct Simulator::Impl {
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   Eigen::Matrix3Xd vertex_drag_force;      // (3 x V) N, drag of the last step; only with detachment
+  Eigen::Matrix3Xd predicted;              // (3 x V) m, p = x + h v* of the current step
 
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   size_t I = 0;
@@ -127,6 +133,10 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
   precompute_islands();
   island_fell_asleep.assign(I, 0);
   cluster_air.setZero(3, C);
+  cluster_centre = cluster_rest_centre;
+  cluster_rotation_matrix.setZero(9, C);
+  predicted = model.rest_positions;
+  precompute_pins();
   cluster_flying.assign(C, 0);
   vertex_flying.assign(V, 0);
   applied_attached.assign(L, 1);
@@ -242,6 +252,26 @@ void Simulator::Impl::precompute_islands() {
     if (vertex_island[v] != kNone) island_vertices[fill[vertex_island[v]]++] = static_cast<uint32_t>(v);
 }
 
+// Leaves => the membership slots that pin each attached leaf to its branch (see match_clusters).
+// A leaf whose shared vertex is in no other cluster is matched like a branch.
+void Simulator::Impl::precompute_pins() {
+  cluster_pin_slot.assign(C, kNone);
+  cluster_pin_own_slot.assign(C, kNone);
+  for (size_t l = 0; l < L; ++l) {
+    const uint32_t c = model.leaf_cluster[l], a = model.leaf_attachment_vertex[l];
+    uint32_t own = kNone, pin = kNone;
+    for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
+      const uint32_t slot = model.vertex_memberships[s];
+      if (member_cluster[slot] == c) own = slot;
+      else if (pin == kNone && model.cluster_kind[member_cluster[slot]] == kClusterBranch) pin = slot;
+    }
+    if (own == kNone || pin == kNone) continue;
+    cluster_pin_slot[c] = pin;
+    cluster_pin_own_slot[c] = own;
+    pinned_leaf_clusters.push_back(c);
+  }
+}
+
 // Releases leaf `leaf` from its branch (paper 4.2): the shared vertex stays with the side it
 // was built for (a leaf vertex leaves its branch clusters; a branch vertex leaves the leaf),
 // the clusters that lost a member get new rest data, and the leaf's vertices fly.
@@ -267,6 +297,7 @@ void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
   vertex_inv_count[a] = active ? 1.0 / active : 0.0;
   if (first != kNone) vertex_air_cluster[a] = first;
   cluster_flying[c] = 1;
+  cluster_pin_slot[c] = kNone;
   for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
     const uint32_t v = model.cluster_members[s];
     if (!member_active[s] || model.vertex_leaf[v] != static_cast<int32_t>(leaf) || model.vertex_anchored[v]) continue;

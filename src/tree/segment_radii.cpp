@@ -41,7 +41,7 @@ SegmentTopology segment_topology(const Skeleton& skeleton, double scale) {
 
 // Pipe model (da Vinci): every tip carries one unit of r^k, a segment carries the sum of its
 // children, so r_parent^k = sum r_child^k holds at every branching. Scaled so the heaviest
-// root gets trunk_radius. => (S) base radius in metres, before clamping.
+// root gets trunk_radius. => (S) base radius in metres, before tapering and clamping.
 static std::vector<double> pipe_radii(const Skeleton& skeleton, const TreeOptions& options) {
   const size_t S = skeleton.segment_count();
   std::vector<double> load(S, 0.0);
@@ -57,12 +57,44 @@ static std::vector<double> pipe_radii(const Skeleton& skeleton, const TreeOption
   return load;
 }
 
+// Pipe radii only change at branchings, so an internode drawn as several segments would be a
+// cylinder ending in a cone. Each run of segments between branchings (or up to the tip) gets
+// its step spread linearly over its arc length instead: the pipe value holds at the run's
+// base, the run ends at its continuation's value (at a tip: tip_taper times the base).
+static void taper_runs(const SegmentTopology& topology, double tip_taper, std::vector<double>& radius) {
+  const std::vector<double> step = radius;
+  for (size_t first = 0; first < step.size(); ++first) {
+    if (!topology.starts_axis[first]) continue;
+    for (int32_t j = int32_t(first); j >= 0;) {
+      int32_t k = j;
+      double run_length = topology.length[j];
+      while (topology.lateral_count[k] == 0 && topology.continuation[k] >= 0) {
+        k = topology.continuation[k];
+        run_length += topology.length[k];
+      }
+      const int32_t next = topology.continuation[k];
+      const double r0 = step[j], r1 = next >= 0 ? step[next] : step[j] * tip_taper;
+      double arc = 0;
+      for (int32_t i = j;; i = topology.continuation[i]) {
+        radius[i] = run_length > 0 ? r0 + (r1 - r0) * (arc / run_length) : r0;
+        arc += topology.length[i];
+        if (i == k) break;
+      }
+      j = next;
+    }
+  }
+}
+
 void segment_radii(const Skeleton& skeleton, const SegmentTopology& topology,
                    const TreeOptions& options, TreeModel& model) {
   const size_t S = skeleton.segment_count();
   const bool any_unset = std::any_of(skeleton.segment_width.begin(), skeleton.segment_width.end(),
                                      [](double w) { return std::isnan(w); });
-  const std::vector<double> pipe = any_unset ? pipe_radii(skeleton, options) : std::vector<double>();
+  std::vector<double> pipe;
+  if (any_unset) {
+    pipe = pipe_radii(skeleton, options);
+    taper_runs(topology, options.tip_taper, pipe);
+  }
   model.segment_radius_base.resize(S);
   model.segment_radius_top.resize(S);
   for (size_t s = 0; s < S; ++s) {

@@ -49,7 +49,7 @@ TEST(GrowSkeleton, SceneAngleAndStepOverrideTheGrammar) {
   GrowthStats stats;
   const Skeleton skeleton = grow_skeleton(options, &stats);
   ASSERT_EQ(skeleton.segment_count(), 1u);
-  EXPECT_NEAR((skeleton.segment_end[0] - Eigen::Vector3d(-2, 0, 0)).norm(), 0.0, 1e-12);  // +(90) turns H to -x... L
+  EXPECT_NEAR((skeleton.segment_end[0] - Eigen::Vector3d(-2, 0, 0)).norm(), 0.0, 1e-12);  // '+' turns H toward L = (-1, 0, 0)
 }
 
 TEST(GrowSkeleton, SegmentCountOfAbop124aPerStep) {
@@ -81,14 +81,14 @@ TEST(GrowSkeleton, SceneDefineMustExistInTheFile) {
   LsystemOptions options;
   options.grammar = grammar_file("abop-2.6a-monopodial.lsys");
   options.defines = {{"r9", 0.5}};
-  EXPECT_EQ(error_of(options), options.grammar->string() +
-                                   ": <scene>/lsystem/defines/r9: the grammar has no '#define r9' (it defines: "
-                                   "r1, r2, a0, a2, d, wr)");
+  std::string expected = options.grammar->string();
+  expected += ": <scene>/lsystem/defines/r9: the grammar has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)";
+  EXPECT_EQ(error_of(options), expected);
 }
 
 TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
   LsystemOptions options;
-  options.axiom = "F";
+  options.axiom = std::string("F");  // (a plain = "F" trips g++ 12's false -Wrestrict)
   options.productions = {"F --> FF"};
   EXPECT_EQ(error_of(options),
             "<scene>/lsystem/axiom: the grammar has no 'derivation length:'; give the number of steps as "

@@ -152,6 +152,8 @@ TEST(Expression, CompileErrors) {
   EXPECT_EQ(compile_error("x = 1"), "3: expected '==' to compare, got '='");
   EXPECT_EQ(compile_error("1/(2-2)"), "2: division by zero");
   EXPECT_EQ(compile_error("x, 1"), "no error, stopped at 1");  // ',' ends an actual parameter
+  EXPECT_EQ(compile_error(std::string(300, '(') + "1" + std::string(300, ')')), "257: expression too deeply nested");
+  EXPECT_EQ(compile_error(std::string(17, '1') + "e999"), "1: number out of range");
 }
 
 }  // namespace

@@ -39,9 +39,9 @@ TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {
 }
 
 TEST(LsystemOptions, InlineGrammar) {
-  Json scene = Json::parse(R"({"lsystem": {"axiom": "A(1)", "productions": ["A(x) --> F(x)A(x*k)"],
+  Json scene = Json::parse(R"json({"lsystem": {"axiom": "A(1)", "productions": ["A(x) --> F(x)A(x*k)"],
       "defines": {"k": 2}, "iterations": 4, "seed": 5, "step": 0.1, "angle": 30, "max_modules": 1000,
-      "width_factor": 0.5, "tropism": [0, -1, 0], "tropism_elasticity": 0.2}})");
+      "width_factor": 0.5, "tropism": [0, -1, 0], "tropism_elasticity": 0.2}})json");
   const LsystemOptions o = read(scene);
   EXPECT_FALSE(o.grammar);
   EXPECT_EQ(o.axiom, "A(1)");

@@ -163,7 +163,10 @@ TEST(BranchRadii, PipeModelWithoutWidths) {
   EXPECT_DOUBLE_EQ(r[0], 0.3);
   const double k = o.pipe_exponent;
   EXPECT_NEAR(std::pow(r[t0], k), std::pow(r[t1], k) + std::pow(r[a], k) + std::pow(r[4], k), 1e-12);
-  EXPECT_NEAR(std::pow(r[a], k), std::pow(r[3], k), 1e-12);  // a single continuation
+  // Lateral a + its continuation run to the tip: the radius falls linearly towards
+  // tip_taper * r[a] over the run (two unit segments).
+  EXPECT_NEAR(r[3], r[a] * (1 - 0.5 * (1 - o.tip_taper)), 1e-12);
+  EXPECT_NEAR(m.segment_radius_top[3], r[3] * o.tip_taper, 1e-12);
   EXPECT_DOUBLE_EQ(m.segment_radius_top[t0], r[t1]);
   // Clamping: a large minimum wins everywhere.
   o.min_radius = 0.25;

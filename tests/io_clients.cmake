@@ -1,0 +1,51 @@
+# Real-client checks of io/'s outputs (docs/outputs.md, "Checks"): one end-to-end bake of
+# tests/golden/small_tree.json with the CLI, then each format opened by the tool its users use.
+# Included by CMakeLists.txt inside TREEANIM_TESTS; labels "io;clients". The tools come from
+# scripts/setup: python3-h5py, hdf5-tools, blender (apt) and tests/clients/node (npm ci).
+set(io_bake_dir ${CMAKE_BINARY_DIR}/io_clients)
+set(io_scene ${CMAKE_SOURCE_DIR}/tests/golden/small_tree.json)
+set(io_clients ${CMAKE_SOURCE_DIR}/tests/clients)
+
+# A client test whose tool is missing fails with the reason instead of silently passing.
+function(io_client_test name program)
+  if(program)
+    add_test(NAME ${name} COMMAND ${program} ${ARGN} WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  else()
+    add_test(NAME ${name} COMMAND sh -c "echo '${name}: tool not installed (run scripts/setup)'; exit 1")
+  endif()
+  set_tests_properties(${name} PROPERTIES LABELS "io;clients" FIXTURES_REQUIRED io_bake TIMEOUT 300)
+endfunction()
+
+add_test(NAME io_clients_bake
+         COMMAND sh -c "rm -rf '${io_bake_dir}' && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(io_clients_bake PROPERTIES LABELS "io;clients" FIXTURES_SETUP io_bake TIMEOUT 120)
+
+find_program(TREEANIM_SYSTEM_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
+io_client_test(io_clients_h5py "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_hdf5.py
+               ${io_bake_dir}/small_tree.h5 --obj ${io_bake_dir}/obj/small_tree --pc2 ${io_bake_dir}/small_tree.pc2
+               --velocities yes --compression 4)
+
+# Golden bake: positions, velocities and every other number within 1e-5 (m, m/s, kg), strings
+# and attributes exact. scripts/update-golden regenerates tests/golden/*.h5 on purpose.
+find_program(TREEANIM_H5DIFF h5diff)
+io_client_test(io_clients_golden "${TREEANIM_H5DIFF}" --delta=1e-5
+               ${CMAKE_SOURCE_DIR}/tests/golden/small_tree.h5 ${io_bake_dir}/small_tree.h5)
+
+find_program(TREEANIM_NODE node)
+if(NOT EXISTS ${io_clients}/node/node_modules/gltf-validator)
+  set(TREEANIM_NODE "")  # scripts/setup runs `npm ci` in tests/clients/node
+endif()
+io_client_test(io_clients_gltf_validator "${TREEANIM_NODE}" ${io_clients}/node/validate_gltf.js
+               ${io_bake_dir}/small_tree.glb ${io_bake_dir}/gltf/small_tree.0000.glb
+               ${io_bake_dir}/gltf/small_tree.0006.glb)
+
+find_program(TREEANIM_BLENDER blender)
+io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --python
+               ${io_clients}/check_blender.py -- ${io_bake_dir}/small_tree.h5 ${io_bake_dir}/small_tree.glb
+               ${io_bake_dir}/small_tree.pc2 ${io_bake_dir}/small_tree.rest.obj)
+
+# A bad output path is refused before simulating, with exit code 4 and the path named.
+add_test(NAME io_cli_unwritable_output
+         COMMAND sh -c "message=$('$<TARGET_FILE:treeanim>' run '${io_scene}' -o /proc/treeanim-out --quiet 2>&1); code=$?; echo \"$message\"; test $code -eq 4 && echo \"$message\" | grep -q '/proc/treeanim-out/small_tree.h5: cannot create the folder'")
+set_tests_properties(io_cli_unwritable_output PROPERTIES LABELS "io;clients")
