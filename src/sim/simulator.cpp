@@ -345,7 +345,10 @@ void Simulator::Impl::predict(SimState& state, bool any_asleep) {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t v = first; v < last; ++v) {
-      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;
+      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {
+        predicted.col(v) = state.positions.col(v);  // anchors hold where they are
+        continue;
+      }
       const bool flying = vertex_flying[v];
       if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
       const Eigen::Vector3d x = state.positions.col(v);
@@ -371,15 +374,18 @@ void Simulator::Impl::predict(SimState& state, bool any_asleep) {
 bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   const Eigen::Vector3d t0 = cluster_rest_centre.col(c);
-  // Cluster-local coordinates: d = p - t0 is small wherever the tree stands. Since
-  // sum w q = 0, A_pq = sum w (p - t) q^T = sum w d q^T; each entry is summed as
-  // s (d_i q_j) so that A is exactly symmetric at the rest pose (R = I exactly there).
-  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  // Cluster-local coordinates: p - t0 is small wherever the tree stands. A_pq is summed over
+  // d = (p - t0) - (t - t0), relative to the current centre t: with p - t0 instead (equal in
+  // exact arithmetic, as sum w q = 0) the round-off of sum w q would be multiplied by the
+  // cluster's travel. Each entry is summed as s (d_i q_j), so that A is exactly symmetric at
+  // the rest pose (R = I exactly there).
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (uint32_t s = begin; s < end; ++s)
+    shift += member_centre_weight[s] * (predicted.col(model.cluster_members[s]) - t0);
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d d = predicted.col(model.cluster_members[s]) - t0;
+    const Eigen::Vector3d d = (predicted.col(model.cluster_members[s]) - t0) - shift;
     const Eigen::Vector3d q = member_offset.col(s);
-    shift += member_centre_weight[s] * d;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) A(i, j) += member_match_weight[s] * (d[i] * q[j]);
   }

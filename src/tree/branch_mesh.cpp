@@ -88,19 +88,27 @@ void write_ring(const Ring& ring, const RingAngles& angles, uint32_t first, int3
   }
 }
 
+// Writes triangle (a, b, c) at out => the slot after it.
+uint32_t* write_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t* out) {
+  out[0] = a;
+  out[1] = b;
+  out[2] = c;
+  return out + 3;
+}
+
 // Two triangles per side between rings a (lower) and b (upper), outward facing.
 uint32_t* write_tube(uint32_t a, uint32_t b, uint32_t sides, uint32_t* out) {
   for (uint32_t k = 0; k < sides; ++k) {
     const uint32_t k1 = (k + 1) % sides;
-    *out++ = a + k, *out++ = a + k1, *out++ = b + k1;
-    *out++ = a + k, *out++ = b + k1, *out++ = b + k;
+    out = write_triangle(a + k, a + k1, b + k1, out);
+    out = write_triangle(a + k, b + k1, b + k, out);
   }
   return out;
 }
 
 // Fan closing ring a with the centre vertex, facing along the ring tangent.
 uint32_t* write_cap(uint32_t a, uint32_t centre, uint32_t sides, uint32_t* out) {
-  for (uint32_t k = 0; k < sides; ++k) *out++ = a + k, *out++ = a + (k + 1) % sides, *out++ = centre;
+  for (uint32_t k = 0; k < sides; ++k) out = write_triangle(a + k, a + (k + 1) % sides, centre, out);
   return out;
 }
 

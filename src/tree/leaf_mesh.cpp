@@ -167,7 +167,10 @@ double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_
     const Eigen::Vector3d local = to_leaf * (p - origin);
     model.uvs.col(first + i) = Eigen::Vector2f(float(local.x()), float(local.y()));
     const double d = (p - origin).squaredNorm();
-    if (d < nearest) nearest = d, attachment = first + i;
+    if (d < nearest) {
+      nearest = d;
+      attachment = first + i;
+    }
   }
   const bool flip = newell.dot(skeleton.leaf_up[l]) < 0;
   for (uint32_t i = 1; i + 1 < n; ++i) {

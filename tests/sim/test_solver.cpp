@@ -39,7 +39,8 @@ TreeModel single_cluster(const Eigen::Vector3d& origin) {
 TEST(Solver, RigidlyMovedRestPoseIsItsOwnGoal) {
   // Far from the origin, no anchors, no forces, global term off: every cluster's goal is the
   // moved rest pose, so nothing moves and the extracted rotation is the applied one.
-  const TreeModel model = small_tree(2, Eigen::Vector3d(5000, 20, -3000));
+  TreeModel model = small_tree(2, Eigen::Vector3d(5000, 20, -3000));
+  std::fill(model.vertex_anchored.begin(), model.vertex_anchored.end(), 0);
   SimOptions options = per_step(0.7, 0, false);
   options.rotation_iterations = 100;  // a cold start 0.8 rad away; the bake warm-starts
   Simulator sim(model, options, calm(), 1.0 / 24, 1);

@@ -89,7 +89,10 @@ TEST(TreeMasses, LeafMassAndDragAreaComeFromTheBladeArea) {
     const double area = 0.5 * 0.1 * 0.06 * s * s;  // rhombus: half the product of its diagonals
     double mass = 0, drag = 0;
     for (size_t v = 0; v < m.vertex_count(); ++v)
-      if (m.vertex_leaf[v] == int32_t(l)) mass += m.vertex_mass[v], drag += m.vertex_drag_area[v];
+      if (m.vertex_leaf[v] == int32_t(l)) {
+        mass += m.vertex_mass[v];
+        drag += m.vertex_drag_area[v];
+      }
     EXPECT_NEAR(mass, 0.2 * area, 1e-15) << l;
     EXPECT_NEAR(drag, area, 1e-15) << l;
   }

@@ -41,5 +41,14 @@ TEST(ValidateTreeModel, CatchesCorruptedIndices) {
             "tree model: vertex_inv_mass[0] disagrees with vertex_anchored");
 }
 
+TEST(ValidateTreeModel, AnEmptySkeletonIsAnInputError) {
+  try {
+    build_tree_model(Skeleton{}, TreeOptions{});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "the grammar draws nothing: no segment (F, G) and no leaf (L, ~, { . })");
+  }
+}
+
 }  // namespace
 }  // namespace treeanim
