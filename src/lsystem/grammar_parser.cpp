@@ -359,7 +359,11 @@ class Parser {
   static void check_symbol(std::string_view text, size_t k, SourcePos line, const char* what) {
     const char c = text[k];
     if (c == '(' || c == ')') fail(line, k, std::string("expected a module symbol, got '") + c + "'");
-    if (c == '*') fail(line, k, std::string("'*' is not a module; alone it stands for an empty ") + what);
+    if (c == '*') {
+      std::string message = "'*' is not a module; alone it stands for an empty ";
+      message += std::string_view(what) == "axiom" ? "successor" : what;
+      fail(line, k, message);
+    }
     if (c == ':' || c == '<' || c == '>')
       fail(line, k, std::string("expected a module symbol, got '") + c + "'");
     if (!std::isgraph(static_cast<unsigned char>(c)))

@@ -51,6 +51,17 @@ Json parse_scene_json(const std::string& text, const std::string& name) {
     if (colon != std::string::npos) what = what.substr(colon + 2);
     const size_t at = e.byte > 0 ? e.byte - 1 : 0;
     throw InputError(name + ":" + line_column(text, at) + ": JSON syntax error: " + what);
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond double range (1e400): nlohmann gives no offset, only the number's text
+    // in quotes, so the place is where that text first occurs.
+    const std::string what = e.what();
+    const size_t open = what.find('\'');
+    const size_t close = what.rfind('\'');
+    const std::string number = open < close ? what.substr(open + 1, close - open - 1) : "";
+    const size_t at = number.empty() ? std::string::npos : text.find(number);
+    throw InputError(name + (at == std::string::npos ? "" : ":" + line_column(text, at)) +
+                     ": JSON number out of range: " + (number.empty() ? what : number) +
+                     " (expected a finite double)");
   }
 }
 
@@ -65,6 +76,8 @@ void apply_override(Json& document, const std::string& assignment) {
     value = Json::parse(text);
   } catch (const nlohmann::json::parse_error&) {
     value = text;  // not JSON: a bare string such as a file name
+  } catch (const nlohmann::json::out_of_range&) {
+    throw InputError("--set '" + assignment + "': number out of range (expected a finite double)");
   }
 
   Json* node = &document;

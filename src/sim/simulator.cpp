@@ -93,6 +93,9 @@ struct Simulator::Impl {
   std::vector<uint8_t> applied_attached;  // (L) detachments already applied to the arrays above
   std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
   bool detach_enabled;
+  // Threads only pay off above a few thousand memberships; below, the fork/join costs more
+  // than the work (results are identical either way).
+  bool parallel;
 
   // --- per-step scratch (no allocation in the step) ---
   double turbulence_sin_b[kMaxModes], turbulence_cos_b[kMaxModes];
@@ -122,7 +125,8 @@ struct Simulator::Impl {
 Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n)
     : model(m), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n),
       V(m.vertex_count()), C(m.cluster_count()), M(m.membership_count()), L(m.leaf_count()),
-      detach_enabled(o.leaf_detach_force > 0 && m.leaf_count() > 0) {
+      detach_enabled(o.leaf_detach_force > 0 && m.leaf_count() > 0),
+      parallel(m.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   precompute_members();
   const StepRates rates = compute_step_rates(model, options, h);
@@ -321,7 +325,7 @@ void Simulator::Impl::sync_detachments(SimState& state) {
 // its centre of the last step).
 void Simulator::Impl::sample_air(const SimState& state, const Eigen::Vector3d& base, double scale) {
   const int N = wind.mode_count();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel)
   for (size_t c = 0; c < C; ++c) {
     if (!cluster_awake(state, c)) continue;
     if (cluster_flying[c]) {
@@ -340,7 +344,7 @@ void Simulator::Impl::sample_air(const SimState& state, const Eigen::Vector3d& b
 void Simulator::Impl::predict(SimState& state, bool any_asleep) {
   const Eigen::Vector3d gravity_step = options.gravity * h;
   const double inv_h = 1.0 / h;
-#pragma omp parallel
+#pragma omp parallel if (parallel)
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
@@ -415,7 +419,7 @@ void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, cons
 // vertex (hierarchical: a 1 g leaf cannot drag its branch, nor drift off it in a gale).
 void Simulator::Impl::match_clusters(SimState& state, long long frame, int substep) {
   uint32_t bad = kNone;
-#pragma omp parallel reduction(min : bad)
+#pragma omp parallel if (parallel) reduction(min : bad)
   {
     const auto [first, last] = balanced_range(model.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t c = first; c < last; ++c) {
@@ -430,7 +434,7 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
     }
   }
   if (bad == kNone && !pinned_leaf_clusters.empty()) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) if (parallel) reduction(min : bad)
     for (size_t k = 0; k < pinned_leaf_clusters.size(); ++k) {
       const uint32_t c = pinned_leaf_clusters[k];
       if (cluster_pin_slot[c] == kNone || !cluster_awake(state, c)) continue;
@@ -458,7 +462,7 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
 void Simulator::Impl::correct(SimState& state, bool any_asleep, long long frame, int substep) {
   const double inv_h = 1.0 / h;
   uint32_t bad = kNone;
-#pragma omp parallel reduction(min : bad)
+#pragma omp parallel if (parallel) reduction(min : bad)
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());

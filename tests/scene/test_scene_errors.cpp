@@ -23,7 +23,7 @@ TEST(SceneErrors, ValidSceneLoads) { EXPECT_EQ(error_of(kValid), ""); }
 
 TEST(SceneErrors, SyntaxErrorGivesLineAndColumn) {
   const std::string message = error_of("{\n  \"time\": {\"fps\": 24,}\n}");
-  EXPECT_EQ(message.rfind("s.json:2:23: JSON syntax error: ", 0), 0u) << message;
+  EXPECT_EQ(message.rfind("s.json:2:22: JSON syntax error: ", 0), 0u) << message;
 }
 
 TEST(SceneErrors, UnterminatedStringGivesLineAndColumn) {
