@@ -23,7 +23,7 @@ class Progress {
   std::FILE* out_;
   bool enabled_;
   bool terminal_;
-  int last_percent_step_ = -1;   // log mode: last 5% step printed
+  int last_percent_step_ = 0;    // log mode: last 5% step printed (0%: nothing to say yet)
   double last_draw_ = -1;        // terminal mode: seconds at the last redraw
   std::chrono::steady_clock::time_point start_;
 };

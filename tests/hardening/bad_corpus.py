@@ -1,0 +1,59 @@
+#!/usr/bin/python3
+"""Runs the bad-input corpus: tests/bad/cases.json => every case exits with its documented code
+and names the problem on stderr; none crashes, hangs or reports an internal error.
+
+usage: bad_corpus.py TREEANIM CORPUS_DIR
+Each case runs in CORPUS_DIR (paths in its args are relative to it); "{tmp}" in an argument is
+replaced by a fresh empty folder, which must still be empty afterwards (a refused bake writes
+nothing).
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+
+def run_case(binary, corpus, case):
+    """case => list of problems (empty when it behaves as documented)."""
+    with tempfile.TemporaryDirectory(prefix="treeanim-bad-") as tmp:
+        args = [a.replace("{tmp}", tmp) for a in case["args"]]
+        try:
+            done = subprocess.run([binary] + args, cwd=corpus, capture_output=True, text=True,
+                                  errors="replace", timeout=120)
+        except subprocess.TimeoutExpired:
+            return ["timed out after 120 s"]
+        problems = []
+        if done.returncode != case["exit"]:
+            problems.append("exit %d, expected %d" % (done.returncode, case["exit"]))
+        if case["message"] not in done.stderr:
+            problems.append("stderr lacks %r" % case["message"])
+        if "internal error" in done.stderr:
+            problems.append("an internal error (an exception nobody mapped)")
+        left = os.listdir(tmp)
+        if left:
+            problems.append("files left in the output folder: %s" % left)
+        if problems:
+            problems.append("stderr was: %s" % done.stderr.strip()[-2000:])
+        return problems
+
+
+def main():
+    binary, corpus = os.path.abspath(sys.argv[1]), sys.argv[2]
+    with open(os.path.join(corpus, "cases.json")) as f:
+        cases = json.load(f)["cases"]
+    names = [c["name"] for c in cases]
+    if len(set(names)) != len(names):
+        sys.exit("cases.json: duplicate case names")
+    failed = 0
+    for case in cases:
+        problems = run_case(binary, corpus, case)
+        if problems:
+            failed += 1
+            print("FAIL %s: %s" % (case["name"], "\n    ".join(problems)))
+    print("bad corpus: %d of %d cases as documented" % (len(cases) - failed, len(cases)))
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
