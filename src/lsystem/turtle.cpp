@@ -274,7 +274,7 @@ class Turtle {
     const auto count = [&](char c) { return static_cast<size_t>(std::count(symbols.begin(), symbols.end(), c)); };
     const size_t segments = count('F') + count('G');
     const size_t leaves = count('L') + count('~') + count('{');
-    if (std::memchr(symbols.data(), '!', symbols.size()) != nullptr) s_.width = settings_.initial_width;
+    if (std::find(symbols.begin(), symbols.end(), '!') != symbols.end()) s_.width = settings_.initial_width;
     Skeleton& k = out_;
     k.segment_start.reserve(segments);
     k.segment_end.reserve(segments);

@@ -107,13 +107,14 @@ struct Simulator::Impl {
   void precompute_islands();
   void detach_leaf(SimState& state, size_t leaf);
   void sync_detachments(SimState& state);
-  void step(SimState& state, double t, long long frame, int substep);
+  void frame(SimState& state, long long frame_index);
+  void prepare_air(const SimState& state, double t);
+  bool all_resting(const SimState& state) const;
   void sample_air(const SimState& state, const Eigen::Vector3d& base, double scale);
-  void predict(SimState& state, bool any_asleep);
+  void vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep);
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
   void match_clusters(SimState& state, long long frame, int substep);
-  void correct(SimState& state, bool any_asleep, long long frame, int substep);
   void precompute_pins();
   void check_detachments(SimState& state);
   void check_sleep(SimState& state, double t);
@@ -339,24 +340,44 @@ void Simulator::Impl::sample_air(const SimState& state, const Eigen::Vector3d& b
   }
 }
 
-// State + forces => predicted velocities v* (damping, drag, gravity, global term Eq. 8) in
-// state.velocities and predicted positions p = x + h v* in `predicted`.
-void Simulator::Impl::predict(SimState& state, bool any_asleep) {
+// The per-vertex pass. `correct`: finish the current step from the predicted state
+// (averaged corrections, Eq. 7); `predict`: start the next step (damping, drag, gravity,
+// global term Eq. 8) into v* (state.velocities) and p = x + h v* (`predicted`). Fused, so a
+// vertex is loaded once per substep; the positions are written to the state only when a
+// step ends without a next prediction (the end of a frame).
+void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep) {
   const Eigen::Vector3d gravity_step = options.gravity * h;
   const double inv_h = 1.0 / h;
-#pragma omp parallel if (parallel)
+  const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
+                                      [](uint8_t a) { return a != 0; });
+  uint32_t bad = kNone;
+#pragma omp parallel if (parallel) reduction(min : bad)
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t v = first; v < last; ++v) {
-      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {
-        predicted.col(v) = state.positions.col(v);  // anchors hold where they are
-        continue;
-      }
+      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;  // anchors hold
       const bool flying = vertex_flying[v];
       if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
-      const Eigen::Vector3d x = state.positions.col(v);
-      const Eigen::Vector3d velocity = state.velocities.col(v);
+      Eigen::Vector3d x, velocity;
+      if (correct) {
+        // Average of the goals of the vertex's clusters, in membership order (never the sum).
+        Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+        for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
+          pull += member_correction.col(model.vertex_memberships[s]);
+        pull *= vertex_inv_count[v];
+        x = predicted.col(v) + pull;
+        velocity = state.velocities.col(v) + pull * inv_h;
+      } else {
+        x = state.positions.col(v);
+        velocity = state.velocities.col(v);
+      }
+      if (!predict) {
+        if (!x.allFinite() || !velocity.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
+        state.positions.col(v) = x;
+        state.velocities.col(v) = velocity;
+        continue;
+      }
       // Quadratic drag integrated exactly over the step for constant air velocity:
       // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
       // the air velocity, whatever the wind speed or step.
@@ -366,11 +387,17 @@ void Simulator::Impl::predict(SimState& state, bool any_asleep) {
       Eigen::Vector3d next = velocity * vertex_damping[v] + drag_dv;
       if (flying) next += gravity_step;
       else next += (vertex_global[v] * inv_h) * (model.rest_positions.col(v) - x);
+      const Eigen::Vector3d ahead = x + h * next;
+      if (!ahead.allFinite() || !next.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
       state.velocities.col(v) = next;
-      predicted.col(v) = x + h * next;
+      predicted.col(v) = ahead;
       if (detach_enabled) vertex_drag_force.col(v) = drag_dv * (model.vertex_mass[v] * inv_h);
     }
   }
+  if (bad != kNone)
+    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                          std::to_string(vertex_air_cluster[bad]) + " (vertex " + std::to_string(bad) +
+                          "): non-finite position or velocity");
 }
 
 // Shape match of cluster c on the predicted positions => its rotation (warm start updated),
@@ -458,38 +485,6 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
                           std::to_string(bad) + ": the shape match produced a non-finite rotation or centre");
 }
 
-// Predicted state + averaged corrections => final velocities (Eq. 7) and positions.
-void Simulator::Impl::correct(SimState& state, bool any_asleep, long long frame, int substep) {
-  const double inv_h = 1.0 / h;
-  uint32_t bad = kNone;
-#pragma omp parallel if (parallel) reduction(min : bad)
-  {
-    const auto [first, last] =
-        balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    for (size_t v = first; v < last; ++v) {
-      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;
-      if (any_asleep && !vertex_flying[v] && state.island_asleep[vertex_island[v]]) continue;
-      // Average of the goals of the vertex's clusters, in membership order (never the sum).
-      Eigen::Vector3d pull = Eigen::Vector3d::Zero();
-      for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
-        pull += member_correction.col(model.vertex_memberships[s]);
-      pull *= vertex_inv_count[v];
-      const Eigen::Vector3d next = state.velocities.col(v) + pull * inv_h;
-      const Eigen::Vector3d moved = predicted.col(v) + pull;
-      if (!moved.allFinite() || !next.allFinite()) {
-        bad = std::min(bad, static_cast<uint32_t>(v));
-        continue;
-      }
-      state.positions.col(v) = moved;
-      state.velocities.col(v) = next;
-    }
-  }
-  if (bad != kNone)
-    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-                          std::to_string(vertex_air_cluster[bad]) + " (vertex " + std::to_string(bad) +
-                          "): non-finite position or velocity");
-}
-
 // Drag on each attached leaf => detach those past the threshold (in leaf order).
 void Simulator::Impl::check_detachments(SimState& state) {
   for (size_t l = 0; l < L; ++l) {
@@ -536,27 +531,40 @@ void Simulator::Impl::check_sleep(SimState& state, double t) {
   std::fill(island_fell_asleep.begin(), island_fell_asleep.end(), 0);
 }
 
-// One substep starting at time t.
-void Simulator::Impl::step(SimState& state, double t, long long frame, int substep) {
-  bool any_asleep = false;
-  if (options.sleep) {
-    const bool calm = wind.calm(t);
-    for (size_t i = 0; i < I; ++i) {
-      if (!calm) state.island_asleep[i] = 0;
-      any_asleep = any_asleep || state.island_asleep[i];
-    }
-    const bool all_asleep = any_asleep && std::all_of(state.island_asleep.begin(), state.island_asleep.end(),
-                                                      [](uint8_t a) { return a != 0; });
-    if (all_asleep && std::none_of(cluster_flying.begin(), cluster_flying.end(), [](uint8_t f) { return f != 0; }))
-      return;
-  }
+// Wind at t => air velocity of every awake cluster (scratch phases filled for t).
+void Simulator::Impl::prepare_air(const SimState& state, double t) {
   const Eigen::Vector3d base = wind.base(t);
   const double scale = wind.temporal_phases(t, turbulence_sin_b, turbulence_cos_b);
   sample_air(state, base, scale);
-  predict(state, any_asleep);
+}
+
+// True when no island is awake and nothing flies: the frame costs nothing.
+bool Simulator::Impl::all_resting(const SimState& state) const {
+  return std::all_of(state.island_asleep.begin(), state.island_asleep.end(), [](uint8_t a) { return a != 0; }) &&
+         std::none_of(cluster_flying.begin(), cluster_flying.end(), [](uint8_t f) { return f != 0; });
+}
+
+// One frame of `substeps` steps from state.time: predict, then per step match the clusters
+// and correct, fused with the next step's prediction.
+void Simulator::Impl::frame(SimState& state, long long frame_index) {
+  const double start = state.time;
+  if (options.sleep) {
+    // Sleeping islands wake as soon as the air moves at any step of this frame.
+    bool calm = true;
+    for (int k = 0; k < substeps && calm; ++k) calm = wind.calm(start + k * h);
+    if (!calm) std::fill(state.island_asleep.begin(), state.island_asleep.end(), 0);
+    if (all_resting(state)) return;
+  }
+  prepare_air(state, start);
+  vertex_pass(state, false, true, frame_index, 0);
   if (detach_enabled) check_detachments(state);
-  match_clusters(state, frame, substep);
-  correct(state, any_asleep, frame, substep);
+  for (int k = 0; k < substeps; ++k) {
+    match_clusters(state, frame_index, k);
+    const bool last = k + 1 == substeps;
+    if (!last) prepare_air(state, start + (k + 1) * h);
+    vertex_pass(state, true, !last, frame_index, k);
+    if (!last && detach_enabled) check_detachments(state);
+  }
 }
 
 Simulator::Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
@@ -585,9 +593,8 @@ void Simulator::advance_frame(SimState& state, long long frame) {
       state.cluster_rotations.cols() != static_cast<Eigen::Index>(s.C) || state.island_asleep.size() != s.I)
     throw SimulationError("frame " + std::to_string(frame) + ": the state does not belong to this tree model");
   s.sync_detachments(state);
-  const double start = state.time;
-  for (int k = 0; k < s.substeps; ++k) s.step(state, start + k * s.h, frame, k);
-  state.time = start + s.frame_dt;
+  s.frame(state, frame);
+  state.time += s.frame_dt;
   if (s.options.sleep) s.check_sleep(state, state.time);
 }
 

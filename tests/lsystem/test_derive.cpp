@@ -74,6 +74,26 @@ TEST(Derive, CountsPerStepForAbopBracketedGrammars) {
   }
 }
 
+TEST(Derive, ClosedFormForParametricAbop26) {
+  // Fig. 2.6: each apex (A, B, C) becomes 2 apices and 6 other modules (! F [ & ] / or
+  // ! F [ - $ ]): apices_n = 2^n, total_n = 2^n + 6 (2^n - 1).
+  const Grammar g = parse(
+      "#define r1 0.9\n#define r2 0.6\n#define a0 45\n#define a2 45\n#define d 137.5\n#define wr 0.707\n"
+      "axiom: A(1,10)\n"
+      "A(l,w) --> !(w)F(l)[&(a0)B(l*r2,w*wr)]/(d)A(l*r1,w*wr)\n"
+      "B(l,w) --> !(w)F(l)[-(a2)$C(l*r2,w*wr)]C(l*r1,w*wr)\n"
+      "C(l,w) --> !(w)F(l)[+(a2)$B(l*r2,w*wr)]B(l*r1,w*wr)\n");
+  for (int n = 0; n <= 12; ++n) {
+    const size_t apices = size_t{1} << n;
+    EXPECT_EQ(derive(g, {n, 1, 20'000'000}).size(), apices + 6 * (apices - 1)) << n;
+  }
+  // The trunk's n-th internode has length r1^(n-1) (the first F after n steps is F(1)).
+  const ModuleString word = derive(g, {3, 1, 1000});
+  EXPECT_EQ(word.symbols[1], 'F');
+  EXPECT_EQ(word.params_of(1)[0], 1.0);
+  EXPECT_EQ(word.params_of(0)[0], 10.0);
+}
+
 TEST(Derive, ParametricValuesFollowTheProductions) {
   // Fig. 2.8's F(l) --> F(l*lr) and !(w) --> !(w*vr): after n steps l = 200 lr^n, w = vr^n.
   const ModuleString word = run("#define lr 1.109\n#define vr 1.732\naxiom: !(1)F(200)/(45)A\n"

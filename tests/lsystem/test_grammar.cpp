@@ -73,6 +73,18 @@ TEST(Grammar, DirectivesAndRules) {
   EXPECT_EQ(g.decomposition.max_depth, 3);
 }
 
+TEST(Grammar, ArrowsAndTurnSymbolsAsPredecessors) {
+  const Grammar g = parse("axiom: A\nA->B\n- --> +\n--->&\n+ > - --> ^\n");
+  ASSERT_EQ(g.productions.rules.size(), 4u);
+  EXPECT_EQ(g.productions.rules[0].predecessor, 'A');
+  EXPECT_EQ(g.productions.successor[g.productions.rules[0].successor_begin].symbol, 'B');
+  EXPECT_EQ(g.productions.rules[1].predecessor, '-');
+  EXPECT_EQ(g.productions.rules[2].predecessor, '-');
+  EXPECT_EQ(g.productions.successor[g.productions.rules[2].successor_begin].symbol, '&');
+  EXPECT_EQ(g.productions.rules[3].predecessor, '+');
+  EXPECT_EQ(g.productions.patterns[g.productions.rules[3].right_begin].symbol, '-');
+}
+
 TEST(Grammar, SceneDefinesOverrideFileDefines) {
   const Grammar g = parse("#define a 1\n#define b a+1\naxiom: F\n", {{"a", 10}});
   ASSERT_EQ(g.defines.size(), 2u);
