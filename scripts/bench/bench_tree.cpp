@@ -50,8 +50,8 @@ void bench_scene(const std::string& file, int repeat) {
                   model.membership_count());
     }
   }
-  std::printf("%s: best of %d: derivation+turtle %.4f s, model %.4f s, total %.4f s\n", file.c_str(), repeat,
-              best_grow, best_model, best_grow + best_model);
+  std::printf("%s: best of %d: derivation+turtle %.2f ms, model %.2f ms, total %.2f ms\n", file.c_str(), repeat,
+              1e3 * best_grow, 1e3 * best_model, 1e3 * (best_grow + best_model));
 }
 
 }  // namespace

@@ -96,7 +96,6 @@ struct OutputSet::Impl {
   std::vector<std::unique_ptr<Worker>> workers;
   bool velocities = false;
   bool has_hdf5 = false;
-  bool started = false;
   bool done = false;  // finished or aborted
 
   explicit Impl(const TreeModel& m) : model(m) {}
@@ -161,7 +160,6 @@ void OutputSet::begin() {
     throw;
   }
   for (auto& worker : impl_->workers) worker->thread = std::thread(&Worker::run, worker.get());
-  impl_->started = true;
 }
 
 void OutputSet::push(FrameData frame) {

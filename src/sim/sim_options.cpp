@@ -49,12 +49,18 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   return cells;
 }
 
-// Keys must have strictly increasing times: interpolation needs an order.
-void check_increasing(const std::vector<WindKey>& keys, size_t i, const std::string& where) {
-  if (i > 0 && !(keys[i].time > keys[i - 1].time))
-    throw InputError(where + ": time " + std::to_string(keys[i].time) +
-                     " must be greater than the previous key's time " +
-                     std::to_string(keys[i - 1].time));
+std::string format_number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// Keys must have strictly increasing times (interpolation needs an order) => "" when key i
+// is in order, else the message.
+std::string order_error(const std::vector<WindKey>& keys, size_t i) {
+  if (i == 0 || keys[i].time > keys[i - 1].time) return "";
+  return "time " + format_number(keys[i].time) + " must be greater than the previous key's time " +
+         format_number(keys[i - 1].time);
 }
 
 }  // namespace
@@ -70,6 +76,7 @@ SimOptions read_sim_options(SceneObject section) {
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
   o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::positive());
   o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
+  o.max_frequency = section.number("max_frequency", o.max_frequency, Range::positive());
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
   o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::non_negative());
   o.gravity = section.vector3("gravity", o.gravity);
@@ -123,7 +130,8 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
       if (key.gust < 0) throw InputError(where + ": column 'gust': expected a number >= 0, got '" + cells[5] + "'");
     }
     keys.push_back(key);
-    check_increasing(keys, keys.size() - 1, where);
+    if (const std::string error = order_error(keys, keys.size() - 1); !error.empty())
+      throw InputError(where + ": " + error);
   }
   if (!header_seen) throw InputError(name + ":1: expected the header 'time,speed,dx,dy,dz[,gust]', the file is empty");
   if (keys.empty()) throw InputError(name + ":" + std::to_string(line_number) + ": expected at least one data line after the header");
@@ -146,7 +154,7 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
     key.direction = *direction;
     key.gust = k.number("gust", 0, Range::non_negative());
     o.keys.push_back(key);
-    check_increasing(o.keys, i, k.pointer_of("time"));
+    if (const std::string error = order_error(o.keys, i); !error.empty()) k.fail("time", error);
   }
   if (o.file) {
     std::ifstream in(*o.file, std::ios::binary);

@@ -62,6 +62,7 @@ struct Simulator::Impl {
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
+  Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s q over the members: round-off only
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
@@ -167,6 +168,7 @@ void Simulator::Impl::precompute_members() {
   member_active.assign(M, 1);
   member_correction.setZero(3, M);
   cluster_rest_centre.setZero(3, C);
+  cluster_offset_sum.setZero(3, C);
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   vertex_inv_count.assign(V, 0);
   vertex_air_cluster.assign(V, 0);
@@ -204,10 +206,13 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
   }
   // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
   const double inv_spread = spread > 0 ? 1.0 / spread : 0.0;
+  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
     member_match_weight[s] = total > 0 ? weight(s) * inv_spread : 0.0;
     member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
+    offset_sum += member_match_weight[s] * member_offset.col(s);
   }
+  cluster_offset_sum.col(c) = offset_sum;
 }
 
 // Drag areas and coefficients => per-vertex drag constants.
@@ -405,21 +410,22 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
 bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   const Eigen::Vector3d t0 = cluster_rest_centre.col(c);
-  // Cluster-local coordinates: p - t0 is small wherever the tree stands. A_pq is summed over
-  // d = (p - t0) - (t - t0), relative to the current centre t: with p - t0 instead (equal in
-  // exact arithmetic, as sum w q = 0) the round-off of sum w q would be multiplied by the
-  // cluster's travel. Each entry is summed as s (d_i q_j), so that A is exactly symmetric at
-  // the rest pose (R = I exactly there).
+  // Cluster-local coordinates: d = p - t0 is small wherever the tree stands. One pass sums
+  // the centre shift and A' = sum s d q^T; then A_pq = sum s (d - shift) q^T
+  // = A' - shift (sum s q)^T. sum s q is 0 in exact arithmetic, but its round-off times the
+  // cluster's travel would tilt R (10^-6 rad for a tree 5 km from the origin), so its
+  // computed value is subtracted. Each entry is summed as s (d_i q_j), so that A is exactly
+  // symmetric at the rest pose (R = I exactly there).
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-  for (uint32_t s = begin; s < end; ++s)
-    shift += member_centre_weight[s] * (predicted.col(model.cluster_members[s]) - t0);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d d = (predicted.col(model.cluster_members[s]) - t0) - shift;
+    const Eigen::Vector3d d = predicted.col(model.cluster_members[s]) - t0;
     const Eigen::Vector3d q = member_offset.col(s);
+    shift += member_centre_weight[s] * d;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) A(i, j) += member_match_weight[s] * (d[i] * q[j]);
   }
+  A -= shift * cluster_offset_sum.col(c).transpose();
   centre = t0 + shift;
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
   extract_rotation(A, rotation, options.rotation_iterations);

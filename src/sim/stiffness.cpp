@@ -115,14 +115,17 @@ StepRates compute_step_rates(const TreeModel& model, const SimOptions& options, 
       const bool leaf = model.cluster_kind[c] == kClusterLeaf;
       // A branch cluster without geometry (zero radius, length or mass) has no finite
       // frequency: it gets the stiffest rate, like an unresolved one.
-      rates.cluster_alpha[c] = leaf ? options.leaf_alpha
-                               : rates.cluster_frequency[c] > 0 ? local_rate(rates.cluster_frequency[c], h)
-                                                                : 1.0;
+      // Segment frequencies of real wood are far above what a step resolves (a 0.5 m
+      // segment of a 10 cm branch: ~2000 rad/s), and alpha saturates at 1 there, which would
+      // make the tree stiffer with every added substep. Frequencies are therefore capped at
+      // max_frequency, a property of the scene, not of the step (docs/solver.md).
+      const double w_local = std::min(rates.cluster_frequency[c], options.max_frequency);
+      rates.cluster_alpha[c] = leaf ? options.leaf_alpha : w_local > 0 ? local_rate(w_local, h) : 1.0;
       if (!leaf) {
         ++branches;
         capped += rates.cluster_alpha[c] == 1.0;
       }
-      const double w = rates.cluster_limb_frequency[c];
+      const double w = std::min(rates.cluster_limb_frequency[c], options.max_frequency);
       cluster_global[c] = global_rate(std::sqrt(options.global_scale) * w, h);
       cluster_damping_frequency[c] = w;
     }

@@ -1,6 +1,7 @@
 #include "tree/build_tree_model.h"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include "common/errors.h"
@@ -27,10 +28,9 @@ void spread(const TreeModel& model, size_t c, double amount, Keep&& keep, std::v
 
 // Anchors: the base ring of every root axis, and a leaf drawn before any segment (its
 // petiole has no branch to hang from, so it is fixed where it was drawn).
-void anchor(const SegmentTopology& topology, const BranchRings& rings, const LeafMeshes& leaves,
-            uint32_t sides, TreeModel& model) {
+void anchor(const BranchRings& rings, const LeafMeshes& leaves, uint32_t sides, TreeModel& model) {
   model.vertex_anchored.assign(model.vertex_count(), 0);
-  for (size_t s = 0; s < topology.starts_axis.size(); ++s)
+  for (size_t s = 0; s < model.segment_count(); ++s)
     if (model.segment_parent[s] < 0)
       std::fill_n(model.vertex_anchored.begin() + rings.base_ring[s], sides, uint8_t(1));
   for (size_t l = 0; l < leaves.attachment.size(); ++l)
@@ -87,7 +87,7 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
     }
   }
   for (double& m : model.vertex_mass) m = std::max(m, kMinVertexMass);
-  anchor(topology, rings, leaves, uint32_t(options.ring_sides), model);
+  anchor(rings, leaves, uint32_t(options.ring_sides), model);
   model.vertex_inv_mass.resize(V);
   for (size_t v = 0; v < V; ++v) model.vertex_inv_mass[v] = model.vertex_anchored[v] ? 0.0 : 1.0 / model.vertex_mass[v];
   model.cluster_mass.assign(C, 0.0);
@@ -112,6 +112,8 @@ TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options)
   counts.leaf_vertices = leaf_vertex_count(skeleton, shape);
   counts.leaf_triangles = leaf_triangle_count(skeleton, shape);
   const size_t V = counts.branch_vertices + counts.leaf_vertices;
+  if (V > std::numeric_limits<uint32_t>::max() / 2)  // ids and membership slots are uint32
+    throw InputError("tree too large: " + std::to_string(V) + " vertices (at most 2^31)");
   model.rest_positions.resize(3, Eigen::Index(V));
   model.uvs.resize(2, Eigen::Index(V));
   model.vertex_segment.resize(V);

@@ -72,10 +72,12 @@ void check_clusters(const TreeModel& m) {
       if (m.cluster_members[i] <= m.cluster_members[i - 1])
         fail("cluster_members of cluster " + std::to_string(c) + " not strictly ascending at " + std::to_string(i));
   expect_range("cluster_kind", m.cluster_kind, 0, 2);
-  for (const auto* a : {&m.cluster_first_segment, &m.cluster_leaf, &m.cluster_parent})
-    expect_size("cluster arrays", a->size(), C);
-  for (const auto* a : {&m.cluster_mass, &m.cluster_length, &m.cluster_radius})
-    expect_size("cluster arrays", a->size(), C);
+  expect_size("cluster_first_segment", m.cluster_first_segment.size(), C);
+  expect_size("cluster_leaf", m.cluster_leaf.size(), C);
+  expect_size("cluster_parent", m.cluster_parent.size(), C);
+  expect_size("cluster_mass", m.cluster_mass.size(), C);
+  expect_size("cluster_length", m.cluster_length.size(), C);
+  expect_size("cluster_radius", m.cluster_radius.size(), C);
   expect_range("cluster_first_segment", m.cluster_first_segment, -1, (long long)m.segment_count());
   expect_range("cluster_leaf", m.cluster_leaf, -1, (long long)m.leaf_count());
   for (size_t c = 0; c < C; ++c)

@@ -123,6 +123,19 @@ TEST(BranchMesh, HelixRingsFollowByParallelTransportWithoutFlips) {
   EXPECT_GT(max_angle * 180 / std::numbers::pi, 1.0);
 }
 
+TEST(BranchMesh, AxisFramesAreSeededFromTheTurtleUp) {
+  SkeletonBuilder b;
+  const int t = b.segment({0, 0, 0}, {0, 1, 0}, -1, false, 0.2, {0, 0, 1});
+  // A lateral along +x whose turtle U is tilted: the ring starts at U made perpendicular.
+  b.segment({0, 1, 0}, {1, 1, 0}, t, false, 0.1, Eigen::Vector3d(0.6, 0.8, 0));
+  const TreeModel m = build_tree_model(b.sk, TreeOptions{});
+  EXPECT_LT((m.rest_positions.col(0) - Eigen::Vector3d(0, 0, 0.1)).norm(), 1e-12);
+  // Trunk: base ring 0..7, top ring 8..15, tip 16; the lateral's base ring starts at 17.
+  EXPECT_LT((m.rest_positions.col(17) - Eigen::Vector3d(0, 1.05, 0)).norm(), 1e-12);
+  // Vertex 2 is a quarter turn counter-clockwise about the axis: T x N = (1,0,0) x (0,1,0).
+  EXPECT_LT((m.rest_positions.col(19) - Eigen::Vector3d(0, 1, 0.05)).norm(), 1e-12);
+}
+
 TEST(BranchMesh, UvsRunAroundAndAlongInMetres) {
   TreeOptions o;
   o.scale = 0.5;

@@ -1,0 +1,34 @@
+# Hardening tests (issue 8), label `hardening`: the bad-input corpus, failure injection around a
+# real bake, and a replay of every fuzz corpus (seeds + kept reproducers) through the fuzz
+# targets built with the normal compiler. Included by CMakeLists.txt inside the test block.
+find_program(TREEANIM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)  # the one with h5py
+if(NOT TREEANIM_PYTHON)
+  find_program(TREEANIM_PYTHON python3 REQUIRED)
+endif()
+
+add_test(NAME hardening.bad_corpus
+  COMMAND ${TREEANIM_PYTHON} ${CMAKE_SOURCE_DIR}/tests/hardening/bad_corpus.py
+          $<TARGET_FILE:treeanim> ${CMAKE_SOURCE_DIR}/tests/bad)
+set_tests_properties(hardening.bad_corpus PROPERTIES LABELS hardening TIMEOUT 300)
+
+set(failure_injection ${CMAKE_SOURCE_DIR}/tests/hardening/failure_injection.py)
+execute_process(COMMAND ${TREEANIM_PYTHON} ${failure_injection} - --list
+  OUTPUT_VARIABLE failure_scenarios OUTPUT_STRIP_TRAILING_WHITESPACE COMMAND_ERROR_IS_FATAL ANY)
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${failure_injection})
+string(REPLACE "\n" ";" failure_scenarios "${failure_scenarios}")
+foreach(scenario ${failure_scenarios})
+  add_test(NAME hardening.${scenario}
+    COMMAND ${TREEANIM_PYTHON} ${failure_injection} $<TARGET_FILE:treeanim> ${scenario})
+  set_tests_properties(hardening.${scenario} PROPERTIES LABELS hardening TIMEOUT 300
+    SKIP_RETURN_CODE 77)
+endforeach()
+
+file(GLOB fuzz_targets CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_*.cpp)
+foreach(src ${fuzz_targets})
+  get_filename_component(fuzz_name ${src} NAME_WE)
+  add_executable(replay_${fuzz_name} ${src} ${CMAKE_SOURCE_DIR}/tests/hardening/fuzz_replay_main.cpp)
+  target_link_libraries(replay_${fuzz_name} PRIVATE treeanim_core)
+  add_test(NAME hardening.replay_${fuzz_name}
+    COMMAND replay_${fuzz_name} ${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${fuzz_name})
+  set_tests_properties(hardening.replay_${fuzz_name} PROPERTIES LABELS hardening TIMEOUT 300)
+endforeach()

@@ -1,0 +1,250 @@
+#!/usr/bin/python3
+"""Failure injection for treeanim (issue 8): hostile conditions around a real bake must give the
+documented exit code and message and leave no file under a final name (and no temporaries).
+
+usage: failure_injection.py TREEANIM SCENARIO     (exit 0 pass, 1 fail, 77 skipped)
+Each scenario bakes tests/hardening/scenes/bake.json (a small tree written as hdf5, an obj
+sequence, glb and pc2) from a fresh copy in a temporary folder. Works as root: an unwritable
+output is a path below a regular file or in /proc, not a chmod that root ignores.
+"""
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SKIP = 77
+
+
+class Failed(Exception):
+    pass
+
+
+def files_under(folder):
+    """folder => every file below it (relative paths); [] when the folder does not exist."""
+    found = []
+    for root, _, names in os.walk(folder):
+        found += [os.path.relpath(os.path.join(root, n), folder) for n in names]
+    return sorted(found)
+
+
+def expect(done, code, message, out):
+    """A finished run => Failed unless it exited `code`, said `message` and left no file in out."""
+    stderr = done.stderr if isinstance(done.stderr, str) else done.stderr.decode(errors="replace")
+    problems = []
+    if done.returncode != code:
+        problems.append("exit %d, expected %d" % (done.returncode, code))
+    if message not in stderr:
+        problems.append("stderr lacks %r" % message)
+    left = files_under(out)
+    if left:
+        problems.append("files left behind: %s" % left[:10])
+    if problems:
+        raise Failed("; ".join(problems) + "\nstderr: " + stderr.strip()[-2000:])
+
+
+class Bake:
+    """A fresh copy of the bake scene in a temporary folder; outputs go to <tmp>/out."""
+
+    def __init__(self, binary, tmp):
+        self.binary, self.tmp = binary, tmp
+        for name in ("bake.json", "wind.csv"):
+            shutil.copy(os.path.join(HERE, "scenes", name), tmp)
+        self.scene = os.path.join(tmp, "bake.json")
+        self.wind = os.path.join(tmp, "wind.csv")
+        self.out = os.path.join(tmp, "out")
+
+    def args(self, frames, extra=(), out=None):
+        return [self.binary, "run", self.scene, "-o", out or self.out, "--quiet",
+                "--set", "time.frames=%d" % frames] + list(extra)
+
+    def run(self, frames, extra=(), out=None, preexec=None, timeout=120):
+        return subprocess.run(self.args(frames, extra, out), capture_output=True, text=True,
+                              errors="replace", preexec_fn=preexec, timeout=timeout)
+
+    def start(self, frames, extra=()):
+        return subprocess.Popen(self.args(frames, extra), stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, errors="replace")
+
+    def wait_until_writing(self, process):
+        """Returns once the bake has staged its temporaries and written some frames."""
+        deadline = time.monotonic() + 60
+        while not any(".tmp-" in f for f in files_under(self.out)):
+            if process.poll() is not None:
+                raise Failed("the bake ended before writing: " + process.communicate()[1])
+            if time.monotonic() > deadline:
+                raise Failed("no temporary file appeared within 60 s")
+            time.sleep(0.02)
+        time.sleep(0.3)
+        if process.poll() is not None:
+            raise Failed("the bake finished before it could be interrupted (raise its frames)")
+
+
+# ---- scenarios: each takes a Bake and raises Failed (or returns SKIP) ------------------------
+
+def output_below_a_file(bake):
+    """-o names a folder below a regular file: mkdir fails with ENOTDIR, even for root."""
+    blocker = os.path.join(bake.tmp, "not-a-folder")
+    open(blocker, "w").close()
+    out = os.path.join(blocker, "out")
+    expect(bake.run(24, out=out), 4, "output failed: " + out, bake.out)
+
+
+def output_in_proc(bake):
+    """An absolute output path in /proc, where no one (root included) can create a file."""
+    done = bake.run(24, ["--set", "outputs.0.path=/proc/treeanim-hardening.h5"])
+    expect(done, 4, "output failed: /proc/treeanim-hardening.h5: cannot create a file in /proc", bake.out)
+    if os.path.exists("/proc/treeanim-hardening.h5"):
+        raise Failed("a file appeared in /proc")
+
+
+def output_directory_in_the_way(bake):
+    """A directory stands where the hdf5 file should go."""
+    os.makedirs(os.path.join(bake.out, "bake.h5"))
+    expect(bake.run(24), 4, "bake.h5: a directory is in the way of the output file", bake.out)
+
+
+def output_read_only_folder(bake):
+    """A folder without write permission (only meaningful when not root)."""
+    if os.geteuid() == 0:
+        print("skipped: root ignores folder permissions (output_below_a_file covers this as root)")
+        return SKIP
+    os.makedirs(bake.out)
+    os.chmod(bake.out, 0o555)
+    expect(bake.run(24), 4, "output failed: ", bake.out)
+
+
+def limit_file_size(ignore_sigxfsz):
+    """=> preexec function: a 100 KiB file-size limit, as a full disk or a quota gives."""
+    def preexec():
+        if ignore_sigxfsz:
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100 * 1024, 100 * 1024))
+    return preexec
+
+
+def disk_full(bake):
+    """`ulimit -f` as a shell sets it (SIGXFSZ at its default, which kills): writes past the
+    limit must fail with exit 4, not kill the bake and strand its temporaries."""
+    done = bake.run(2000, preexec=limit_file_size(False))
+    expect(done, 4, "output failed: ", bake.out)
+    if "File too large" not in done.stderr:
+        raise Failed("the message does not name the cause: " + done.stderr)
+
+
+def disk_full_efbig(bake):
+    """A write that fails with an error (SIGXFSZ ignored, as with ENOSPC): exit 4 naming the file."""
+    done = bake.run(2000, preexec=limit_file_size(True))
+    expect(done, 4, "write failed: File too large", bake.out)
+
+
+def interrupted(signal_number, code, name):
+    def scenario(bake):
+        """A signal in the middle of a bake: the documented code, and no output at all."""
+        process = bake.start(30000)  # under the GLB limit of 31898 frames
+        bake.wait_until_writing(process)
+        process.send_signal(signal_number)
+        try:
+            _, stderr = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            raise Failed("the bake did not stop within 60 s of " + name)
+        done = subprocess.CompletedProcess(process.args, process.returncode, "", stderr)
+        expect(done, code, "interrupted by " + name, bake.out)
+    return scenario
+
+
+def wind_file_deleted(bake):
+    """The wind file is gone when the bake starts: bad input (2) naming /wind/file."""
+    os.remove(bake.wind)
+    expect(bake.run(24), 2, "/wind/file: cannot open wind file '%s'" % bake.wind, bake.out)
+
+
+def wind_file_truncated(bake):
+    """The wind file was cut in the middle of a line (a copy that did not finish): file:line."""
+    with open(bake.wind, "rb") as f:
+        text = f.read()
+    with open(bake.wind, "wb") as f:
+        f.write(text[: text.rindex(b",")])
+    expect(bake.run(24), 2, "%s:4: expected 6 comma-separated values, got 5" % bake.wind, bake.out)
+
+
+def wind_file_deleted_mid_bake(bake):
+    """The wind is read once when the scene loads: deleting the file during the bake changes
+    nothing, and the bake completes (every output under its final name, no temporaries)."""
+    process = bake.start(3000)
+    bake.wait_until_writing(process)
+    os.remove(bake.wind)
+    _, stderr = process.communicate(timeout=300)
+    if process.returncode != 0:
+        raise Failed("exit %d: %s" % (process.returncode, stderr))
+    left = files_under(bake.out)
+    if any(".tmp-" in f for f in left) or "bake.h5" not in left:
+        raise Failed("unexpected outputs: %s" % left[:10])
+
+
+def module_cap_under_ulimit_v(bake):
+    """A grammar that doubles every step stops at the default module cap (20 million) with a
+    clear message, within a 4 GB address-space limit (ulimit -v 4000000), not an OOM kill."""
+    if asan_binary(bake.binary):
+        print("skipped: AddressSanitizer reserves terabytes of address space; ulimit -v cannot apply")
+        return SKIP
+    def preexec():
+        limit = 4000000 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    done = bake.run(24, ["--set", "lsystem.productions=[\"A(x) --> A(x)A(x)\"]",
+                         "--set", "lsystem.iterations=40"], preexec=preexec, timeout=300)
+    expect(done, 2, "reached 20000002 modules, more than lsystem.max_modules = 20000000", bake.out)
+
+
+def glb_too_large(bake):
+    """A GLB cannot exceed 4 GiB: a bake whose animated GLB would is refused before simulating
+    (the 1 million frames would take minutes to simulate; the refusal takes milliseconds)."""
+    done = bake.run(1000000, timeout=60)
+    expect(done, 4, "over glTF's 4 GiB GLB limit; at most", bake.out)
+
+
+def asan_binary(path):
+    """True when the binary was built with AddressSanitizer."""
+    with open(path, "rb") as f:
+        return b"__asan_init" in f.read()
+
+
+SCENARIOS = {
+    "output-below-a-file": output_below_a_file,
+    "output-in-proc": output_in_proc,
+    "output-directory-in-the-way": output_directory_in_the_way,
+    "output-read-only-folder": output_read_only_folder,
+    "disk-full": disk_full,
+    "disk-full-efbig": disk_full_efbig,
+    "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
+    "sigterm": interrupted(signal.SIGTERM, 143, "SIGTERM"),
+    "wind-file-deleted": wind_file_deleted,
+    "wind-file-truncated": wind_file_truncated,
+    "wind-file-deleted-mid-bake": wind_file_deleted_mid_bake,
+    "module-cap-under-ulimit-v": module_cap_under_ulimit_v,
+    "glb-too-large": glb_too_large,
+}
+
+
+def main():
+    binary, name = os.path.abspath(sys.argv[1]), sys.argv[2]
+    if name == "--list":
+        print("\n".join(SCENARIOS))
+        return 0
+    with tempfile.TemporaryDirectory(prefix="treeanim-fi-") as tmp:
+        try:
+            result = SCENARIOS[name](Bake(binary, tmp))
+        except Failed as failure:
+            print("FAIL %s: %s" % (name, failure))
+            return 1
+    print("ok %s" % name)
+    return result or 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

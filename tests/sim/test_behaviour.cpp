@@ -1,0 +1,250 @@
+// Whole-bake behaviour on grown trees: coming to rest, thin versus thick branches, leaves
+// detaching, sleeping, thread-count determinism, convergence in the substep count.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstring>
+
+#include "lsystem/lsystem.h"
+#include "sim/simulator.h"
+#include "sim/stiffness.h"
+#include "sim_test_models.h"
+#include "tree/build_tree_model.h"
+
+namespace treeanim {
+namespace {
+
+// The Table-1 monopodial grammar grown `iterations` seasons with `leaves` per node.
+TreeModel grown_tree(int iterations, int leaves, int segments_per_cluster) {
+  LsystemOptions lsystem;
+  lsystem.grammar = std::filesystem::path(TREEANIM_SOURCE_DIR) / "grammars/table1-monopodial.lsys";
+  lsystem.iterations = iterations;
+  lsystem.tropism_elasticity = 0.01;
+  lsystem.defines = {{"K", 4}, {"NP", leaves}, {"LT", 1}};
+  GrowthStats stats;
+  const Skeleton skeleton = grow_skeleton(lsystem, &stats);
+  TreeOptions tree;
+  tree.trunk_radius = 0.1;
+  tree.cluster.segments_per_cluster = segments_per_cluster;
+  TreeModel model = build_tree_model(skeleton, tree);
+  validate_tree_model(model);
+  return model;
+}
+
+WindOptions gust_then_calm(double speed, double blow_until, double calm_from) {
+  WindOptions wind;
+  wind.keys = {{0, speed, {1, 0, 0.2}, speed * 0.3}, {blow_until, speed, {1, 0, 0.2}, speed * 0.3},
+               {calm_from, 0, {1, 0, 0.2}, 0}};
+  return wind;
+}
+
+double max_displacement(const SimState& state, const TreeModel& model) {
+  return (state.positions - model.rest_positions).colwise().norm().maxCoeff();
+}
+
+TEST(Behaviour, TreeComesToRestAfterTheWindStops) {
+  // Documented in docs/solver.md ("Damping"): with the default damping a tree is within
+  // 1 mm of its rest pose 10 s after the wind has stopped.
+  const TreeModel model = grown_tree(5, 2, 4);
+  SimOptions options;
+  options.sleep = false;
+  Simulator sim(model, options, gust_then_calm(12, 3, 3.5), 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  double peak = 0;
+  for (int f = 1; f <= 24 * 14; ++f) {
+    sim.advance_frame(state, f);
+    if (f <= 24 * 4) peak = std::max(peak, max_displacement(state, model));
+  }
+  EXPECT_GT(peak, 0.02);  // the wind did bend the tree
+  EXPECT_LT(max_displacement(state, model), 1e-3);
+  EXPECT_LT(state.velocities.colwise().norm().maxCoeff(), 1e-2);
+}
+
+TEST(Behaviour, ThinBranchesMoveMoreThanThickOnes) {
+  const TreeModel model = grown_tree(6, 0, 2);
+  WindOptions wind;
+  wind.keys = {{0, 8, {1, 0, 0.3}, 2}};
+  SimOptions options;
+  Simulator sim(model, options, wind, 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  const size_t C = model.cluster_count();
+  std::vector<double> peak(C, 0);
+  for (int f = 1; f <= 24 * 4; ++f) {
+    sim.advance_frame(state, f);
+    for (size_t c = 0; c < C; ++c)
+      for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
+        const uint32_t v = model.cluster_members[s];
+        peak[c] = std::max(peak[c], (state.positions.col(v) - model.rest_positions.col(v)).norm());
+      }
+  }
+  // Branch clusters sorted by radius, split in four classes: the mean peak displacement of
+  // each class is below the thinner class's.
+  std::vector<size_t> branches;
+  for (size_t c = 0; c < C; ++c)
+    if (model.cluster_kind[c] == kClusterBranch) branches.push_back(c);
+  std::sort(branches.begin(), branches.end(),
+            [&](size_t a, size_t b) { return model.cluster_radius[a] < model.cluster_radius[b]; });
+  ASSERT_GE(branches.size(), 40u);
+  double previous = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    double sum = 0;
+    const size_t lo = branches.size() * k / 4, hi = branches.size() * (k + 1) / 4;
+    for (size_t i = lo; i < hi; ++i) sum += peak[branches[i]];
+    const double mean = sum / double(hi - lo);
+    EXPECT_LT(mean, previous) << "radius class " << k << " (radius up to " << model.cluster_radius[branches[hi - 1]]
+                              << " m)";
+    previous = mean;
+  }
+}
+
+TEST(Behaviour, ThickBranchesAreStifferAndHeavier) {
+  const TreeModel model = grown_tree(6, 0, 2);
+  const StepRates rates = compute_step_rates(model, SimOptions{}, 1.0 / 96);
+  // Parent clusters are thicker than their children: heavier per length, and the limb
+  // holding a child sways no faster than the one holding its parent.
+  size_t checked = 0;
+  for (size_t c = 0; c < model.cluster_count(); ++c) {
+    const int32_t p = model.cluster_parent[c];
+    if (p < 0 || model.cluster_kind[c] != kClusterBranch) continue;
+    EXPECT_LE(rates.cluster_limb_frequency[c], rates.cluster_limb_frequency[p]);
+    if (model.cluster_radius[p] > 1.5 * model.cluster_radius[c]) {
+      EXPECT_GT(model.cluster_mass[p] / model.cluster_length[p], model.cluster_mass[c] / model.cluster_length[c]);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 10u);
+}
+
+TEST(Behaviour, DetachedLeavesFallAndNeverComeBack) {
+  const TreeModel model = testing::small_tree(6);
+  SimOptions options;
+  options.leaf_detach_force = 0.55;  // N: a 6 cm leaf lets go in the strongest gusts
+  Simulator sim(model, options, gust_then_calm(20, 1.0, 1.2), 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  std::vector<uint8_t> attached = state.leaf_attached;
+  std::vector<double> height_when_free(model.leaf_count(), 0);
+  for (int f = 1; f <= 24 * 4; ++f) {
+    sim.advance_frame(state, f);
+    for (size_t l = 0; l < model.leaf_count(); ++l) {
+      ASSERT_LE(state.leaf_attached[l], attached[l]) << "leaf " << l << " re-attached at frame " << f;
+      if (attached[l] && !state.leaf_attached[l])
+        height_when_free[l] = state.positions(1, model.leaf_attachment_vertex[l]);
+    }
+    attached = state.leaf_attached;
+  }
+  size_t detached = 0;
+  for (size_t l = 0; l < model.leaf_count(); ++l) {
+    if (state.leaf_attached[l]) continue;
+    ++detached;
+    // Three seconds after the gust a free leaf has fallen well below where it let go, and
+    // far from its branch.
+    const uint32_t v = model.leaf_attachment_vertex[l];
+    EXPECT_LT(state.positions(1, v), height_when_free[l] - 1.0) << "leaf " << l;
+    EXPECT_GT((state.positions.col(v) - model.rest_positions.col(v)).norm(), 1.0) << "leaf " << l;
+    // Still a rigid leaf: its side keeps its length.
+    const uint32_t c = model.leaf_cluster[l], a = model.cluster_members[model.cluster_offsets[c]],
+                   b = model.cluster_members[model.cluster_offsets[c] + 1];
+    EXPECT_NEAR((state.positions.col(a) - state.positions.col(b)).norm(),
+                (model.rest_positions.col(a) - model.rest_positions.col(b)).norm(), 1e-3);
+  }
+  EXPECT_GT(detached, 0u);
+  EXPECT_LT(detached, model.leaf_count());  // the weakest gusts leave some leaves on
+}
+
+TEST(Behaviour, NoDetachmentByDefault) {
+  const TreeModel model = testing::small_tree(6);
+  Simulator sim(model, SimOptions{}, gust_then_calm(40, 2, 2.5), 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  for (int f = 1; f <= 48; ++f) sim.advance_frame(state, f);
+  for (uint8_t a : state.leaf_attached) EXPECT_EQ(a, 1);
+}
+
+TEST(Behaviour, SleepingBakeMatchesTheFullBake) {
+  const TreeModel model = grown_tree(5, 2, 4);
+  const WindOptions wind = gust_then_calm(10, 2, 2.5);
+  SimOptions awake;
+  awake.sleep = false;
+  Simulator full(model, awake, wind, 1.0 / 24, 4);
+  Simulator sleeping(model, SimOptions{}, wind, 1.0 / 24, 4);
+  SimState a = full.initial_state(0), b = sleeping.initial_state(0);
+  double worst = 0;
+  for (int f = 1; f <= 24 * 20; ++f) {
+    full.advance_frame(a, f);
+    sleeping.advance_frame(b, f);
+    worst = std::max(worst, (a.positions - b.positions).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-5);
+  for (uint8_t asleep : b.island_asleep) EXPECT_EQ(asleep, 1);
+  EXPECT_EQ(b.positions, model.rest_positions);  // put to sleep exactly at rest
+  // ... and woken by the next wind.
+  WindOptions again = wind;
+  again.keys.push_back({25, 10, {1, 0, 0}, 0});
+  Simulator woken(model, SimOptions{}, again, 1.0 / 24, 4);
+  b.time = 25;
+  woken.advance_frame(b, 24 * 25 + 1);
+  EXPECT_EQ(b.island_asleep[0], 0);
+  EXPECT_GT(max_displacement(b, model), 0);
+}
+
+TEST(Behaviour, IdenticalBytesFor1And2And4Threads) {
+  const TreeModel model = grown_tree(7, 2, 2);
+  ASSERT_GE(model.membership_count(), 4096u);  // large enough to run in parallel
+  WindOptions wind = gust_then_calm(18, 1, 1.5);
+  SimOptions options;
+  options.leaf_detach_force = 0.01;
+  std::vector<SimState> results;
+  const int saved = omp_get_max_threads();
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    Simulator sim(model, options, wind, 1.0 / 24, 3);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 36; ++f) sim.advance_frame(state, f);
+    results.push_back(state);
+  }
+  omp_set_num_threads(saved);
+  for (size_t k = 1; k < results.size(); ++k) {
+    EXPECT_EQ(std::memcmp(results[0].positions.data(), results[k].positions.data(),
+                          sizeof(double) * results[0].positions.size()), 0);
+    EXPECT_EQ(std::memcmp(results[0].velocities.data(), results[k].velocities.data(),
+                          sizeof(double) * results[0].velocities.size()), 0);
+    EXPECT_EQ(results[0].leaf_attached, results[k].leaf_attached);
+  }
+  size_t detached = 0;
+  for (uint8_t a : results[0].leaf_attached) detached += a == 0;
+  EXPECT_GT(detached, 0u);  // the detachment path ran too
+}
+
+// Final positions after 1.5 s of a rising wind, at 4, 8, 16 and 32 substeps per frame =>
+// (largest difference to the 32-substep result, largest displacement of that result).
+std::pair<double, double> substep_spread(const TreeModel& model, const SimOptions& options) {
+  WindOptions wind;
+  wind.keys = {{0, 0, {1, 0, 0}, 0}, {0.5, 20, {1, 0, 0}, 0}};
+  wind.turbulence_intensity = 0;
+  std::vector<Eigen::Matrix3Xd> finals;
+  for (int substeps : {4, 8, 16, 32}) {
+    Simulator sim(model, options, wind, 1.0 / 24, substeps);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 36; ++f) sim.advance_frame(state, f);
+    finals.push_back(state.positions);
+  }
+  double spread = 0;
+  for (size_t k = 0; k + 1 < finals.size(); ++k)
+    spread = std::max(spread, (finals[k] - finals.back()).colwise().norm().maxCoeff());
+  return {spread, (finals.back() - model.rest_positions).colwise().norm().maxCoeff()};
+}
+
+TEST(Behaviour, SubstepCountDoesNotChangeThePhysicalMotion) {
+  // Physical stiffness: the same motion at 4 to 32 substeps (within 5% of the sway). The
+  // paper's per-step rates make the tree stiffer with every doubling instead (> 30%).
+  const TreeModel model = grown_tree(5, 0, 4);
+  const auto [physical_spread, physical_sway] = substep_spread(model, SimOptions{});
+  EXPECT_GT(physical_sway, 0.005);
+  EXPECT_LT(physical_spread, 0.05 * physical_sway);
+  SimOptions per_step;
+  per_step.stiffness = StiffnessMode::kPerStep;
+  const auto [paper_spread, paper_sway] = substep_spread(model, per_step);
+  EXPECT_GT(paper_spread, 0.3 * paper_sway);
+}
+
+}  // namespace
+}  // namespace treeanim
