@@ -42,7 +42,8 @@ std::string Range::describe() const {
 }
 
 std::string describe_json(const Json& value) {
-  std::string text = value.dump();
+  // replace: a message must never throw, even for a string that is not UTF-8.
+  std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
   if (text.size() > 60) text = text.substr(0, 57) + "...";
   return text;
 }

@@ -2,6 +2,9 @@
 // writer thread behind a bounded queue, so the bake takes about max(simulation, slowest sink).
 #include "io/outputs.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -19,6 +22,12 @@ namespace treeanim {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Nice increment of writer threads (Linux: per thread). When the solver's OpenMP threads
+// already use every core, a writer that preempts one of them stalls the whole team at its next
+// barrier; niced, the writer runs in the gaps and only takes a core when its queue is full
+// and the solver is waiting anyway.
+constexpr int kWriterNice = 5;
 
 // Frames a sink may lag behind the solver. Enough to absorb a slow frame (a compressed chunk,
 // a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
@@ -49,6 +58,7 @@ struct Worker {
 
   // Writer thread: writes queued frames in order until closed, stopped or failed.
   void run() {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWriterNice);  // best effort
     for (;;) {
       std::shared_ptr<const FrameData> frame;
       {

@@ -66,6 +66,13 @@ Json parse_scene_json(const std::string& text, const std::string& name) {
 }
 
 void apply_override(Json& document, const std::string& assignment) {
+  // The file's strings were checked by the JSON parser; command-line bytes were not, and the
+  // resolved scene (written into every output) must stay valid JSON text.
+  try {
+    (void)Json(assignment).dump();
+  } catch (const nlohmann::json::type_error&) {
+    throw InputError("--set " + describe_json(Json(assignment)) + ": not valid UTF-8 text");
+  }
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0)
     throw InputError("--set '" + assignment + "': expected PATH=VALUE, e.g. lsystem.iterations=6");

@@ -58,7 +58,7 @@ struct Simulator::Impl {
   std::vector<double> member_match_weight; // (M) 1/m^2: w / sum(w |q|^2), A_pq normalised to order 1
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
-  Eigen::Matrix3Xd member_correction;      // (3 x M) m, alpha_c (g - x) of the current step
+  Eigen::Matrix3Xd member_correction;      // (3 x M) m, alpha_c (g - p) of the current step
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
@@ -90,9 +90,10 @@ struct Simulator::Impl {
   std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
   std::vector<uint32_t> island_vertices;        // non-anchored vertices, ascending per island
 
+  std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
+
   // --- leaves ---
   std::vector<uint8_t> applied_attached;  // (L) detachments already applied to the arrays above
-  std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
   bool detach_enabled;
   // Threads only pay off above a few thousand memberships; below, the fork/join costs more
   // than the work (results are identical either way).
@@ -361,7 +362,10 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t v = first; v < last; ++v) {
-      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) continue;  // anchors hold
+      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {  // anchors hold where they are
+        if (!correct) predicted.col(v) = state.positions.col(v);
+        continue;
+      }
       const bool flying = vertex_flying[v];
       if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
       Eigen::Vector3d x, velocity;

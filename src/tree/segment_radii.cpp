@@ -99,7 +99,7 @@ void segment_radii(const Skeleton& skeleton, const SegmentTopology& topology,
   model.segment_radius_top.resize(S);
   for (size_t s = 0; s < S; ++s) {
     const double w = skeleton.segment_width[s];
-    const double r = std::isnan(w) ? pipe[s] : 0.5 * w * options.scale;
+    const double r = std::isnan(w) ? pipe[s] : 0.5 * w * options.scale * options.width_scale;
     model.segment_radius_base[s] = std::max(r, options.min_radius);
   }
   // The top of a segment is the base of its continuation, so an axis tapers without steps.

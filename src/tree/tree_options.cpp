@@ -25,6 +25,7 @@ static ClusterOptions read_cluster_options(SceneObject section) {
 TreeOptions read_tree_options(SceneObject section) {
   TreeOptions o;
   o.scale = section.number("scale", o.scale, Range::positive());
+  o.width_scale = section.number("width_scale", o.width_scale, Range::positive());
   o.ring_sides = int(section.integer("ring_sides", o.ring_sides, 3, 256));
   o.trunk_radius = section.number("trunk_radius", o.trunk_radius, Range::positive());
   o.min_radius = section.number("min_radius", o.min_radius, Range::positive());

@@ -24,6 +24,7 @@ struct ClusterOptions {
 
 struct TreeOptions {
   double scale = 1.0;          // metres per scene unit
+  double width_scale = 1.0;    // extra factor on '!' widths (ABOP's widths are line widths)
   int ring_sides = 8;          // vertices per branch ring
   double trunk_radius = 0.1;   // m, trunk base radius when the grammar sets no widths
   double min_radius = 0.002;   // m, no branch thinner

@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""Runs the bad-input corpus: tests/bad/cases.json => every case exits with its documented code
+r"""Runs the bad-input corpus: tests/bad/cases.json => every case exits with its documented code
 and names the problem on stderr; none crashes, hangs or reports an internal error.
 
 usage: bad_corpus.py TREEANIM CORPUS_DIR
-Each case runs in CORPUS_DIR (paths in its args are relative to it); "{tmp}" in an argument is
+Each case runs in CORPUS_DIR (paths in its args are relative to it; a lone surrogate such as
+\udcda in cases.json stands for the byte 0xDA, as os.fsencode maps it); "{tmp}" in an argument is
 replaced by a fresh empty folder, which must still be empty afterwards (a refused bake writes
 nothing).
 """

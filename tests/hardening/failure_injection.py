@@ -193,19 +193,33 @@ def module_cap_under_ulimit_v(bake):
     if asan_binary(bake.binary):
         print("skipped: AddressSanitizer reserves terabytes of address space; ulimit -v cannot apply")
         return SKIP
-    def preexec():
-        limit = 4000000 * 1024
-        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
     done = bake.run(24, ["--set", "lsystem.productions=[\"A(x) --> A(x)A(x)\"]",
-                         "--set", "lsystem.iterations=40"], preexec=preexec, timeout=300)
+                         "--set", "lsystem.iterations=40"], preexec=limit_address_space, timeout=300)
     expect(done, 2, "reached 20000002 modules, more than lsystem.max_modules = 20000000", bake.out)
 
 
 def glb_too_large(bake):
-    """A GLB cannot exceed 4 GiB: a bake whose animated GLB would is refused before simulating
-    (the 1 million frames would take minutes to simulate; the refusal takes milliseconds)."""
-    done = bake.run(1000000, timeout=60)
-    expect(done, 4, "over glTF's 4 GiB GLB limit; at most", bake.out)
+    """A GLB cannot exceed 4 GiB: a bake whose animated GLB would (100000 frames of 563
+    vertices, 31898 fit) is refused before simulating, naming the limit and what fits."""
+    done = bake.run(100000, timeout=120)
+    expect(done, 4, "over glTF's 4 GiB GLB limit; at most 31898 frames", bake.out)
+
+
+def glb_far_too_large_under_ulimit_v(bake):
+    """The largest bake a scene may ask for (time.frames = 10 million) is refused the same way
+    within 4 GB of address space: the size check itself must not need memory per frame."""
+    if asan_binary(bake.binary):
+        print("skipped: AddressSanitizer reserves terabytes of address space; ulimit -v cannot apply")
+        return SKIP
+    done = bake.run(10000000, ["--set", "outputs=[{\"format\": \"glb\", \"path\": \"tree.glb\"}]"],
+                    preexec=limit_address_space, timeout=120)
+    expect(done, 4, "over glTF's 4 GiB GLB limit", bake.out)
+
+
+def limit_address_space():
+    """preexec: ulimit -v 4000000 (KiB), a render-farm node's share of memory."""
+    limit = 4000000 * 1024
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 
 def asan_binary(path):
@@ -228,6 +242,7 @@ SCENARIOS = {
     "wind-file-deleted-mid-bake": wind_file_deleted_mid_bake,
     "module-cap-under-ulimit-v": module_cap_under_ulimit_v,
     "glb-too-large": glb_too_large,
+    "glb-far-too-large-under-ulimit-v": glb_far_too_large_under_ulimit_v,
 }
 
 

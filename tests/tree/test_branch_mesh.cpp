@@ -159,6 +159,19 @@ TEST(BranchRadii, WidthsGiveDiametersTimesScale) {
   EXPECT_NEAR(m.rest_positions.col(0).norm(), 0.2, 1e-12);
 }
 
+TEST(BranchRadii, WidthScaleMultipliesOnlyTheWidths) {
+  TreeOptions o;
+  o.scale = 2.0;
+  o.width_scale = 0.5;
+  const TreeModel m = build_tree_model(test::small_tree(), o);
+  EXPECT_DOUBLE_EQ(m.segment_radius_base[0], 0.1);
+  EXPECT_DOUBLE_EQ(m.segment_radius_base[3], 0.04);
+  // Lengths keep `scale` alone.
+  const TreeModel unscaled = build_tree_model(test::small_tree(), TreeOptions{});
+  EXPECT_DOUBLE_EQ((m.segment_end[0] - m.segment_start[0]).norm(),
+                   2.0 * (unscaled.segment_end[0] - unscaled.segment_start[0]).norm());
+}
+
 TEST(BranchRadii, PipeModelWithoutWidths) {
   // Trunk t0 => continuation t1 and two laterals; pipe exponent 2.5.
   SkeletonBuilder b;

@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""Stress runner of issue 7 (tests/stress/README.md).
+
+  run_stress.py --treeanim BIN case NAME...        cases of tests/stress/cases.json
+  run_stress.py --treeanim BIN ctest-cases          every case marked "ctest"
+  run_stress.py --treeanim BIN all-cases            every case
+  run_stress.py --treeanim BIN random N [--seed S]  N scenes of scripts/stress-scenes
+  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4
+
+A bake passes when treeanim exits 0 and its HDF5 holds only finite positions with every
+attached vertex closer to its rest position than twice the tree's size (the largest extent
+of the rest mesh's bounding box), or when it exits 3 naming the frame and leaves no bake
+behind (nothing non-finite is ever written). Prints one line per case; exit 1 on any failure.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300):
+    """One `treeanim run` => (exit code, stderr, seconds)."""
+    args = [binary, "run", scene, "-o", out_dir, "--quiet", *extra]
+    for key, value in sets.items():
+        args += ["--set", f"{key}={json.dumps(value)}"]
+    env = dict(os.environ)
+    if threads:
+        env["OMP_NUM_THREADS"] = str(threads)
+    start = time.perf_counter()
+    done = subprocess.run(args, env=env, capture_output=True, text=True, timeout=timeout)
+    return done.returncode, done.stderr.strip(), time.perf_counter() - start
+
+
+def check_bake(path):
+    """HDF5 bake => (None, summary) when finite and bounded, else (reason, summary)."""
+    with h5py.File(path, "r") as f:
+        rest = f["/mesh/rest_positions"][()].astype(np.float64)
+        positions = f["/frames/positions"]
+        attached = f["/frames/leaf_attached"][()] if "/frames/leaf_attached" in f else None
+        vertex_leaf = None
+        if attached is not None:
+            # Vertices of each leaf cluster: a detached leaf flies off, it is not bounded.
+            offsets, members, kind = (f["/model/cluster_offsets"][()], f["/model/cluster_members"][()],
+                                      f["/model/cluster_kind"][()])
+            vertex_leaf = np.full(rest.shape[0], -1)
+            leaf = 0
+            for c in range(len(kind)):
+                if kind[c] == 1:
+                    vertex_leaf[members[offsets[c]:offsets[c + 1]]] = leaf
+                    leaf += 1
+        size = float((rest.max(axis=0) - rest.min(axis=0)).max())
+        worst, frames = 0.0, positions.shape[0]
+        for k in range(frames):  # frame by frame: long bakes need not fit in memory
+            x = positions[k].astype(np.float64)
+            if not np.isfinite(x).all():
+                return f"frame index {k}: non-finite position written", ""
+            d = np.linalg.norm(x - rest, axis=1)
+            if vertex_leaf is not None:
+                flying = (vertex_leaf >= 0) & (attached[k][np.maximum(vertex_leaf, 0)] == 0)
+                d[flying] = 0
+            worst = max(worst, float(d.max()))
+    summary = f"{frames} frames, max displacement {worst:.3g} m of size {size:.3g} m"
+    if not worst < 2 * size:
+        return f"displacement {worst:.3g} m >= 2 x tree size {size:.3g} m", summary
+    return None, summary
+
+
+def judge(code, stderr, out_dir, h5_name):
+    """Exit code, stderr, output folder => (passed, text)."""
+    path = os.path.join(out_dir, h5_name)
+    if code == 0:
+        reason, summary = check_bake(path)
+        return (reason is None), (summary if reason is None else reason)
+    last = stderr.splitlines()[-1] if stderr else ""
+    if code == 3:
+        leftovers = [n for n in os.listdir(out_dir) if n.endswith(".h5") or ".h5." in n]
+        if leftovers:
+            return False, f"exit 3 but left {leftovers} behind: {last}"
+        if "frame" not in stderr:
+            return False, f"exit 3 without naming the frame: {last}"
+        return True, f"stopped with exit 3: {last}"
+    return False, f"exit {code}: {last}"
+
+
+def kinetic_energy(path):
+    """Bake with velocities => per-frame kinetic energy (J) and max displacement (m)."""
+    with h5py.File(path, "r") as f:
+        mass = f["/model/mass"][()] * (1 - f["/model/anchored"][()])
+        v = f["/frames/velocities"][()].astype(np.float64)
+        x = f["/frames/positions"][()].astype(np.float64)
+        rest = f["/mesh/rest_positions"][()].astype(np.float64)
+    energy = 0.5 * np.einsum("fnk,fnk,n->f", v, v, mass)
+    return energy, np.linalg.norm(x - rest[None], axis=2).max(axis=1)
+
+
+def run_million(binary, case, tmp):
+    """1,000,000 steps: the last `window` frames against the first `window` (same run's prefix):
+    kinetic energy and displacement must stay within 2x of the first window's maxima."""
+    m = case["million"]
+    scene = os.path.join(HERE, case["scene"])
+    sets = dict(case.get("set", {}), **{"time.fps": m["fps"], "time.substeps": m["substeps"],
+                                        "outputs": [{"format": "hdf5", "path": "out.h5", "velocities": True}]})
+    w = m["window"]
+    code, err, _ = treeanim(binary, scene, tmp, dict(sets, **{"time.frames": w}), timeout=case.get("timeout", 300))
+    if code != 0:
+        return False, f"first window: exit {code}: {err}"
+    e0, d0 = kinetic_energy(os.path.join(tmp, "out.h5"))
+    last = m["frames"] - 1
+    code, err, _ = treeanim(binary, scene, tmp, dict(sets, **{"time.frames": m["frames"]}),
+                            extra=["--frames", f"{last - w + 1}:{last}"], timeout=case.get("timeout", 300))
+    passed, text = judge(code, err, tmp, "out.h5")
+    if not passed or code != 0:
+        return passed, text
+    e1, d1 = kinetic_energy(os.path.join(tmp, "out.h5"))
+    steps = (m["frames"] - 1) * m["substeps"]
+    text = (f"{steps} steps: kinetic energy max {e0.max():.3g} J (first {w} frames) vs {e1.max():.3g} J (last {w}), "
+            f"displacement {d0.max():.3g} vs {d1.max():.3g} m")
+    bounded = e1.max() <= 2 * e0.max() and d1.max() <= 2 * d0.max()
+    return bounded, text if bounded else "energy grew: " + text
+
+
+def run_case(binary, case):
+    with tempfile.TemporaryDirectory(prefix="stress-") as tmp:
+        if "million" in case:
+            return run_million(binary, case, tmp)
+        sets = dict(case.get("set", {}), outputs=[{"format": "hdf5", "path": "out.h5"}])
+        code, err, _ = treeanim(binary, os.path.join(HERE, case["scene"]), tmp, sets, timeout=case.get("timeout", 300))
+        return judge(code, err, tmp, "out.h5")
+
+
+def run_random(binary, count, seed):
+    """`count` generated scenes => list of failures."""
+    failures = []
+    with tempfile.TemporaryDirectory(prefix="stress-random-") as tmp:
+        scenes = os.path.join(tmp, "scenes")
+        subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "stress-scenes"), "--seed", str(seed),
+                        "--count", str(count), "--out", scenes], check=True)
+        for name in sorted(os.listdir(scenes)):
+            out = os.path.join(tmp, "out", name)
+            os.makedirs(out)
+            code, err, seconds = treeanim(binary, os.path.join(scenes, name), out, {})
+            passed, text = judge(code, err, out, "out.h5")
+            report(f"random/{name}", passed, f"{text} ({seconds:.1f} s)")
+            if not passed:
+                failures.append(name)
+    return failures
+
+
+def run_determinism(binary):
+    """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, at 1, 2 and 4 threads."""
+    digests = {}
+    with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
+        sets = {"time.frames": 8, "outputs": [{"format": "hdf5", "path": "out.h5"}],
+                "wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
+                "hsm.leaf_detach_force": 0.3}
+        for threads in (1, 2, 4):
+            code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets, threads=threads)
+            if code != 0:
+                return False, f"OMP_NUM_THREADS={threads}: exit {code}: {err}"
+            with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
+                digests[threads] = f["/frames/positions"][()].tobytes()
+    same = digests[1] == digests[2] == digests[4]
+    return same, ("identical" if same else "DIFFERENT") + f" /frames/positions ({len(digests[1])} bytes) for 1, 2, 4 threads"
+
+
+def report(name, passed, text):
+    print(f"{'PASS' if passed else 'FAIL'} {name}: {text}", flush=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--treeanim", required=True)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("what", choices=["case", "ctest-cases", "all-cases", "random", "determinism"])
+    parser.add_argument("args", nargs="*")
+    a = parser.parse_args()
+    with open(os.path.join(HERE, "cases.json")) as f:
+        cases = json.load(f)["cases"]
+    failures = []
+    if a.what == "random":
+        failures = run_random(a.treeanim, int(a.args[0]) if a.args else 20, a.seed)
+    elif a.what == "determinism":
+        passed, text = run_determinism(a.treeanim)
+        report("determinism", passed, text)
+        failures = [] if passed else ["determinism"]
+    else:
+        if a.what == "case":
+            unknown = set(a.args) - {c["name"] for c in cases}
+            if unknown:
+                sys.exit(f"unknown case(s): {sorted(unknown)}")
+        chosen = [c for c in cases if (a.what == "all-cases") or (a.what == "ctest-cases" and c.get("ctest"))
+                  or (a.what == "case" and c["name"] in a.args)]
+        for case in chosen:
+            start = time.perf_counter()
+            passed, text = run_case(a.treeanim, case)
+            report(case["name"], passed, f"{text} ({time.perf_counter() - start:.1f} s)")
+            if not passed:
+                failures.append(case["name"])
+    if failures:
+        print(f"{len(failures)} failed: {' '.join(failures)}")
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
