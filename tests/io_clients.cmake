@@ -49,3 +49,9 @@ io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --p
 add_test(NAME io_cli_unwritable_output
          COMMAND sh -c "message=$('$<TARGET_FILE:treeanim>' run '${io_scene}' -o /proc/treeanim-out --quiet 2>&1); code=$?; echo \"$message\"; test $code -eq 4 && echo \"$message\" | grep -q '/proc/treeanim-out/small_tree.h5: cannot create the folder'")
 set_tests_properties(io_cli_unwritable_output PROPERTIES LABELS "io;clients")
+
+# SIGINT in the middle of a bake: exit 130 and not one file left (folders made by the checks stay).
+set(io_sigint_dir ${CMAKE_BINARY_DIR}/io_sigint)
+add_test(NAME io_cli_sigint_leaves_nothing
+         COMMAND sh -c "rm -rf '${io_sigint_dir}'; '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_sigint_dir}' --quiet --set time.frames=200000 --set 'outputs=[{\"format\":\"hdf5\",\"path\":\"bake.h5\"},{\"format\":\"obj\",\"path\":\"obj/tree\"},{\"format\":\"pc2\",\"path\":\"tree.pc2\"}]' & pid=$!; sleep 2; kill -INT $pid; wait $pid; code=$?; left=$(find '${io_sigint_dir}' -type f); echo \"exit $code, files left: $left\"; test $code -eq 130 && test -z \"$left\"")
+set_tests_properties(io_cli_sigint_leaves_nothing PROPERTIES LABELS "io;clients" TIMEOUT 60)

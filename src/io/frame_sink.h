@@ -3,8 +3,8 @@
 // selected frame in order (on the sink's own writer thread), then finish() and, once every
 // sink finished, commit(); or abort() at any point.
 // Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
-#include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,14 +28,11 @@ struct FrameSelection {
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  // Every file the sink will create, final names (checked and de-duplicated before simulating).
-  virtual std::vector<std::filesystem::path> targets() const = 0;
+  // Calls `visit` with every file the sink will create, final names (checked and de-duplicated
+  // before simulating), one at a time: a long sequence needs no list of its names.
+  virtual void for_each_target(const std::function<void(const std::filesystem::path&)>& visit) const = 0;
   // The files named in the run's summary (a sequence's first frame stands for the rest).
-  virtual std::vector<std::filesystem::path> summary_paths() const {
-    std::vector<std::filesystem::path> paths = targets();
-    paths.resize(std::min<size_t>(paths.size(), 1));
-    return paths;
-  }
+  virtual std::vector<std::filesystem::path> summary_paths() const = 0;
   // Opens the temporaries and writes what does not change over frames.
   virtual void begin() = 0;
   // Appends one selected frame. Throws OutputError naming the path.

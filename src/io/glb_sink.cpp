@@ -150,29 +150,72 @@ std::vector<std::string> target_names(const FrameSelection& selection) {
   return names;
 }
 
-GlbContent placeholder_content(const TreeModel& model, const BakeInfo& info, const FrameSelection& selection) {
+// The JSON with every number at its longest, for `frames` frames named as in `names`.
+GlbContent placeholder_content(const TreeModel& model, const std::string& generator, size_t frames,
+                               std::vector<std::string> names) {
   GlbContent content;
   content.vertices = model.vertex_count();
   content.triangles = model.triangle_count();
-  content.frames = size_t(selection.written());
-  content.generator = info.generator;
-  content.target_names = target_names(selection);
+  content.frames = frames;
+  content.generator = generator;
+  content.target_names = std::move(names);
   content.placeholder = true;
   return content;
 }
 
-uint64_t glb_bytes(size_t json_bytes, const GlbContent& c) {
-  return 12 + 8 + json_bytes + 8 + bin_bytes(c.vertices, c.triangles, c.frames);
-}
+// An upper bound of the GLB's bytes for any frame count, in O(1) time and memory (a scene may ask
+// for 10 million frames): the JSON of one frame rendered at its longest, plus the longest text
+// each further frame adds, plus room for the few totals whose digits grow with the frame count.
+class GlbSizeBound {
+ public:
+  GlbSizeBound(const TreeModel& model, const std::string& generator)
+      : vertices_(model.vertex_count()), triangles_(model.triangle_count()) {
+    using nlohmann::json;
+    constexpr uint64_t kMax = std::numeric_limits<uint64_t>::max();
+    constexpr double kLongest = -1.7976931348623157e308;
+    const json longest3 = {kLongest, kLongest, kLongest};
+    const json accessor = {{"bufferView", 3}, {"byteOffset", kMax}, {"componentType", kFloat}, {"count", kMax},
+                           {"type", "VEC3"}, {"min", longest3}, {"max", longest3}};
+    const json target = {{"POSITION", kMax}};
+    const json name = "frame_-9223372036854775808";
+    per_frame_json_ = accessor.dump().size() + target.dump().size() + name.dump().size() + json(0.0).dump().size() + 4;
+    no_frame_json_ = render_json(placeholder_content(model, generator, 0, {})).size();
+    one_frame_json_ = render_json(placeholder_content(model, generator, 1, {name.get<std::string>()})).size();
+  }
+
+  uint64_t bytes(uint64_t frames) const {
+    // Totals that grow with the frame count: view and buffer lengths and offsets, counts.
+    constexpr uint64_t kGrowingDigits = 16 * 20;
+    const uint64_t json = frames == 0 ? no_frame_json_ : one_frame_json_ + (frames - 1) * per_frame_json_ + kGrowingDigits;
+    return glb_bytes(json + 3, bin_bytes(vertices_, triangles_, frames));
+  }
+
+  // The largest frame count (written frames) whose GLB fits in `limit` bytes.
+  uint64_t frames_within(uint64_t limit) const {
+    uint64_t fits = 0, too_many = uint64_t(1) << 32;  // 4 F^2 bytes of weights alone pass 4 GiB at 2^16
+    while (too_many - fits > 1) {
+      const uint64_t mid = fits + (too_many - fits) / 2;
+      (bytes(mid) <= limit ? fits : too_many) = mid;
+    }
+    return fits;
+  }
+
+  static uint64_t glb_bytes(uint64_t json_bytes, uint64_t bin) { return 12 + 8 + json_bytes + 8 + bin; }
+
+ private:
+  size_t vertices_, triangles_;
+  uint64_t per_frame_json_ = 0, no_frame_json_ = 0, one_frame_json_ = 0;
+};
 
 class GlbSink final : public FrameSink {
  public:
   GlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : path_(std::move(path)), model_(model),
         selection_{info.frame_start, info.frame_count, options.frame_step},
-        content_(placeholder_content(model, info, selection_)) {}
+        content_(placeholder_content(model, info.generator, size_t(selection_.written()), target_names(selection_))) {}
 
-  std::vector<fs::path> targets() const override { return {path_}; }
+  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
+  std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {
     reserved_json_ = render_json(content_).size();
@@ -226,7 +269,7 @@ class GlbSink final : public FrameSink {
     file_->seek(0);
     file_->write_u32_le(kGlbMagic);
     file_->write_u32_le(2);
-    file_->write_u32_le(uint32_t(glb_bytes(reserved_json_, content_)));
+    file_->write_u32_le(uint32_t(GlbSizeBound::glb_bytes(reserved_json_, bin_bytes(content_.vertices, content_.triangles, f))));
     file_->write_u32_le(uint32_t(reserved_json_));
     file_->write_u32_le(kChunkJson);
     file_->write(json);
@@ -257,28 +300,21 @@ class GlbSink final : public FrameSink {
 
 uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step) {
   const FrameSelection selection{info.frame_start, info.frame_count, frame_step};
-  const GlbContent content = placeholder_content(model, info, selection);
-  return glb_bytes(render_json(content).size(), content);
+  return GlbSizeBound(model, info.generator).bytes(uint64_t(selection.written()));
 }
 
 std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
-  const uint64_t bytes = animated_glb_bytes(model, info, options.frame_step);
+  const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
+  const GlbSizeBound bound(model, info.generator);
+  const uint64_t bytes = bound.bytes(uint64_t(selection.written()));
   if (bytes > kGlbMaxBytes) {
-    // The size grows with the frame count (quadratically through the one-hot weights).
-    long long fits = 0, too_many = info.frame_count;  // frame counts known to fit / not to fit
-    while (too_many - fits > 1) {
-      BakeInfo shorter = info;
-      shorter.frame_count = (fits + too_many) / 2;
-      (animated_glb_bytes(model, shorter, options.frame_step) <= kGlbMaxBytes ? fits : too_many) =
-          shorter.frame_count;
-    }
+    const uint64_t fits = bound.frames_within(kGlbMaxBytes);  // written frames
     char size[32];
     std::snprintf(size, sizeof size, "%.2f GiB", double(bytes) / double(1ull << 30));
     throw OutputError(path.string() + ": the animated GLB would be " + size + " (" +
-                      std::to_string(model.vertex_count()) + " vertices x " +
-                      std::to_string((info.frame_count + options.frame_step - 1) / options.frame_step) +
-                      " frames), over glTF's 4 GiB GLB limit; at most " + std::to_string(fits) +
+                      std::to_string(model.vertex_count()) + " vertices x " + std::to_string(selection.written()) +
+                      " frames), over glTF's 4 GiB GLB limit; at most " + std::to_string(fits * uint64_t(options.frame_step)) +
                       " frames of this bake fit at frame_step " + std::to_string(options.frame_step) +
                       " (raise frame_step, shorten the bake, or use hdf5/pc2)");
   }

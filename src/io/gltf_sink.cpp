@@ -61,11 +61,13 @@ class GltfSink final : public FrameSink {
       : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  std::vector<fs::path> targets() const override {
-    std::vector<fs::path> paths;
-    for (long long k = 0; k < selection_.written(); ++k)
-      paths.push_back(pattern_.frame(selection_.start + k * selection_.step));
-    return paths;
+  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
+    for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
+  }
+
+  std::vector<fs::path> summary_paths() const override {
+    if (selection_.written() == 0) return {};
+    return {pattern_.frame(selection_.start)};
   }
 
   void begin() override { scene_ = make_scene(model_); }

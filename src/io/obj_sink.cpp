@@ -18,11 +18,14 @@ class ObjSink final : public FrameSink {
       : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  std::vector<fs::path> targets() const override {
-    std::vector<fs::path> paths{pattern_.rest()};  // the rest mesh first, then the frames
-    for (long long k = 0; k < selection_.written(); ++k)
-      paths.push_back(pattern_.frame(selection_.start + k * selection_.step));
-    return paths;
+  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
+    visit(pattern_.rest());
+    for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
+  }
+
+  std::vector<fs::path> summary_paths() const override {
+    if (selection_.written() == 0) return {pattern_.rest()};
+    return {pattern_.rest(), pattern_.frame(selection_.start)};
   }
 
   void begin() override {
@@ -39,11 +42,6 @@ class ObjSink final : public FrameSink {
                    frame.positions, shared_);
   }
 
-  std::vector<fs::path> summary_paths() const override {
-    std::vector<fs::path> paths = targets();
-    paths.resize(std::min<size_t>(paths.size(), 2));  // the rest mesh and the first frame
-    return paths;
-  }
 
  private:
   SequencePattern pattern_;

@@ -23,8 +23,11 @@ class Pc2Sink final : public FrameSink {
         rest_(fs::path(path_).replace_extension(".rest.obj")), model_(model),
         info_(info), selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  std::vector<fs::path> targets() const override { return {path_, rest_}; }
-  std::vector<fs::path> summary_paths() const override { return targets(); }
+  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
+    visit(path_);
+    visit(rest_);
+  }
+  std::vector<fs::path> summary_paths() const override { return {path_, rest_}; }
 
   void begin() override {
     write_obj_file(staged_.stage(rest_), rest_, info_.generator + ", rest pose for " + path_.filename().string(),

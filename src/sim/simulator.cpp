@@ -58,7 +58,10 @@ struct Simulator::Impl {
   std::vector<double> member_match_weight; // (M) 1/m^2: w / sum(w |q|^2), A_pq normalised to order 1
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
-  Eigen::Matrix3Xd member_correction;      // (3 x M) m, alpha_c (g - p) of the current step
+  // (3 x M) m, alpha_c (g - p) of the current step. Float: a correction is a small move
+  // (its 1e-7 relative error is far below a micrometre) and this array is the largest
+  // stream of the step.
+  Eigen::Matrix3Xf member_correction;
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
@@ -68,7 +71,7 @@ struct Simulator::Impl {
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
   std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
   Eigen::Matrix3Xd cluster_air;            // (3 x C) m/s, air velocity at the cluster this step
-  Eigen::Matrix3Xd cluster_centre;         // (3 x C) m, centre t of the last fit
+  Eigen::Matrix3Xd cluster_shift;          // (3 x C) m, t - t0: the centre of the last fit from the rest centre
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of the last fit, column-major
   std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
   std::vector<uint32_t> cluster_pin_own_slot;  // (C) attached leaf: membership of the shared vertex in the leaf
@@ -83,7 +86,10 @@ struct Simulator::Impl {
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   Eigen::Matrix3Xd vertex_drag_force;      // (3 x V) N, drag of the last step; only with detachment
-  Eigen::Matrix3Xd predicted;              // (3 x V) m, p = x + h v* of the current step
+  // (3 x V) m, u = p - x0: the predicted position p = x + h v* of the current step as a
+  // displacement from rest. Small numbers wherever the tree stands, and x0 is not read
+  // again until the frame ends.
+  Eigen::Matrix3Xd predicted_offset;
 
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   size_t I = 0;
@@ -99,7 +105,9 @@ struct Simulator::Impl {
   // than the work (results are identical either way).
   bool parallel;
 
-  // --- per-step scratch (no allocation in the step) ---
+  // --- per-step scratch (no allocation in the step): the wind at the time being sampled ---
+  Eigen::Vector3d air_base = Eigen::Vector3d::Zero();  // m/s, mean wind + gust
+  double air_scale = 0;                                // m/s, turbulence amplitude
   double turbulence_sin_b[kMaxModes], turbulence_cos_b[kMaxModes];
 
   Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n);
@@ -110,13 +118,14 @@ struct Simulator::Impl {
   void detach_leaf(SimState& state, size_t leaf);
   void sync_detachments(SimState& state);
   void frame(SimState& state, long long frame_index);
-  void prepare_air(const SimState& state, double t);
+  void set_air_time(double t);
+  void sample_cluster_air(size_t c);
   bool all_resting(const SimState& state) const;
-  void sample_air(const SimState& state, const Eigen::Vector3d& base, double scale);
+  void sample_air(const SimState& state);
   void vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep);
-  bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre);
-  void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
-  void match_clusters(SimState& state, long long frame, int substep);
+  bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
+  void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
+  void match_clusters(SimState& state, bool next_air, long long frame, int substep);
   void precompute_pins();
   void check_detachments(SimState& state);
   void check_sleep(SimState& state, double t);
@@ -140,9 +149,9 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
   precompute_islands();
   island_fell_asleep.assign(I, 0);
   cluster_air.setZero(3, C);
-  cluster_centre = cluster_rest_centre;
+  cluster_shift.setZero(3, C);
   cluster_rotation_matrix.setZero(9, C);
-  predicted = model.rest_positions;
+  predicted_offset.setZero(3, V);
   precompute_pins();
   cluster_flying.assign(C, 0);
   vertex_flying.assign(V, 0);
@@ -328,29 +337,39 @@ void Simulator::Impl::sync_detachments(SimState& state) {
   }
 }
 
-// Wind at t => the air velocity at every awake cluster (at its rest centre; a flying leaf at
-// its centre of the last step).
-void Simulator::Impl::sample_air(const SimState& state, const Eigen::Vector3d& base, double scale) {
+// t => the wind terms shared by every cluster at t (base wind, turbulence amplitude and
+// temporal phases), for sample_cluster_air.
+void Simulator::Impl::set_air_time(double t) {
+  air_base = wind.base(t);
+  air_scale = wind.temporal_phases(t, turbulence_sin_b, turbulence_cos_b);
+}
+
+// Air velocity at cluster c (its rest centre; a flying leaf: its centre of the last fit).
+void Simulator::Impl::sample_cluster_air(size_t c) {
   const int N = wind.mode_count();
-#pragma omp parallel for schedule(static) if (parallel)
-  for (size_t c = 0; c < C; ++c) {
-    if (!cluster_awake(state, c)) continue;
-    if (cluster_flying[c]) {
-      double sin_a[kMaxModes], cos_a[kMaxModes];
-      wind.spatial_phases(cluster_centre.col(c), sin_a, cos_a);
-      cluster_air.col(c) = base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, scale);
-    } else {
-      cluster_air.col(c) = base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
-                                                  turbulence_sin_b, turbulence_cos_b, scale);
-    }
+  if (cluster_flying[c]) {
+    double sin_a[kMaxModes], cos_a[kMaxModes];
+    wind.spatial_phases(Eigen::Vector3d(cluster_rest_centre.col(c) + cluster_shift.col(c)), sin_a, cos_a);
+    cluster_air.col(c) = air_base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, air_scale);
+  } else {
+    cluster_air.col(c) = air_base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
+                                                    turbulence_sin_b, turbulence_cos_b, air_scale);
   }
 }
 
-// The per-vertex pass. `correct`: finish the current step from the predicted state
-// (averaged corrections, Eq. 7); `predict`: start the next step (damping, drag, gravity,
-// global term Eq. 8) into v* (state.velocities) and p = x + h v* (`predicted`). Fused, so a
-// vertex is loaded once per substep; the positions are written to the state only when a
-// step ends without a next prediction (the end of a frame).
+// Air velocity of every awake cluster (at the start of a frame; later steps sample it in
+// match_clusters, saving a parallel region per step).
+void Simulator::Impl::sample_air(const SimState& state) {
+#pragma omp parallel for schedule(static) if (parallel)
+  for (size_t c = 0; c < C; ++c)
+    if (cluster_awake(state, c)) sample_cluster_air(c);
+}
+
+// The per-vertex pass, in displacements from rest (u = x - x0). `correct`: finish the
+// current step from the predicted state (averaged corrections, Eq. 7); `predict`: start the
+// next step (damping, drag, gravity, global term Eq. 8, which is -k u / h) into v*
+// (state.velocities) and u_p = u + h v* (`predicted_offset`). Fused, so a vertex is loaded
+// once per substep; positions are read at the first step of a frame and written at the last.
 void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep) {
   const Eigen::Vector3d gravity_step = options.gravity * h;
   const double inv_h = 1.0 / h;
@@ -363,25 +382,26 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t v = first; v < last; ++v) {
       if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {  // anchors hold where they are
-        if (!correct) predicted.col(v) = state.positions.col(v);
+        if (!correct) predicted_offset.col(v) = state.positions.col(v) - model.rest_positions.col(v);
         continue;
       }
       const bool flying = vertex_flying[v];
       if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
-      Eigen::Vector3d x, velocity;
+      Eigen::Vector3d u, velocity;
       if (correct) {
         // Average of the goals of the vertex's clusters, in membership order (never the sum).
         Eigen::Vector3d pull = Eigen::Vector3d::Zero();
         for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
-          pull += member_correction.col(model.vertex_memberships[s]);
+          pull += member_correction.col(model.vertex_memberships[s]).cast<double>();
         pull *= vertex_inv_count[v];
-        x = predicted.col(v) + pull;
+        u = predicted_offset.col(v) + pull;
         velocity = state.velocities.col(v) + pull * inv_h;
       } else {
-        x = state.positions.col(v);
+        u = state.positions.col(v) - model.rest_positions.col(v);
         velocity = state.velocities.col(v);
       }
       if (!predict) {
+        const Eigen::Vector3d x = model.rest_positions.col(v) + u;
         if (!x.allFinite() || !velocity.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
         state.positions.col(v) = x;
         state.velocities.col(v) = velocity;
@@ -395,11 +415,11 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
       const Eigen::Vector3d drag_dv = relative * (kuh / (1 + kuh));
       Eigen::Vector3d next = velocity * vertex_damping[v] + drag_dv;
       if (flying) next += gravity_step;
-      else next += (vertex_global[v] * inv_h) * (model.rest_positions.col(v) - x);
-      const Eigen::Vector3d ahead = x + h * next;
+      else next -= (vertex_global[v] * inv_h) * u;
+      const Eigen::Vector3d ahead = u + h * next;
       if (!ahead.allFinite() || !next.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
       state.velocities.col(v) = next;
-      predicted.col(v) = ahead;
+      predicted_offset.col(v) = ahead;
       if (detach_enabled) vertex_drag_force.col(v) = drag_dv * (model.vertex_mass[v] * inv_h);
     }
   }
@@ -409,85 +429,87 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
                           "): non-finite position or velocity");
 }
 
-// Shape match of cluster c on the predicted positions => its rotation (warm start updated),
-// centre and R; false when a value is not finite.
-bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& centre) {
+// Shape match of cluster c on the predicted positions => its rotation R (warm start
+// updated) and its centre as t - t0; false when a value is not finite.
+bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
-  const Eigen::Vector3d t0 = cluster_rest_centre.col(c);
-  // Cluster-local coordinates: d = p - t0 is small wherever the tree stands. One pass sums
-  // the centre shift and A' = sum s d q^T; then A_pq = sum s (d - shift) q^T
-  // = A' - shift (sum s q)^T. sum s q is 0 in exact arithmetic, but its round-off times the
-  // cluster's travel would tilt R (10^-6 rad for a tree 5 km from the origin), so its
-  // computed value is subtracted. Each entry is summed as s (d_i q_j), so that A is exactly
-  // symmetric at the rest pose (R = I exactly there).
-  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
+  // numbers wherever the tree stands and however far it travelled. One pass sums the centre
+  // shift and A' = sum s d q^T; A_pq = sum s (d - shift) q^T = A' - shift (sum s q)^T, with
+  // the computed sum s q (0 but for round-off). Each entry is summed as s (d_i q_j), so
+  // that A is exactly symmetric at the rest pose (R = I exactly there).
+  shift.setZero();
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d d = predicted.col(model.cluster_members[s]) - t0;
     const Eigen::Vector3d q = member_offset.col(s);
+    const Eigen::Vector3d d = predicted_offset.col(model.cluster_members[s]) + q;
     shift += member_centre_weight[s] * d;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) A(i, j) += member_match_weight[s] * (d[i] * q[j]);
   }
   A -= shift * cluster_offset_sum.col(c).transpose();
-  centre = t0 + shift;
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
   extract_rotation(A, rotation, options.rotation_iterations);
   state.cluster_rotations.col(c) = rotation.coeffs();
   R = rotation.toRotationMatrix();
-  cluster_centre.col(c) = centre;
+  cluster_shift.col(c) = shift;
   Eigen::Map<Eigen::Matrix3d>(&cluster_rotation_matrix(0, c)) = R;
-  return R.allFinite() && centre.allFinite();
+  return R.allFinite() && shift.allFinite();
 }
 
-// Goals g = R q + t of cluster c => per-membership corrections alpha_c (g - p).
-void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+// Goals g = R q + t of cluster c, with t given as t - t0 => per-membership corrections
+// alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p).
+void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift) {
   const double alpha = cluster_alpha[c];
   for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
-    const Eigen::Vector3d goal = R * member_offset.col(s) + t;
-    member_correction.col(s) = member_active[s]
-                                   ? Eigen::Vector3d(alpha * (goal - predicted.col(model.cluster_members[s])))
-                                   : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d q = member_offset.col(s);
+    const Eigen::Vector3d move = (R * q - q) + shift - predicted_offset.col(model.cluster_members[s]);
+    member_correction.col(s) = member_active[s] ? Eigen::Vector3f((alpha * move).cast<float>())
+                                                : Eigen::Vector3f::Zero();
   }
 }
 
 // Predicted positions => corrections of every awake cluster: branches and free leaves first,
 // then the attached leaves, whose translation is pinned to their branch's goal for the shared
 // vertex (hierarchical: a 1 g leaf cannot drag its branch, nor drift off it in a gale).
-void Simulator::Impl::match_clusters(SimState& state, long long frame, int substep) {
+// With `next_air`, each cluster also samples the air of the next step (set_air_time).
+void Simulator::Impl::match_clusters(SimState& state, bool next_air, long long frame, int substep) {
   uint32_t bad = kNone;
 #pragma omp parallel if (parallel) reduction(min : bad)
   {
     const auto [first, last] = balanced_range(model.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t c = first; c < last; ++c) {
-      if (cluster_pin_slot[c] != kNone || !cluster_awake(state, c)) continue;
-      Eigen::Matrix3d R;
-      Eigen::Vector3d centre;
-      if (!fit_cluster(state, c, R, centre)) {
-        bad = std::min(bad, static_cast<uint32_t>(c));
-        continue;
+      if (!cluster_awake(state, c)) continue;
+      if (cluster_pin_slot[c] == kNone) {
+        Eigen::Matrix3d R;
+        Eigen::Vector3d shift;
+        if (fit_cluster(state, c, R, shift)) write_corrections(c, R, shift);
+        else bad = std::min(bad, static_cast<uint32_t>(c));
       }
-      write_corrections(c, R, centre);
+      if (next_air) sample_cluster_air(c);
     }
-  }
-  if (bad == kNone && !pinned_leaf_clusters.empty()) {
-#pragma omp parallel for schedule(static) if (parallel) reduction(min : bad)
-    for (size_t k = 0; k < pinned_leaf_clusters.size(); ++k) {
-      const uint32_t c = pinned_leaf_clusters[k];
-      if (cluster_pin_slot[c] == kNone || !cluster_awake(state, c)) continue;
-      Eigen::Matrix3d R;
-      Eigen::Vector3d centre;
-      if (!fit_cluster(state, c, R, centre)) {
-        bad = std::min(bad, c);
-        continue;
+    if (!pinned_leaf_clusters.empty()) {
+#pragma omp barrier
+#pragma omp for schedule(static)
+      for (size_t k = 0; k < pinned_leaf_clusters.size(); ++k) {
+        const uint32_t c = pinned_leaf_clusters[k];
+        if (cluster_pin_slot[c] == kNone || !cluster_awake(state, c)) continue;
+        Eigen::Matrix3d R;
+        Eigen::Vector3d shift;
+        if (!fit_cluster(state, c, R, shift)) {
+          bad = std::min(bad, c);
+          continue;
+        }
+        // The branch's goal for the shared vertex, t0_b + shift_b + R_b q_b, must be the
+        // leaf's goal for it, t + R q_own: so t - t0 = (t0_b - t0) + shift_b + R_b q_b - R q_own.
+        const uint32_t pin = cluster_pin_slot[c];
+        const uint32_t branch = member_cluster[pin];
+        const Eigen::Vector3d pinned =
+            (cluster_rest_centre.col(branch) - cluster_rest_centre.col(c)) + cluster_shift.col(branch) +
+            Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.col(pin) -
+            R * member_offset.col(cluster_pin_own_slot[c]);
+        write_corrections(c, R, pinned);
       }
-      // The branch's goal for the shared vertex, and the same vertex's offset in the leaf.
-      const uint32_t pin = cluster_pin_slot[c];
-      const uint32_t branch = member_cluster[pin];
-      const Eigen::Vector3d anchor =
-          Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.col(pin) +
-          cluster_centre.col(branch);
-      write_corrections(c, R, anchor - R * member_offset.col(cluster_pin_own_slot[c]));
     }
   }
   if (bad != kNone)
@@ -541,13 +563,6 @@ void Simulator::Impl::check_sleep(SimState& state, double t) {
   std::fill(island_fell_asleep.begin(), island_fell_asleep.end(), 0);
 }
 
-// Wind at t => air velocity of every awake cluster (scratch phases filled for t).
-void Simulator::Impl::prepare_air(const SimState& state, double t) {
-  const Eigen::Vector3d base = wind.base(t);
-  const double scale = wind.temporal_phases(t, turbulence_sin_b, turbulence_cos_b);
-  sample_air(state, base, scale);
-}
-
 // True when no island is awake and nothing flies: the frame costs nothing.
 bool Simulator::Impl::all_resting(const SimState& state) const {
   return std::all_of(state.island_asleep.begin(), state.island_asleep.end(), [](uint8_t a) { return a != 0; }) &&
@@ -565,13 +580,15 @@ void Simulator::Impl::frame(SimState& state, long long frame_index) {
     if (!calm) std::fill(state.island_asleep.begin(), state.island_asleep.end(), 0);
     if (all_resting(state)) return;
   }
-  prepare_air(state, start);
+  set_air_time(start);
+  sample_air(state);
   vertex_pass(state, false, true, frame_index, 0);
   if (detach_enabled) check_detachments(state);
   for (int k = 0; k < substeps; ++k) {
-    match_clusters(state, frame_index, k);
     const bool last = k + 1 == substeps;
-    if (!last) prepare_air(state, start + (k + 1) * h);
+    // The air of step k was used by its prediction, so the scratch can move on to k + 1.
+    if (!last) set_air_time(start + (k + 1) * h);
+    match_clusters(state, !last, frame_index, k);
     vertex_pass(state, true, !last, frame_index, k);
     if (!last && detach_enabled) check_detachments(state);
   }

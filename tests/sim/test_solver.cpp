@@ -94,7 +94,8 @@ TEST(Solver, AlphaOneLandsDeformedClusterOnGoals) {
   const Eigen::Matrix3Xd goals = reference_goals(model.rest_positions, model.vertex_mass, state.positions);
   ASSERT_GT((goals - state.positions).cwiseAbs().maxCoeff(), 1e-3);  // really deformed
   sim.advance_frame(state, 1);
-  EXPECT_LT((state.positions - goals).cwiseAbs().maxCoeff(), 1e-9);
+  // Corrections are stored as float (docs/solver.md): 1e-7 of a 2 cm move.
+  EXPECT_LT((state.positions - goals).cwiseAbs().maxCoeff(), 1e-8);
 }
 
 TEST(Solver, SharedVertexTakesTheAverageOfItsGoals) {

@@ -202,11 +202,13 @@ def main():
         for case in chosen:
             start = time.perf_counter()
             passed, text = run_case(a.treeanim, case)
+            if not passed and "defect" in case:
+                text += f" [known defect: {case['defect']}]"
             report(case["name"], passed, f"{text} ({time.perf_counter() - start:.1f} s)")
             if not passed:
-                failures.append(case["name"])
+                failures.append(case["name"] + (" (known defect)" if "defect" in case else ""))
     if failures:
-        print(f"{len(failures)} failed: {' '.join(failures)}")
+        print(f"{len(failures)} failed: {', '.join(failures)}")
     sys.exit(1 if failures else 0)
 
 
