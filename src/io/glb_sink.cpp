@@ -192,7 +192,8 @@ class GlbSizeBound {
 
   // The largest frame count (written frames) whose GLB fits in `limit` bytes.
   uint64_t frames_within(uint64_t limit) const {
-    uint64_t fits = 0, too_many = uint64_t(1) << 32;  // 4 F^2 bytes of weights alone pass 4 GiB at 2^16
+    // 4 F^2 bytes of weights alone pass 4 GiB from F = 2^15 on; 2^20 keeps bytes() far from overflow.
+    uint64_t fits = 0, too_many = uint64_t(1) << 20;
     while (too_many - fits > 1) {
       const uint64_t mid = fits + (too_many - fits) / 2;
       (bytes(mid) <= limit ? fits : too_many) = mid;

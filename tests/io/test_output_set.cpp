@@ -155,6 +155,11 @@ TEST_F(OutputSetTest, GlbOverFourGibIsRefusedWithTheFramesThatFit) {
   shorter.frame_count = fits + 1;
   EXPECT_GT(animated_glb_bytes(m, shorter, 1), kGlbMaxBytes);
   EXPECT_TRUE(entries().empty());
+  // The largest bake a scene may ask for is refused as fast, without memory per frame.
+  BakeInfo longest = info;
+  longest.frame_count = 10000000;
+  EXPECT_NE(output_error({output("glb", "anim.glb")}, dir_, m, longest).find("at most " + std::to_string(fits)),
+            std::string::npos);
   OutputOptions stepped = output("glb", "anim.glb", 2);  // half the frames fit
   EXPECT_NO_THROW(OutputSet(std::vector<OutputOptions>{stepped}, dir_, m, info));
 }
