@@ -1,5 +1,7 @@
 // OutputSet: targets checked before simulating, nothing left behind on abort or failure,
 // the GLB size limit refused early with the number of frames that would fit.
+#include <cstdio>
+
 #include "common/errors.h"
 #include "io/glb_size.h"
 #include "io_test_support.h"
