@@ -64,15 +64,19 @@ int main(int argc, char** argv) {
 
   std::filesystem::path info_scene;
   std::vector<std::string> info_overrides;
-  bool info_json = false;
+  bool info_json = false, info_resolved = false;
   CLI::App* info_app = app.add_subcommand("info", "Print counts (modules, segments, vertices, clusters) and estimates");
   info_app->add_option("scene", info_scene, "Scene file (JSON)")->required();
   info_app->add_option("--set", info_overrides, "Override a scene value: PATH=VALUE");
-  info_app->add_flag("--json", info_json, "Print one JSON object");
+  CLI::Option* json_flag = info_app->add_flag("--json", info_json, "Print one JSON object");
+  info_app->add_flag("--resolved-scene", info_resolved,
+                     "Print the scene with every default filled in (what outputs record)")
+      ->excludes(json_flag);
   info_app->footer(
       "Examples:\n"
       "  treeanim info configs/table1-13548.json\n"
-      "  treeanim info configs/demo.json --json | jq .mesh.vertices");
+      "  treeanim info configs/demo.json --json | jq .mesh.vertices\n"
+      "  treeanim info configs/demo.json --resolved-scene --set time.fps=30");
 
   try {
     app.parse(argc, argv);
@@ -87,7 +91,10 @@ int main(int argc, char** argv) {
       return run_command(run);
     }
     if (*validate_app) return validate_command(validate_scene, validate_overrides);
-    return info_command(info_scene, info_overrides, info_json);
+    return info_command(info_scene, info_overrides,
+                        info_resolved ? InfoFormat::kResolvedScene
+                        : info_json   ? InfoFormat::kJson
+                                      : InfoFormat::kText);
   } catch (const InputError& error) {
     return report("error: ", error, kExitInput);
   } catch (const SimulationError& error) {

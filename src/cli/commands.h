@@ -23,9 +23,10 @@ struct RunRequest {
 int run_command(const RunRequest& request);
 // Loads, derives and builds the model without simulating; prints counts.
 int validate_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides);
-// Prints counts and estimates, as text or as one JSON object.
+enum class InfoFormat { kText, kJson, kResolvedScene };
+// Prints counts and estimates as text or as one JSON object, or the resolved scene.
 int info_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides,
-                 bool as_json);
+                 InfoFormat format);
 
 // "START:END" => inclusive range within [first, last]; throws InputError naming --frames.
 std::pair<long long, long long> parse_frame_range(const std::string& text, long long first,

@@ -34,11 +34,16 @@ int validate_command(const std::filesystem::path& scene_file,
 }
 
 int info_command(const std::filesystem::path& scene_file, const std::vector<std::string>& overrides,
-                 bool as_json) {
+                 InfoFormat format) {
   const Scene scene = load_scene(scene_file, overrides);
+  if (format == InfoFormat::kResolvedScene) {
+    // The scene as a bake records it: every default filled in, overrides applied.
+    std::cout << scene.resolved.dump(2) << "\n";
+    return 0;
+  }
   const PreparedTree tree = prepare_tree(scene);
   const Json summary = tree_summary(scene, tree);
-  if (as_json) {
+  if (format == InfoFormat::kJson) {
     std::cout << summary.dump(2) << "\n";
     return 0;
   }

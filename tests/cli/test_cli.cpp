@@ -115,6 +115,17 @@ TEST_F(Cli, SetOverridesASceneValue) {
   EXPECT_EQ(nlohmann::json::parse(r.out)["skeleton"]["segments"], 5);
 }
 
+TEST_F(Cli, ResolvedSceneHasDefaultsAndOverrides) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("info --resolved-scene " + scene.string() + " --set time.fps=30");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto resolved = nlohmann::json::parse(r.out);
+  EXPECT_EQ(resolved["time"]["fps"], 30);
+  EXPECT_EQ(resolved["time"]["frames"], 5);
+  EXPECT_TRUE(resolved["tree"].contains("ring_sides"));
+  EXPECT_TRUE(resolved["hsm"].contains("stiffness"));
+}
+
 TEST_F(Cli, ValidatePrintsOk) {
   const fs::path scene = write("line.json", kLine);
   const Result r = run("validate " + scene.string());
