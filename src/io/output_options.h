@@ -1,5 +1,5 @@
 #pragma once
-// Scene /outputs elements (docs/scene-outputs.md). Owned by io/; fields are added as sinks need.
+// Scene /outputs elements (docs/scene.md). Owned by io/; fields are added as sinks need.
 #include <filesystem>
 #include <string>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Scene sections /hsm and /wind (docs/scene-hsm.md, docs/scene-wind.md). Owned by sim/.
+// Scene sections /hsm and /wind (docs/scene.md). Owned by sim/.
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>

@@ -1,5 +1,5 @@
 #pragma once
-// The air velocity field (docs/scene-wind.md, docs/solver.md "Wind"): a mean wind from the
+// The air velocity field (docs/scene.md, docs/solver.md "Wind"): a mean wind from the
 // keys (piecewise linear, held before the first and after the last key), gusts along it, and
 // a frozen-turbulence field of sinusoidal modes advected with the mean wind. Deterministic:
 // everything is a function of (seed, position, time), never of the step or thread count.

@@ -1,5 +1,5 @@
 #pragma once
-// Scene section /tree (docs/scene-tree.md). Owned by tree/; fields are added as the mesher needs.
+// Scene section /tree (docs/scene.md). Owned by tree/; fields are added as the mesher needs.
 #include <filesystem>
 #include <optional>
 
