@@ -19,7 +19,7 @@ struct TimeOptions {
   double fps = 24;          // frames per second
   long long frames = 120;   // frames simulated (and written)
   long long start = 0;      // index of the first frame; frame k is at time k / fps
-  int substeps = 4;         // solver steps per frame
+  int substeps = 16;        // solver steps per frame (<= 1% error with the default hsm, docs/benchmarks.md)
 };
 
 struct Scene {
