@@ -74,7 +74,9 @@ SimOptions read_sim_options(SceneObject section) {
   o.alpha = section.number("alpha", o.alpha, Range::between(0, 1));
   o.k_d = section.number("k_d", o.k_d, Range::between(0, 1));
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
-  o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::positive());
+  // Below ~1 MPa (softer than any self-supporting plant tissue; green wood is 5-12 GPa) a
+  // branch has no stiffness to speak of and the wind carries the tree away.
+  o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::at_least(1e6));
   o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
   o.max_frequency = section.number("max_frequency", o.max_frequency, Range::positive());
   o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, Range::positive());
@@ -86,6 +88,11 @@ SimOptions read_sim_options(SceneObject section) {
   o.sleep_distance = section.number("sleep_distance", o.sleep_distance, Range::positive());
   o.rotation_iterations =
       static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
+  // Per-step rates of 0 for both terms leave nothing holding the tree: refuse, not bake a
+  // tree that blows away.
+  if (o.stiffness == StiffnessMode::kPerStep && o.alpha == 0 && (o.k_d == 0 || !o.global_matching))
+    section.fail("alpha", "expected a number in (0, 1] when k_d is 0 or global_matching is off "
+                          "(nothing would hold the tree), got 0");
   return o;
 }
 
