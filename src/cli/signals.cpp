@@ -19,6 +19,9 @@ void install_interrupt_handlers() {
   action.sa_flags = 0;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A file-size limit (ulimit -f) must fail the write (EFBIG => exit 4, temporaries removed),
+  // not kill the process with SIGXFSZ and strand the temporaries.
+  std::signal(SIGXFSZ, SIG_IGN);
 }
 
 int pending_signal() { return received_signal; }

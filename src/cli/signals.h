@@ -4,7 +4,7 @@
 
 namespace treeanim {
 
-// Installs handlers for SIGINT and SIGTERM (idempotent).
+// Installs handlers for SIGINT and SIGTERM and ignores SIGXFSZ (idempotent).
 void install_interrupt_handlers();
 // The signal number received since installation, or 0.
 int pending_signal();

@@ -248,11 +248,7 @@ SCENARIOS = {
 
 # Scenarios that reproduce an open defect (reported to the stage owner): tests/hardening.cmake
 # registers them DISABLED, so ctest lists them as "Not Run (Disabled)" until the fix lands.
-OPEN_DEFECTS = {
-    "disk-full": "cli: SIGXFSZ kills the bake and strands its temporaries (ignore SIGXFSZ)",
-    "glb-far-too-large-under-ulimit-v": "io: the GLB size check renders the whole glTF JSON "
-                                        "(memory and time per frame; bad_alloc => abort)",
-}
+OPEN_DEFECTS = {}
 
 
 def main():
