@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -50,6 +51,11 @@ struct Simulator::Impl {
   double frame_dt;
   int substeps;
   double h;  // s, one substep
+  // m^2: (2 x the largest extent of the rest mesh)^2. An attached vertex of an anchored tree
+  // farther than that from rest means the tree came apart (a step the stiffness cannot
+  // resolve): the bake stops rather than writing it. Infinite without anchors (a free body
+  // may travel) and for a single-point model.
+  double runaway_distance2;
   size_t V, C, M, L;
 
   // --- per membership (M), in cluster_members order ---
@@ -140,6 +146,9 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
       detach_enabled(o.leaf_detach_force > 0 && m.leaf_count() > 0),
       parallel(m.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
+  const double size = V ? (m.rest_positions.rowwise().maxCoeff() - m.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
+  const bool anchored = std::any_of(m.vertex_anchored.begin(), m.vertex_anchored.end(), [](auto a) { return a != 0; });
+  runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
   precompute_members();
   const StepRates rates = compute_step_rates(model, options, h);
   cluster_alpha = rates.cluster_alpha;
@@ -375,8 +384,8 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
   const double inv_h = 1.0 / h;
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
-  uint32_t bad = kNone;
-#pragma omp parallel if (parallel) reduction(min : bad)
+  uint32_t bad = kNone, runaway = kNone;
+#pragma omp parallel if (parallel) reduction(min : bad, runaway)
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
@@ -403,6 +412,7 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
       if (!predict) {
         const Eigen::Vector3d x = model.rest_positions.col(v) + u;
         if (!x.allFinite() || !velocity.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
+        if (!flying && u.squaredNorm() > runaway_distance2) runaway = std::min(runaway, static_cast<uint32_t>(v));
         state.positions.col(v) = x;
         state.velocities.col(v) = velocity;
         continue;
@@ -429,6 +439,16 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
     throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
                           std::to_string(vertex_air_cluster[bad]) + " (vertex " + std::to_string(bad) +
                           "): non-finite position or velocity");
+  if (runaway != kNone) {
+    char distances[96];
+    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m)",
+                  (state.positions.col(runaway) - model.rest_positions.col(runaway)).norm(),
+                  std::sqrt(runaway_distance2) / 2);
+    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                          std::to_string(vertex_air_cluster[runaway]) + " (vertex " + std::to_string(runaway) +
+                          "): " + distances +
+                          ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+  }
 }
 
 // Shape match of cluster c on the predicted positions => its rotation R (warm start

@@ -186,8 +186,19 @@ TEST(Solver, ExtremeWindAndLargeStepStayFinite) {
     SimState state = sim.initial_state(0);
     double fastest = 0;
     const int frames = static_cast<int>(30 * fps);
-    for (int f = 1; f <= frames; ++f) {
-      ASSERT_NO_THROW(sim.advance_frame(state, f));
+    bool came_apart = false;
+    for (int f = 1; f <= frames && !came_apart; ++f) {
+      try {
+        sim.advance_frame(state, f);
+      } catch (const SimulationError& e) {
+        // One step (0.25 s or 1/24 s) in this gale may carry thin branches farther than twice
+        // the tree's size (issue 7's limit): the runaway guard stops the bake then, and the
+        // error is that, never a non-finite value.
+        const std::string message = e.what();
+        EXPECT_NE(message.find("more than twice the tree's size"), std::string::npos) << message;
+        came_apart = true;
+        continue;
+      }
       fastest = std::max(fastest, state.velocities.colwise().norm().maxCoeff());
       // At one substep per frame the gale carries thin branches up to a step's worth of
       // wind (80 m/s x 0.25 s) before the clusters pull them back; at 24 fps the tree bends
@@ -195,6 +206,7 @@ TEST(Solver, ExtremeWindAndLargeStepStayFinite) {
       const double bound = fps == 4.0 ? 80 * 0.25 : 8.4;
       ASSERT_LT((state.positions - model.rest_positions).colwise().norm().maxCoeff(), bound) << fps << " " << f;
     }
+    if (came_apart) continue;
     EXPECT_LT(fastest, 80.0 * 1.5);  // never much faster than the air (60 m/s + 20 m/s gusts)
     // 25 s after the gale the tree is back near its rest pose.
     EXPECT_LT((state.positions - model.rest_positions).colwise().norm().maxCoeff(), 1e-2) << fps;
