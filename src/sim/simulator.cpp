@@ -61,7 +61,9 @@ struct Simulator::Impl {
   // --- per membership (M), in cluster_members order ---
   std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
   Eigen::Matrix3Xd member_offset;          // (3 x M) m, rest offset q = x0 - t0 from the cluster's rest centre
-  std::vector<double> member_match_weight; // (M) 1/m^2: w / sum(w |q|^2), A_pq normalised to order 1
+  // (3 x M) 1/m, s q with s = w / sum(w |q|^2): the rest offset weighted so that A_pq is
+  // of order 1 for any cluster size
+  Eigen::Matrix3Xd member_weighted_offset;
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
   // (3 x M) m, alpha_c (g - p) of the current step. Float: a correction is a small move
@@ -72,6 +74,8 @@ struct Simulator::Impl {
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
   Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s q over the members: round-off only
+  Eigen::Matrix3Xd cluster_centre_offset;  // (3 x C) m, sum of (w / sum w) q: round-off only
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s q q^T, column-major: A_pq at rest
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
@@ -104,6 +108,11 @@ struct Simulator::Impl {
 
   std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
 
+  // --- the next frame's first prediction, made by the last step of a frame ---
+  Eigen::Matrix3Xd carried_velocity;       // (3 x V) m/s, v* of the next step (state.velocities holds v)
+  uint64_t carried_stamp = 0;              // the SimState::prediction_stamp it belongs to; 0: none
+  uint64_t stamps_issued = 0;
+
   // --- leaves ---
   std::vector<uint8_t> applied_attached;  // (L) detachments already applied to the arrays above
   bool detach_enabled;
@@ -122,19 +131,20 @@ struct Simulator::Impl {
   void precompute_drag(const WindOptions& w);
   void precompute_islands();
   void detach_leaf(SimState& state, size_t leaf);
-  void sync_detachments(SimState& state);
+  bool sync_detachments(SimState& state);
   void frame(SimState& state, long long frame_index);
   void set_air_time(double t);
   void sample_cluster_air(size_t c);
   bool all_resting(const SimState& state) const;
   void sample_air(const SimState& state);
-  void vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep);
+  enum class Pass { kStart, kStep, kEnd };
+  bool vertex_pass(SimState& state, Pass pass, long long frame, int substep);
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
-  void match_clusters(SimState& state, bool next_air, long long frame, int substep);
+  void match_clusters(SimState& state, long long frame, int substep);
   void precompute_pins();
   void check_detachments(SimState& state);
-  void check_sleep(SimState& state, double t);
+  bool check_sleep(SimState& state, double t);
   bool cluster_awake(const SimState& state, size_t c) const {
     return cluster_flying[c] || !state.island_asleep[cluster_island[c]];
   }
@@ -161,6 +171,7 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
   cluster_shift.setZero(3, C);
   cluster_rotation_matrix.setZero(9, C);
   predicted_offset.setZero(3, V);
+  carried_velocity.setZero(3, V);
   precompute_pins();
   cluster_flying.assign(C, 0);
   vertex_flying.assign(V, 0);
@@ -182,12 +193,14 @@ void Simulator::Impl::precompute_members() {
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
       member_cluster[s] = static_cast<uint32_t>(c);
   member_offset.setZero(3, M);
-  member_match_weight.assign(M, 0);
+  member_weighted_offset.setZero(3, M);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
   member_correction.setZero(3, M);
   cluster_rest_centre.setZero(3, C);
   cluster_offset_sum.setZero(3, C);
+  cluster_centre_offset.setZero(3, C);
+  cluster_rest_moment.setZero(9, C);
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   vertex_inv_count.assign(V, 0);
   vertex_air_cluster.assign(V, 0);
@@ -225,13 +238,22 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
   }
   // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
   const double inv_spread = spread > 0 ? 1.0 / spread : 0.0;
-  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero(), centre_offset = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    member_match_weight[s] = total > 0 ? weight(s) * inv_spread : 0.0;
+    const double match_weight = total > 0 ? weight(s) * inv_spread : 0.0;
+    const Eigen::Vector3d q = member_offset.col(s);
     member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
-    offset_sum += member_match_weight[s] * member_offset.col(s);
+    member_weighted_offset.col(s) = match_weight * q;
+    offset_sum += match_weight * q;
+    centre_offset += member_centre_weight[s] * q;
+    // Each entry as s (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) moment(i, j) += match_weight * (q[i] * q[j]);
   }
   cluster_offset_sum.col(c) = offset_sum;
+  cluster_centre_offset.col(c) = centre_offset;
+  Eigen::Map<Eigen::Matrix3d>(&cluster_rest_moment(0, c)) = moment;
 }
 
 // Drag areas and coefficients => per-vertex drag constants.
@@ -337,13 +359,17 @@ void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
   state.leaf_attached[leaf] = 0;
 }
 
-// state.leaf_attached => the arrays of this simulator (a state may come from a checkpoint).
-void Simulator::Impl::sync_detachments(SimState& state) {
+// state.leaf_attached => the arrays of this simulator (a state may come from a checkpoint);
+// true when a leaf was detached here.
+bool Simulator::Impl::sync_detachments(SimState& state) {
+  bool changed = false;
   for (size_t l = 0; l < L; ++l) {
     if (state.leaf_attached[l] == applied_attached[l]) continue;
     if (state.leaf_attached[l]) throw SimulationError("leaf " + std::to_string(l) + " was re-attached: leaves never re-attach");
     detach_leaf(state, l);
+    changed = true;
   }
+  return changed;
 }
 
 // t => the wind terms shared by every cluster at t (base wind, turbulence amplitude and
@@ -374,12 +400,17 @@ void Simulator::Impl::sample_air(const SimState& state) {
     if (cluster_awake(state, c)) sample_cluster_air(c);
 }
 
-// The per-vertex pass, in displacements from rest (u = x - x0). `correct`: finish the
-// current step from the predicted state (averaged corrections, Eq. 7); `predict`: start the
-// next step (damping, drag, gravity, global term Eq. 8, which is -k u / h) into v*
-// (state.velocities) and u_p = u + h v* (`predicted_offset`). Fused, so a vertex is loaded
-// once per substep; positions are read at the first step of a frame and written at the last.
-void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, long long frame, int substep) {
+// The per-vertex pass, in displacements from rest (u = x - x0). kStep and kEnd finish the
+// current step from the predicted state (averaged corrections, Eq. 7); all three start the
+// next step (damping, drag, gravity, global term Eq. 8, which is -k u / h) into v* and
+// u_p = u + h v* (`predicted_offset`). Fused, so a vertex is loaded once per substep.
+// kStart predicts from state.positions (the first step of a frame without a carried
+// prediction); kEnd, the last step of a frame, also writes positions and velocities to the
+// state and puts v* of the next frame's first step in carried_velocity. Returns whether an
+// island was asleep (its vertices were skipped, so their prediction is not current).
+bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, int substep) {
+  const bool correct = pass != Pass::kStart, end = pass == Pass::kEnd;
+  Eigen::Matrix3Xd& next_velocities = end ? carried_velocity : state.velocities;
   const Eigen::Vector3d gravity_step = options.gravity * h;
   const double inv_h = 1.0 / h;
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
@@ -409,13 +440,12 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
         u = state.positions.col(v) - model.rest_positions.col(v);
         velocity = state.velocities.col(v);
       }
-      if (!predict) {
+      if (end) {
         const Eigen::Vector3d x = model.rest_positions.col(v) + u;
         if (!x.allFinite() || !velocity.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
         if (!flying && u.squaredNorm() > runaway_distance2) runaway = std::min(runaway, static_cast<uint32_t>(v));
         state.positions.col(v) = x;
         state.velocities.col(v) = velocity;
-        continue;
       }
       // Quadratic drag integrated exactly over the step for constant air velocity:
       // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
@@ -430,7 +460,7 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
       // One test for six values: a sum is finite only if every term is (or past 1e308 m).
       const double sum = ahead.sum() + next.sum();
       if (!(sum - sum == 0)) bad = std::min(bad, static_cast<uint32_t>(v));
-      state.velocities.col(v) = next;
+      next_velocities.col(v) = next;
       predicted_offset.col(v) = ahead;
       if (detach_enabled) vertex_drag_force.col(v) = drag_dv * (model.vertex_mass[v] * inv_h);
     }
@@ -449,6 +479,7 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
                           "): " + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
   }
+  return any_asleep;
 }
 
 // Shape match of cluster c on the predicted positions => its rotation R (warm start
@@ -456,19 +487,22 @@ void Simulator::Impl::vertex_pass(SimState& state, bool correct, bool predict, l
 bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
-  // numbers wherever the tree stands and however far it travelled. One pass sums the centre
-  // shift and A' = sum s d q^T; A_pq = sum s (d - shift) q^T = A' - shift (sum s q)^T, with
-  // the computed sum s q (0 but for round-off). Each entry is summed as s (d_i q_j), so
-  // that A is exactly symmetric at the rest pose (R = I exactly there).
-  shift.setZero();
+  // numbers wherever the tree stands and however far it travelled. With the rest terms
+  // precomputed, one pass over the displacements sums the centre shift
+  // t - t0 = sum (w / sum w) u_p + sum (w / sum w) q and A' = sum s d q^T = sum u_p (s q)^T +
+  // sum s q q^T; then A_pq = A' - shift (sum s q)^T, with the computed sum s q (0 but for
+  // round-off). At the rest pose u_p = 0 and A_pq is the exactly symmetric rest moment.
+  Eigen::Vector3d centre_shift = Eigen::Vector3d::Zero();
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d q = member_offset.col(s);
-    const Eigen::Vector3d d = predicted_offset.col(model.cluster_members[s]) + q;
-    shift += member_centre_weight[s] * d;
+    const Eigen::Vector3d u = predicted_offset.col(model.cluster_members[s]);
+    const Eigen::Vector3d weighted_q = member_weighted_offset.col(s);
+    centre_shift += member_centre_weight[s] * u;
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) A(i, j) += member_match_weight[s] * (d[i] * q[j]);
+      for (int i = 0; i < 3; ++i) A(i, j) += u[i] * weighted_q[j];
   }
+  shift = centre_shift + cluster_centre_offset.col(c);
+  A += Eigen::Map<const Eigen::Matrix3d>(&cluster_rest_moment(0, c));
   A -= shift * cluster_offset_sum.col(c).transpose();
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
   extract_rotation(A, rotation, options.rotation_iterations);
@@ -494,8 +528,8 @@ void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, cons
 // Predicted positions => corrections of every awake cluster: branches and free leaves first,
 // then the attached leaves, whose translation is pinned to their branch's goal for the shared
 // vertex (hierarchical: a 1 g leaf cannot drag its branch, nor drift off it in a gale).
-// With `next_air`, each cluster also samples the air of the next step (set_air_time).
-void Simulator::Impl::match_clusters(SimState& state, bool next_air, long long frame, int substep) {
+// Each cluster also samples the air of the next step (set_air_time) for the prediction.
+void Simulator::Impl::match_clusters(SimState& state, long long frame, int substep) {
   uint32_t bad = kNone;
 #pragma omp parallel if (parallel) reduction(min : bad)
   {
@@ -508,7 +542,7 @@ void Simulator::Impl::match_clusters(SimState& state, bool next_air, long long f
         if (fit_cluster(state, c, R, shift)) write_corrections(c, R, shift);
         else bad = std::min(bad, static_cast<uint32_t>(c));
       }
-      if (next_air) sample_cluster_air(c);
+      sample_cluster_air(c);
     }
     if (!pinned_leaf_clusters.empty()) {
 #pragma omp barrier
@@ -554,9 +588,11 @@ void Simulator::Impl::check_detachments(SimState& state) {
 }
 
 // End of a frame at time t: an awake island in calm air whose vertices all rest (slower than
-// sleep_velocity, closer than sleep_distance to rest) is put to sleep exactly at rest.
-void Simulator::Impl::check_sleep(SimState& state, double t) {
-  if (!wind.calm(t)) return;
+// sleep_velocity, closer than sleep_distance to rest) is put to sleep exactly at rest;
+// true when one was.
+bool Simulator::Impl::check_sleep(SimState& state, double t) {
+  if (!wind.calm(t)) return false;
+  bool fell_asleep = false;
   const double v2 = options.sleep_velocity * options.sleep_velocity;
   const double d2 = options.sleep_distance * options.sleep_distance;
   for (size_t i = 0; i < I; ++i) {
@@ -570,6 +606,7 @@ void Simulator::Impl::check_sleep(SimState& state, double t) {
     }
     if (!rests) continue;
     state.island_asleep[i] = 1;
+    fell_asleep = true;
     island_fell_asleep[i] = 1;
     for (uint32_t k = island_vertex_offsets[i]; k < island_vertex_offsets[i + 1]; ++k) {
       const uint32_t v = island_vertices[k];
@@ -583,6 +620,7 @@ void Simulator::Impl::check_sleep(SimState& state, double t) {
     if (island_fell_asleep[cluster_island[c]] && !cluster_flying[c])
       state.cluster_rotations.col(c) = Eigen::Quaterniond::Identity().coeffs();
   std::fill(island_fell_asleep.begin(), island_fell_asleep.end(), 0);
+  return fell_asleep;
 }
 
 // True when no island is awake and nothing flies: the frame costs nothing.
@@ -595,6 +633,10 @@ bool Simulator::Impl::all_resting(const SimState& state) const {
 // and correct, fused with the next step's prediction.
 void Simulator::Impl::frame(SimState& state, long long frame_index) {
   const double start = state.time;
+  // The last step of the previous frame predicted this frame's first step for exactly this
+  // state, unless something changed it since (the stamp is reset below until this frame ends).
+  const bool carried = carried_stamp != 0 && state.prediction_stamp == carried_stamp;
+  state.prediction_stamp = carried_stamp = 0;
   if (options.sleep) {
     // Sleeping islands wake as soon as the air moves at any step of this frame.
     bool calm = true;
@@ -602,18 +644,25 @@ void Simulator::Impl::frame(SimState& state, long long frame_index) {
     if (!calm) std::fill(state.island_asleep.begin(), state.island_asleep.end(), 0);
     if (all_resting(state)) return;
   }
-  set_air_time(start);
-  sample_air(state);
-  vertex_pass(state, false, true, frame_index, 0);
+  if (carried) {
+    state.velocities.swap(carried_velocity);  // v* of the first step; the old v is not needed
+  } else {
+    set_air_time(start);
+    sample_air(state);
+    vertex_pass(state, Pass::kStart, frame_index, 0);
+  }
   if (detach_enabled) check_detachments(state);
+  bool skipped_sleepers = false;
   for (int k = 0; k < substeps; ++k) {
     const bool last = k + 1 == substeps;
-    // The air of step k was used by its prediction, so the scratch can move on to k + 1.
-    if (!last) set_air_time(start + (k + 1) * h);
-    match_clusters(state, !last, frame_index, k);
-    vertex_pass(state, true, !last, frame_index, k);
+    // The air of step k was used by its prediction, so the scratch can move on to k + 1
+    // (after the last step: the next frame's first).
+    set_air_time(last ? start + frame_dt : start + (k + 1) * h);
+    match_clusters(state, frame_index, k);
+    skipped_sleepers = vertex_pass(state, last ? Pass::kEnd : Pass::kStep, frame_index, k);
     if (!last && detach_enabled) check_detachments(state);
   }
+  if (!skipped_sleepers) state.prediction_stamp = carried_stamp = ++stamps_issued;
 }
 
 Simulator::Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
@@ -641,10 +690,11 @@ void Simulator::advance_frame(SimState& state, long long frame) {
   if (state.positions.cols() != static_cast<Eigen::Index>(s.V) || state.leaf_attached.size() != s.L ||
       state.cluster_rotations.cols() != static_cast<Eigen::Index>(s.C) || state.island_asleep.size() != s.I)
     throw SimulationError("frame " + std::to_string(frame) + ": the state does not belong to this tree model");
-  s.sync_detachments(state);
+  if (s.sync_detachments(state)) state.prediction_stamp = 0;
   s.frame(state, frame);
   state.time += s.frame_dt;
-  if (s.options.sleep) s.check_sleep(state, state.time);
+  // An island put to sleep is moved to its rest pose: its carried prediction no longer holds.
+  if (s.options.sleep && s.check_sleep(state, state.time)) state.prediction_stamp = s.carried_stamp = 0;
 }
 
 }  // namespace treeanim
