@@ -1,22 +1,18 @@
 #include "lsystem/lsystem.h"
 
-#include <fstream>
-#include <sstream>
 
 #include "common/errors.h"
+#include "common/read_text_file.h"
 
 namespace treeanim {
 
 namespace {
 
 std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in || std::filesystem::is_directory(path))
-    throw InputError(path.string() + ": cannot read the grammar file (" +
-                     (std::filesystem::exists(path) ? "not a readable file" : "no such file") + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  std::string text, reason;
+  if (!read_text_file(path, text, reason))
+    throw InputError(path.string() + ": cannot read the grammar file (" + reason + ")");
+  return text;
 }
 
 // A scene define must replace a #define of the file: otherwise it is a typo that would

@@ -1,9 +1,8 @@
 #include "scene/scene.h"
 
-#include <fstream>
-#include <sstream>
 
 #include "common/errors.h"
+#include "common/read_text_file.h"
 
 namespace treeanim {
 
@@ -140,17 +139,13 @@ Scene load_scene_text(const std::string& text, const std::string& name,
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in || std::filesystem::is_directory(file)) {
+  std::string text, reason;
+  if (!read_text_file(file, text, reason)) {
     const std::filesystem::path shown = std::filesystem::absolute(file).lexically_normal();
-    throw InputError(shown.string() + ": cannot read the scene file (" +
-                     (std::filesystem::exists(file) ? "permission denied or not a file"
-                                                    : "no such file") + ")");
+    throw InputError(shown.string() + ": cannot read the scene file (" + reason + ")");
   }
-  std::ostringstream text;
-  text << in.rdbuf();
   const std::filesystem::path dir = std::filesystem::absolute(file).parent_path();
-  Scene scene = load_scene_text(text.str(), file.string(), dir, overrides);
+  Scene scene = load_scene_text(text, file.string(), dir, overrides);
   scene.file = file;
   return scene;
 }

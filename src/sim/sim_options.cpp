@@ -1,11 +1,11 @@
 #include "sim/sim_options.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
 #include "common/errors.h"
+#include "common/read_text_file.h"
 
 namespace treeanim {
 
@@ -165,11 +165,10 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
     if (const std::string error = order_error(o.keys, i); !error.empty()) k.fail("time", error);
   }
   if (o.file) {
-    std::ifstream in(*o.file, std::ios::binary);
-    if (!in) section.fail("file", "cannot open wind file '" + o.file->string() + "'");
-    std::stringstream text;
-    text << in.rdbuf();
-    o.keys = parse_wind_csv(text.str(), o.file->string());
+    std::string text, reason;
+    if (!read_text_file(*o.file, text, reason))
+      section.fail("file", "cannot open wind file '" + o.file->string() + "' (" + reason + ")");
+    o.keys = parse_wind_csv(text, o.file->string());
   }
   o.air_density = section.number("air_density", o.air_density, Range::non_negative());
   o.branch_drag_coefficient = section.number("branch_drag_coefficient", o.branch_drag_coefficient, Range::between(0, 10));

@@ -1,0 +1,20 @@
+#pragma once
+// Whole-file reads of the text inputs (scene, grammar, wind CSV), with one size cap.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace treeanim {
+
+// 256 MiB: far above any scene, grammar or wind series (a key per millisecond for an hour is
+// ~100 MB), far below what would exhaust memory.
+constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t(256) << 20;
+
+// path => its whole content in `text`, true; or false with `reason` ("no such file", "not a
+// readable file", "larger than 256 MiB"). Reads at most max_bytes + 1 bytes, so a device or
+// pipe without end (/dev/zero) fails instead of filling memory; FIFOs and process
+// substitution still work.
+bool read_text_file(const std::filesystem::path& path, std::string& text, std::string& reason,
+                    std::uintmax_t max_bytes = kMaxTextFileBytes);
+
+}  // namespace treeanim
