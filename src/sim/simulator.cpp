@@ -423,6 +423,7 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
     for (size_t v = first; v < last; ++v) {
       if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {  // anchors hold where they are
         if (!correct) predicted_offset.col(v) = state.positions.col(v) - model.rest_positions.col(v);
+        if (end) carried_velocity.col(v) = state.velocities.col(v);
         continue;
       }
       const bool flying = vertex_flying[v];
