@@ -29,6 +29,20 @@ SimOptions per_step(double alpha, double k_d, bool global) {
 
 WindOptions calm() { return WindOptions{}; }
 
+// Steady wind of `speed` (m/s) along `direction` with gusts of `gust` (m/s).
+WindOptions steady_wind(double speed, const Eigen::Vector3d& direction, double gust) {
+  WindOptions wind;
+  wind.keys = {{0, speed, direction, gust}};
+  return wind;
+}
+
+// Physical defaults with sleeping off, so that every step really runs.
+SimOptions awake() {
+  SimOptions options;
+  options.sleep = false;
+  return options;
+}
+
 // One free (unanchored) branch cluster of two rings, far from the origin.
 TreeModel single_cluster(const Eigen::Vector3d& origin) {
   ModelBuilder b;
@@ -127,10 +141,8 @@ TEST(Solver, SharedVertexTakesTheAverageOfItsGoals) {
 
 TEST(Solver, AnchoredVerticesNeverMove) {
   const TreeModel model = small_tree(1);
-  WindOptions wind;
-  wind.keys = {{0, 25, {1, 0, 0.3}, 5}};
-  SimOptions options;
-  options.sleep = false;
+  const WindOptions wind = steady_wind(25, Eigen::Vector3d{1, 0, 0.3}, 5);
+  SimOptions options = awake();
   Simulator sim(model, options, wind, 1.0 / 24, 4);
   SimState state = sim.initial_state(0);
   for (int f = 1; f <= 24; ++f) sim.advance_frame(state, f);
@@ -146,8 +158,7 @@ TEST(Solver, TreeAtRestStaysAtRestFor100kSteps) {
   // Physical default stiffness, no wind, sleeping off (so every step really runs), far from
   // the origin to include the precision of the cluster-local frame.
   const TreeModel model = small_tree(2, Eigen::Vector3d(1000, 0, -2000));
-  SimOptions options;
-  options.sleep = false;
+  SimOptions options = awake();
   Simulator sim(model, options, calm(), 1.0 / 24, 100);
   SimState state = sim.initial_state(0);
   double worst = 0;
@@ -160,8 +171,7 @@ TEST(Solver, TreeAtRestStaysAtRestFor100kSteps) {
 
 TEST(Solver, NonFiniteValueNamesFrameSubstepAndCluster) {
   const TreeModel model = small_tree();
-  SimOptions options;
-  options.sleep = false;
+  SimOptions options = awake();
   Simulator sim(model, options, calm(), 1.0 / 24, 3);
   SimState state = sim.initial_state(0);
   state.positions(1, 40) = std::numeric_limits<double>::quiet_NaN();
@@ -230,10 +240,8 @@ TEST(Solver, DegenerateClustersStayFinite) {
   b.area.push_back(0);
   b.mass.push_back(0);
   const TreeModel model = b.finish();
-  WindOptions wind;
-  wind.keys = {{0, 30, {0, 0, 1}, 10}};
-  SimOptions options;
-  options.sleep = false;
+  const WindOptions wind = steady_wind(30, Eigen::Vector3d{0, 0, 1}, 10);
+  SimOptions options = awake();
   Simulator sim(model, options, wind, 1.0 / 24, 2);
   SimState state = sim.initial_state(0);
   for (int f = 1; f <= 48; ++f) ASSERT_NO_THROW(sim.advance_frame(state, f));
@@ -246,10 +254,8 @@ TEST(Solver, DegenerateClustersStayFinite) {
 // state edited by hand with the stamp reset, must be predicted from their positions instead.
 TEST(Solver, ResumedAndEditedStatesArePredictedFromTheirPositions) {
   const TreeModel model = small_tree(3);
-  WindOptions wind;
-  wind.keys = {{0, 12, {1, 0, 0.2}, 3}};
-  SimOptions options;
-  options.sleep = false;
+  const WindOptions wind = steady_wind(12, Eigen::Vector3d{1, 0, 0.2}, 3);
+  SimOptions options = awake();
   Simulator whole(model, options, wind, 1.0 / 24, 4);
   SimState state = whole.initial_state(0);
   SimState checkpoint;
