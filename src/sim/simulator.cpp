@@ -42,6 +42,24 @@ uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
   return a;
 }
 
+// One block of a thread's vertices in vertex_pass, on its stack (no allocation).
+constexpr int kVertexBlock = 256;
+struct VertexBlock {
+  uint8_t moving[kVertexBlock];              // 1: the vertex steps; 0: anchored, asleep, no cluster
+  double pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
+  // Per-step factors of each vertex; a vertex that does not move gets those of a still
+  // point (damping 1, no drag, no pull, no fall), which map its u = 0, v = 0 onto themselves
+  // exactly, so that the loop needs no branch.
+  double drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
+  double damping[kVertexBlock];              // velocity factor
+  double pull_back[kVertexBlock];            // 1/s, global rate / h
+  double falling[kVertexBlock];              // 1 on a flying leaf, else 0
+  double end_offset[3][kVertexBlock];        // m, corrected u at the end of a frame (kEnd)
+  double end_velocity[3][kVertexBlock];      // m/s, corrected v at the end of a frame (kEnd)
+  double check[kVertexBlock];                // sum of the new values: finite iff all are
+  double excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
+};
+
 }  // namespace
 
 struct Simulator::Impl {
@@ -59,17 +77,16 @@ struct Simulator::Impl {
   size_t V, C, M, L;
 
   // --- per membership (M), in cluster_members order ---
+  // Arrays of 3-vectors read or written in the step are (n x 3): a column per axis
+  // (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
   std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
-  Eigen::Matrix3Xd member_offset;          // (3 x M) m, rest offset q = x0 - t0 from the cluster's rest centre
-  // (3 x M) 1/m, s q with s = w / sum(w |q|^2): the rest offset weighted so that A_pq is
+  Eigen::MatrixX3d member_offset;          // (M x 3) m, rest offset q = x0 - t0 from the cluster's rest centre
+  // (M x 3) 1/m, s q with s = w / sum(w |q|^2): the rest offset weighted so that A_pq is
   // of order 1 for any cluster size
-  Eigen::Matrix3Xd member_weighted_offset;
+  Eigen::MatrixX3d member_weighted_offset;
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
-  // (3 x M) m, alpha_c (g - p) of the current step. Float: a correction is a small move
-  // (its 1e-7 relative error is far below a micrometre) and this array is the largest
-  // stream of the step.
-  Eigen::Matrix3Xf member_correction;
+  Eigen::MatrixX3d member_correction;      // (M x 3) m, alpha_c (g - p) of the current step
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
@@ -80,7 +97,7 @@ struct Simulator::Impl {
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
   std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
-  Eigen::Matrix3Xd cluster_air;            // (3 x C) m/s, air velocity at the cluster this step
+  Eigen::MatrixX3d cluster_air;            // (C x 3) m/s, air velocity at the cluster this step
   Eigen::Matrix3Xd cluster_shift;          // (3 x C) m, t - t0: the centre of the last fit from the rest centre
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of the last fit, column-major
   std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
@@ -95,11 +112,14 @@ struct Simulator::Impl {
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
-  Eigen::Matrix3Xd vertex_drag_force;      // (3 x V) N, drag of the last step; only with detachment
-  // (3 x V) m, u = p - x0: the predicted position p = x + h v* of the current step as a
+  Eigen::MatrixX3d vertex_drag_force;      // (V x 3) N, drag of the last step; only with detachment
+  // (V x 3) m, u = p - x0: the predicted position p = x + h v* of the current step as a
   // displacement from rest. Small numbers wherever the tree stands, and x0 is not read
   // again until the frame ends.
-  Eigen::Matrix3Xd predicted_offset;
+  Eigen::MatrixX3d predicted_offset;
+  // (V x 3) m/s, v* of the current step; the state holds v at the end of a frame. After
+  // the last step it holds v* of the next frame's first step (see frame()).
+  Eigen::MatrixX3d step_velocity;
 
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   size_t I = 0;
@@ -109,7 +129,6 @@ struct Simulator::Impl {
   std::vector<uint8_t> island_fell_asleep; // (I) scratch of check_sleep
 
   // --- the next frame's first prediction, made by the last step of a frame ---
-  Eigen::Matrix3Xd carried_velocity;       // (3 x V) m/s, v* of the next step (state.velocities holds v)
   uint64_t carried_stamp = 0;              // the SimState::prediction_stamp it belongs to; 0: none
   uint64_t stamps_issued = 0;
 
@@ -139,6 +158,9 @@ struct Simulator::Impl {
   void sample_air(const SimState& state);
   enum class Pass { kStart, kStep, kEnd };
   bool vertex_pass(SimState& state, Pass pass, long long frame, int substep);
+  void gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n, VertexBlock& block);
+  template <bool kEnd, bool kDetach>
+  bool predict_block(size_t begin, int n, VertexBlock& block);
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
   void match_clusters(SimState& state, long long frame, int substep);
@@ -167,16 +189,16 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
   precompute_drag(w);
   precompute_islands();
   island_fell_asleep.assign(I, 0);
-  cluster_air.setZero(3, C);
+  cluster_air.setZero(C, 3);
   cluster_shift.setZero(3, C);
   cluster_rotation_matrix.setZero(9, C);
-  predicted_offset.setZero(3, V);
-  carried_velocity.setZero(3, V);
+  predicted_offset.setZero(V, 3);
+  step_velocity.setZero(V, 3);
   precompute_pins();
   cluster_flying.assign(C, 0);
   vertex_flying.assign(V, 0);
   applied_attached.assign(L, 1);
-  if (detach_enabled) vertex_drag_force.setZero(3, V);
+  if (detach_enabled) vertex_drag_force.setZero(V, 3);
   // Spatial turbulence phases at the rest centres: the tree moves little against the
   // length scale of the eddies, so they are evaluated once (flying leaves use their centre).
   const int N = wind.mode_count();
@@ -192,11 +214,11 @@ void Simulator::Impl::precompute_members() {
   for (size_t c = 0; c < C; ++c)
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
       member_cluster[s] = static_cast<uint32_t>(c);
-  member_offset.setZero(3, M);
-  member_weighted_offset.setZero(3, M);
+  member_offset.setZero(M, 3);
+  member_weighted_offset.setZero(M, 3);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
-  member_correction.setZero(3, M);
+  member_correction.setZero(M, 3);
   cluster_rest_centre.setZero(3, C);
   cluster_offset_sum.setZero(3, C);
   cluster_centre_offset.setZero(3, C);
@@ -232,9 +254,9 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
   cluster_rest_centre.col(c) = centre;
   double spread = 0;  // sum w |q|^2, kg m^2
   for (uint32_t s = begin; s < end; ++s) {
-    member_offset.col(s) = member_active[s] ? Eigen::Vector3d(model.rest_positions.col(model.cluster_members[s]) - centre)
-                                            : Eigen::Vector3d::Zero();
-    spread += weight(s) * member_offset.col(s).squaredNorm();
+    member_offset.row(s) = member_active[s] ? Eigen::RowVector3d((model.rest_positions.col(model.cluster_members[s]) - centre).transpose())
+                                            : Eigen::RowVector3d::Zero();
+    spread += weight(s) * member_offset.row(s).squaredNorm();
   }
   // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
   const double inv_spread = spread > 0 ? 1.0 / spread : 0.0;
@@ -242,9 +264,9 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
   Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
     const double match_weight = total > 0 ? weight(s) * inv_spread : 0.0;
-    const Eigen::Vector3d q = member_offset.col(s);
+    const Eigen::Vector3d q = member_offset.row(s).transpose();
     member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
-    member_weighted_offset.col(s) = match_weight * q;
+    member_weighted_offset.row(s) = match_weight * q.transpose();
     offset_sum += match_weight * q;
     centre_offset += member_centre_weight[s] * q;
     // Each entry as s (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
@@ -335,7 +357,7 @@ void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
     const uint32_t owner = member_cluster[slot];
     if ((owner == c) == goes_with_leaf || !member_active[slot]) continue;
     member_active[slot] = 0;
-    member_correction.col(slot).setZero();
+    member_correction.row(slot).setZero();
     rebuild_cluster_rest(owner);
   }
   uint32_t active = 0, first = kNone;
@@ -385,10 +407,11 @@ void Simulator::Impl::sample_cluster_air(size_t c) {
   if (cluster_flying[c]) {
     double sin_a[kMaxModes], cos_a[kMaxModes];
     wind.spatial_phases(Eigen::Vector3d(cluster_rest_centre.col(c) + cluster_shift.col(c)), sin_a, cos_a);
-    cluster_air.col(c) = air_base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, air_scale);
+    cluster_air.row(c) = (air_base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, air_scale)).transpose();
   } else {
-    cluster_air.col(c) = air_base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
-                                                    turbulence_sin_b, turbulence_cos_b, air_scale);
+    cluster_air.row(c) = (air_base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
+                                                     turbulence_sin_b, turbulence_cos_b, air_scale))
+                             .transpose();
   }
 }
 
@@ -402,17 +425,14 @@ void Simulator::Impl::sample_air(const SimState& state) {
 
 // The per-vertex pass, in displacements from rest (u = x - x0). kStep and kEnd finish the
 // current step from the predicted state (averaged corrections, Eq. 7); all three start the
-// next step (damping, drag, gravity, global term Eq. 8, which is -k u / h) into v* and
-// u_p = u + h v* (`predicted_offset`). Fused, so a vertex is loaded once per substep.
-// kStart predicts from state.positions (the first step of a frame without a carried
-// prediction); kEnd, the last step of a frame, also writes positions and velocities to the
-// state and puts v* of the next frame's first step in carried_velocity. Returns whether an
-// island was asleep (its vertices were skipped, so their prediction is not current).
+// next step (damping, drag, gravity, global term Eq. 8, which is -k u / h) into v*
+// (`step_velocity`) and u_p = u + h v* (`predicted_offset`). Fused, so a vertex is loaded
+// once per substep. kStart predicts from state.positions and velocities (the first step of
+// a frame without a carried prediction); kEnd, the last step of a frame, also writes
+// positions and velocities to the state, and its prediction is the next frame's first.
+// Returns whether an island was asleep (its vertices were skipped, so their prediction is
+// not current).
 bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, int substep) {
-  const bool correct = pass != Pass::kStart, end = pass == Pass::kEnd;
-  Eigen::Matrix3Xd& next_velocities = end ? carried_velocity : state.velocities;
-  const Eigen::Vector3d gravity_step = options.gravity * h;
-  const double inv_h = 1.0 / h;
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
   uint32_t bad = kNone, runaway = kNone;
@@ -420,50 +440,37 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    for (size_t v = first; v < last; ++v) {
-      if (model.vertex_anchored[v] || vertex_inv_count[v] == 0) {  // anchors hold where they are
-        if (!correct) predicted_offset.col(v) = state.positions.col(v) - model.rest_positions.col(v);
-        if (end) carried_velocity.col(v) = state.velocities.col(v);
-        continue;
+    VertexBlock block;
+    for (size_t begin = first; begin < last; begin += kVertexBlock) {
+      const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
+      gather_block(state, pass, any_asleep, begin, n, block);
+      const bool end = pass == Pass::kEnd;
+      const bool flagged = end ? (detach_enabled ? predict_block<true, true>(begin, n, block)
+                                                 : predict_block<true, false>(begin, n, block))
+                               : (detach_enabled ? predict_block<false, true>(begin, n, block)
+                                                 : predict_block<false, false>(begin, n, block));
+      if (end)
+        for (int k = 0; k < n; ++k) {
+          if (!block.moving[k]) continue;
+          const size_t v = begin + k;
+          for (int i = 0; i < 3; ++i) {
+            state.positions(i, v) = model.rest_positions(i, v) + block.end_offset[i][k];
+            state.velocities(i, v) = block.end_velocity[i][k];
+          }
+        }
+      if (flagged) {  // rare: find the first vertex at fault, as the scalar tests would
+        for (int k = 0; k < n; ++k) {
+          if (!block.moving[k]) continue;
+          const uint32_t v = static_cast<uint32_t>(begin + k);
+          if (!predicted_offset.row(v).allFinite() || !step_velocity.row(v).allFinite() ||
+              (end && !(state.positions.col(v).allFinite() && state.velocities.col(v).allFinite())))
+            bad = std::min(bad, v);
+          const double moved2 = end ? Eigen::Vector3d(block.end_offset[0][k], block.end_offset[1][k],
+                                                      block.end_offset[2][k]).squaredNorm()
+                                    : 0.0;
+          if (!vertex_flying[v] && moved2 > runaway_distance2) runaway = std::min(runaway, v);
+        }
       }
-      const bool flying = vertex_flying[v];
-      if (any_asleep && !flying && state.island_asleep[vertex_island[v]]) continue;
-      Eigen::Vector3d u, velocity;
-      if (correct) {
-        // Average of the goals of the vertex's clusters, in membership order (never the sum).
-        Eigen::Vector3d pull = Eigen::Vector3d::Zero();
-        for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
-          pull += member_correction.col(model.vertex_memberships[s]).cast<double>();
-        pull *= vertex_inv_count[v];
-        u = predicted_offset.col(v) + pull;
-        velocity = state.velocities.col(v) + pull * inv_h;
-      } else {
-        u = state.positions.col(v) - model.rest_positions.col(v);
-        velocity = state.velocities.col(v);
-      }
-      if (end) {
-        const Eigen::Vector3d x = model.rest_positions.col(v) + u;
-        if (!x.allFinite() || !velocity.allFinite()) bad = std::min(bad, static_cast<uint32_t>(v));
-        if (!flying && u.squaredNorm() > runaway_distance2) runaway = std::min(runaway, static_cast<uint32_t>(v));
-        state.positions.col(v) = x;
-        state.velocities.col(v) = velocity;
-      }
-      // Quadratic drag integrated exactly over the step for constant air velocity:
-      // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
-      // the air velocity, whatever the wind speed or step.
-      const Eigen::Vector3d relative = cluster_air.col(vertex_air_cluster[v]) - velocity;
-      const double kuh = vertex_drag[v] * relative.norm() * h;
-      const Eigen::Vector3d drag_dv = relative * (kuh / (1 + kuh));
-      Eigen::Vector3d next = velocity * vertex_damping[v] + drag_dv;
-      if (flying) next += gravity_step;
-      else next -= (vertex_global[v] * inv_h) * u;
-      const Eigen::Vector3d ahead = u + h * next;
-      // One test for six values: a sum is finite only if every term is (or past 1e308 m).
-      const double sum = ahead.sum() + next.sum();
-      if (!(sum - sum == 0)) bad = std::min(bad, static_cast<uint32_t>(v));
-      next_velocities.col(v) = next;
-      predicted_offset.col(v) = ahead;
-      if (detach_enabled) vertex_drag_force.col(v) = drag_dv * (model.vertex_mass[v] * inv_h);
     }
   }
   if (bad != kNone)
@@ -483,6 +490,114 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
   return any_asleep;
 }
 
+// Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
+// asleep) and block.pull, the mean of each vertex's corrections in membership order (never
+// the sum); kStart: 0, after loading u = x - x0 and v from the state (anchors included: they
+// hold where they are).
+void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n,
+                                   VertexBlock& block) {
+  const double inv_h = 1.0 / h;
+  for (int k = 0; k < n; ++k) {
+    const size_t v = begin + k;
+    const bool still = model.vertex_anchored[v] || vertex_inv_count[v] == 0 ||
+                       (any_asleep && !vertex_flying[v] && state.island_asleep[vertex_island[v]]);
+    block.moving[k] = still ? 0 : 1;
+    block.drag[k] = still ? 0.0 : vertex_drag[v];
+    block.damping[k] = still ? 1.0 : vertex_damping[v];
+    block.pull_back[k] = still ? 0.0 : vertex_global[v] * inv_h;
+    block.falling[k] = !still && vertex_flying[v] ? 1.0 : 0.0;
+    Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+    if (pass == Pass::kStart) {
+      predicted_offset.row(v) = (state.positions.col(v) - model.rest_positions.col(v)).transpose();
+      step_velocity.row(v) = state.velocities.col(v).transpose();
+    } else if (!still) {
+      for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
+        pull += member_correction.row(model.vertex_memberships[s]).transpose();
+      pull *= vertex_inv_count[v];
+    }
+    for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
+  }
+}
+
+// Corrected vertices of a block => their prediction for the next step, written for the
+// moving ones; with `kEnd` also the corrected u and v in block.end_*. One loop without
+// branches, vectorised across vertices: the drag's square root and division dominate it.
+// Returns true when some moving vertex turned non-finite or (kEnd) ran away; the caller
+// finds which.
+template <bool kEnd, bool kDetach>
+bool Simulator::Impl::predict_block(size_t begin, int n, VertexBlock& block) {
+  const double inv_h = 1.0 / h, step = h;
+  const double gravity_step[3] = {options.gravity.x() * h, options.gravity.y() * h, options.gravity.z() * h};
+  double* offset[3] = {predicted_offset.col(0).data() + begin, predicted_offset.col(1).data() + begin,
+                       predicted_offset.col(2).data() + begin};
+  double* velocity[3] = {step_velocity.col(0).data() + begin, step_velocity.col(1).data() + begin,
+                         step_velocity.col(2).data() + begin};
+  const double* air[3] = {cluster_air.col(0).data(), cluster_air.col(1).data(), cluster_air.col(2).data()};
+  double* force[3] = {nullptr, nullptr, nullptr};
+  if constexpr (kDetach)
+    for (int i = 0; i < 3; ++i) force[i] = vertex_drag_force.col(i).data() + begin;
+  const uint32_t* air_cluster = vertex_air_cluster.data() + begin;
+  const double* mass = model.vertex_mass.data() + begin;
+  const double limit2 = runaway_distance2;
+  double* offset_x = offset[0];
+  double* offset_y = offset[1];
+  double* offset_z = offset[2];
+  double* velocity_x = velocity[0];
+  double* velocity_y = velocity[1];
+  double* velocity_z = velocity[2];
+#pragma omp simd
+  for (int k = 0; k < n; ++k) {
+    const uint32_t c = air_cluster[k];
+    const double ux = offset_x[k] + block.pull[0][k], uy = offset_y[k] + block.pull[1][k],
+                 uz = offset_z[k] + block.pull[2][k];
+    const double vx = velocity_x[k] + block.pull[0][k] * inv_h, vy = velocity_y[k] + block.pull[1][k] * inv_h,
+                 vz = velocity_z[k] + block.pull[2][k] * inv_h;
+    const double rx = air[0][c] - vx, ry = air[1][c] - vy, rz = air[2][c] - vz;
+    // Quadratic drag integrated exactly over the step for constant air velocity:
+    // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
+    // the air velocity, whatever the wind speed or step.
+    const double kuh = block.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
+    const double share = kuh / (1 + kuh);
+    // A flying leaf falls (its global rate is 0); an attached vertex is pulled back.
+    const double damping = block.damping[k], falling = block.falling[k], pull_back = block.pull_back[k];
+    const double nx = ((vx * damping + rx * share) + falling * gravity_step[0]) - pull_back * ux;
+    const double ny = ((vy * damping + ry * share) + falling * gravity_step[1]) - pull_back * uy;
+    const double nz = ((vz * damping + rz * share) + falling * gravity_step[2]) - pull_back * uz;
+    const double ax = ux + step * nx, ay = uy + step * ny, az = uz + step * nz;
+    velocity_x[k] = nx;
+    velocity_y[k] = ny;
+    velocity_z[k] = nz;
+    offset_x[k] = ax;
+    offset_y[k] = ay;
+    offset_z[k] = az;
+    if constexpr (kDetach) {
+      const double scale = mass[k] * inv_h;
+      force[0][k] = rx * share * scale;
+      force[1][k] = ry * share * scale;
+      force[2][k] = rz * share * scale;
+    }
+    double sum = ((ax + nx) + (ay + ny)) + (az + nz);
+    double excess = 0;  // > 0: an attached vertex ran away (kEnd)
+    if constexpr (kEnd) {
+      block.end_offset[0][k] = ux;
+      block.end_offset[1][k] = uy;
+      block.end_offset[2][k] = uz;
+      block.end_velocity[0][k] = vx;
+      block.end_velocity[1][k] = vy;
+      block.end_velocity[2][k] = vz;
+      sum += (vx + vy) + vz;
+      excess = (1 - falling) * (ux * ux + uy * uy + uz * uz) - limit2;
+    }
+    block.check[k] = sum;
+    block.excess[k] = excess;
+  }
+  // One test for all values: a sum is finite only if every term is (or past 1e308 m). Kept
+  // out of the loop above: a reduction there stops GCC from vectorising it.
+  bool flagged = false;
+  for (int k = 0; k < n; ++k) flagged |= !(block.check[k] - block.check[k] == 0) || block.excess[k] > 0;
+  return flagged;
+}
+
 // Shape match of cluster c on the predicted positions => its rotation R (warm start
 // updated) and its centre as t - t0; false when a value is not finite.
 bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
@@ -496,8 +611,8 @@ bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R,
   Eigen::Vector3d centre_shift = Eigen::Vector3d::Zero();
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d u = predicted_offset.col(model.cluster_members[s]);
-    const Eigen::Vector3d weighted_q = member_weighted_offset.col(s);
+    const Eigen::Vector3d u = predicted_offset.row(model.cluster_members[s]).transpose();
+    const Eigen::Vector3d weighted_q = member_weighted_offset.row(s).transpose();
     centre_shift += member_centre_weight[s] * u;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) A(i, j) += u[i] * weighted_q[j];
@@ -518,11 +633,23 @@ bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R,
 // alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p).
 void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift) {
   const double alpha = cluster_alpha[c];
+  const uint32_t* members = model.cluster_members.data();
+  const uint8_t* active = member_active.data();
+  const double *qx = member_offset.col(0).data(), *qy = member_offset.col(1).data(), *qz = member_offset.col(2).data();
+  const double *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
+               *uz = predicted_offset.col(2).data();
+  double *cx = member_correction.col(0).data(), *cy = member_correction.col(1).data(),
+         *cz = member_correction.col(2).data();
+  const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2);
+  const double r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2), tx = shift.x(), ty = shift.y(), tz = shift.z();
+#pragma omp simd
   for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
-    const Eigen::Vector3d q = member_offset.col(s);
-    const Eigen::Vector3d move = (R * q - q) + shift - predicted_offset.col(model.cluster_members[s]);
-    member_correction.col(s) = member_active[s] ? Eigen::Vector3f((alpha * move).cast<float>())
-                                                : Eigen::Vector3f::Zero();
+    const uint32_t v = members[s];
+    const double x = qx[s], y = qy[s], z = qz[s];
+    const double weight = active[s] ? alpha : 0.0;  // a released membership pulls nothing
+    cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
+    cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
+    cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
   }
 }
 
@@ -563,8 +690,8 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
         const uint32_t branch = member_cluster[pin];
         const Eigen::Vector3d pinned =
             (cluster_rest_centre.col(branch) - cluster_rest_centre.col(c)) + cluster_shift.col(branch) +
-            Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.col(pin) -
-            R * member_offset.col(cluster_pin_own_slot[c]);
+            Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.row(pin).transpose() -
+            R * member_offset.row(cluster_pin_own_slot[c]).transpose();
         write_corrections(c, R, pinned);
       }
     }
@@ -582,7 +709,7 @@ void Simulator::Impl::check_detachments(SimState& state) {
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
       const uint32_t v = model.cluster_members[s];
-      if (model.vertex_leaf[v] == static_cast<int32_t>(l)) force += vertex_drag_force.col(v);
+      if (model.vertex_leaf[v] == static_cast<int32_t>(l)) force += vertex_drag_force.row(v).transpose();
     }
     if (force.norm() > options.leaf_detach_force) detach_leaf(state, l);
   }
@@ -645,9 +772,7 @@ void Simulator::Impl::frame(SimState& state, long long frame_index) {
     if (!calm) std::fill(state.island_asleep.begin(), state.island_asleep.end(), 0);
     if (all_resting(state)) return;
   }
-  if (carried) {
-    state.velocities.swap(carried_velocity);  // v* of the first step; the old v is not needed
-  } else {
+  if (!carried) {
     set_air_time(start);
     sample_air(state);
     vertex_pass(state, Pass::kStart, frame_index, 0);
