@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -44,6 +45,21 @@ uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
 
 // One block of a thread's vertices in vertex_pass, on its stack (no allocation).
 constexpr int kVertexBlock = 256;
+// 0, 1, ..., kVertexBlock - 1: a block's own lanes as rows.
+const std::array<uint32_t, kVertexBlock> kLaneIndex = [] {
+  std::array<uint32_t, kVertexBlock> lanes{};
+  for (int k = 0; k < kVertexBlock; ++k) lanes[k] = static_cast<uint32_t>(k);
+  return lanes;
+}();
+// Where predict_block reads a block's vertices: the mean correction of vertex k is row
+// pull_row[k] of `pull`; the factors are per vertex.
+struct VertexInputs {
+  const double* pull[3];
+  const uint32_t* pull_row;
+  const double *drag, *damping, *global;
+  const uint8_t* flying;
+};
+
 struct VertexBlock {
   uint8_t moving[kVertexBlock];              // 1: the vertex steps; 0: anchored, asleep, no cluster
   double pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
@@ -52,8 +68,8 @@ struct VertexBlock {
   // exactly, so that the loop needs no branch.
   double drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
   double damping[kVertexBlock];              // velocity factor
-  double pull_back[kVertexBlock];            // 1/s, global rate / h
-  double falling[kVertexBlock];              // 1 on a flying leaf, else 0
+  double global[kVertexBlock];               // global rate per step
+  uint8_t flying[kVertexBlock];              // 1 on a flying leaf
   double end_offset[3][kVertexBlock];        // m, corrected u at the end of a frame (kEnd)
   double end_velocity[3][kVertexBlock];      // m/s, corrected v at the end of a frame (kEnd)
   double check[kVertexBlock];                // sum of the new values: finite iff all are
@@ -86,7 +102,10 @@ struct Simulator::Impl {
   Eigen::MatrixX3d member_weighted_offset;
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
-  Eigen::MatrixX3d member_correction;      // (M x 3) m, alpha_c (g - p) of the current step
+  // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
+  // anchor). Before the vertex prediction, the first membership's row of a shared vertex
+  // takes the vertex's mean correction (average_shared_pulls).
+  Eigen::MatrixX3d member_correction;
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
@@ -110,6 +129,8 @@ struct Simulator::Impl {
   std::vector<double> vertex_drag;         // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
   std::vector<double> vertex_inv_count;    // (V) 1 / number of active memberships (0: none)
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
+  std::vector<uint32_t> vertex_pull_row;   // (V) row of member_correction with its mean correction (M: anchored)
+  std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   Eigen::MatrixX3d vertex_drag_force;      // (V x 3) N, drag of the last step; only with detachment
@@ -160,7 +181,8 @@ struct Simulator::Impl {
   bool vertex_pass(SimState& state, Pass pass, long long frame, int substep);
   void gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n, VertexBlock& block);
   template <bool kEnd, bool kDetach>
-  bool predict_block(size_t begin, int n, VertexBlock& block);
+  bool predict_block(size_t begin, int n, const VertexInputs& in, VertexBlock& block);
+  void average_shared_pulls(size_t first, size_t last);
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
   void match_clusters(SimState& state, long long frame, int substep);
@@ -218,7 +240,7 @@ void Simulator::Impl::precompute_members() {
   member_weighted_offset.setZero(M, 3);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
-  member_correction.setZero(M, 3);
+  member_correction.setZero(M + 1, 3);
   cluster_rest_centre.setZero(3, C);
   cluster_offset_sum.setZero(3, C);
   cluster_centre_offset.setZero(3, C);
@@ -226,10 +248,14 @@ void Simulator::Impl::precompute_members() {
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   vertex_inv_count.assign(V, 0);
   vertex_air_cluster.assign(V, 0);
+  vertex_pull_row.assign(V, static_cast<uint32_t>(M));
   for (size_t v = 0; v < V; ++v) {
     const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
     vertex_inv_count[v] = end > begin ? 1.0 / double(end - begin) : 0.0;
     vertex_air_cluster[v] = end > begin ? member_cluster[model.vertex_memberships[begin]] : 0;
+    if (model.vertex_anchored[v] || end == begin) continue;
+    vertex_pull_row[v] = model.vertex_memberships[begin];
+    if (end - begin > 1) shared_vertices.push_back(static_cast<uint32_t>(v));
   }
 }
 
@@ -440,15 +466,30 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
   {
     const auto [first, last] =
         balanced_range(model.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    // Without sleeping islands every free vertex moves and reads its mean correction from
+    // one row (anchors: the zero row, with factors that keep them still); otherwise, and when
+    // a frame starts from the state, each block is gathered lane by lane.
+    const bool direct = pass != Pass::kStart && !any_asleep;
+    if (direct) average_shared_pulls(first, last);
     VertexBlock block;
     for (size_t begin = first; begin < last; begin += kVertexBlock) {
       const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
-      gather_block(state, pass, any_asleep, begin, n, block);
+      VertexInputs in;
+      if (direct) {
+        for (int i = 0; i < 3; ++i) in.pull[i] = member_correction.col(i).data();
+        in = {{in.pull[0], in.pull[1], in.pull[2]}, vertex_pull_row.data() + begin, vertex_drag.data() + begin,
+              vertex_damping.data() + begin, vertex_global.data() + begin, vertex_flying.data() + begin};
+        std::fill(block.moving, block.moving + n, uint8_t(1));
+      } else {
+        gather_block(state, pass, any_asleep, begin, n, block);
+        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
+              block.global, block.flying};
+      }
       const bool end = pass == Pass::kEnd;
-      const bool flagged = end ? (detach_enabled ? predict_block<true, true>(begin, n, block)
-                                                 : predict_block<true, false>(begin, n, block))
-                               : (detach_enabled ? predict_block<false, true>(begin, n, block)
-                                                 : predict_block<false, false>(begin, n, block));
+      const bool flagged = end ? (detach_enabled ? predict_block<true, true>(begin, n, in, block)
+                                                 : predict_block<true, false>(begin, n, in, block))
+                               : (detach_enabled ? predict_block<false, true>(begin, n, in, block)
+                                                 : predict_block<false, false>(begin, n, in, block));
       if (end)
         for (int k = 0; k < n; ++k) {
           if (!block.moving[k]) continue;
@@ -490,13 +531,26 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
   return any_asleep;
 }
 
+// Shared vertices in [first, last) => the mean of their corrections (in membership order,
+// never the sum) in the row of their first membership, read by the direct vertex pass.
+void Simulator::Impl::average_shared_pulls(size_t first, size_t last) {
+  const auto from = std::lower_bound(shared_vertices.begin(), shared_vertices.end(), first);
+  const auto to = std::lower_bound(from, shared_vertices.end(), last);
+  for (auto it = from; it != to; ++it) {
+    const uint32_t v = *it;
+    Eigen::RowVector3d pull = Eigen::RowVector3d::Zero();
+    for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
+      pull += member_correction.row(model.vertex_memberships[s]);
+    member_correction.row(vertex_pull_row[v]) = pull * vertex_inv_count[v];
+  }
+}
+
 // Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
 // asleep) and block.pull, the mean of each vertex's corrections in membership order (never
 // the sum); kStart: 0, after loading u = x - x0 and v from the state (anchors included: they
 // hold where they are).
 void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n,
                                    VertexBlock& block) {
-  const double inv_h = 1.0 / h;
   for (int k = 0; k < n; ++k) {
     const size_t v = begin + k;
     const bool still = model.vertex_anchored[v] || vertex_inv_count[v] == 0 ||
@@ -504,8 +558,8 @@ void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_as
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? 0.0 : vertex_drag[v];
     block.damping[k] = still ? 1.0 : vertex_damping[v];
-    block.pull_back[k] = still ? 0.0 : vertex_global[v] * inv_h;
-    block.falling[k] = !still && vertex_flying[v] ? 1.0 : 0.0;
+    block.global[k] = still ? 0.0 : vertex_global[v];
+    block.flying[k] = still ? 0 : vertex_flying[v];
     Eigen::Vector3d pull = Eigen::Vector3d::Zero();
     if (pass == Pass::kStart) {
       predicted_offset.row(v) = (state.positions.col(v) - model.rest_positions.col(v)).transpose();
@@ -525,7 +579,7 @@ void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_as
 // Returns true when some moving vertex turned non-finite or (kEnd) ran away; the caller
 // finds which.
 template <bool kEnd, bool kDetach>
-bool Simulator::Impl::predict_block(size_t begin, int n, VertexBlock& block) {
+bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in, VertexBlock& block) {
   const double inv_h = 1.0 / h, step = h;
   const double gravity_step[3] = {options.gravity.x() * h, options.gravity.y() * h, options.gravity.z() * h};
   double* offset[3] = {predicted_offset.col(0).data() + begin, predicted_offset.col(1).data() + begin,
@@ -547,19 +601,18 @@ bool Simulator::Impl::predict_block(size_t begin, int n, VertexBlock& block) {
   double* velocity_z = velocity[2];
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
-    const uint32_t c = air_cluster[k];
-    const double ux = offset_x[k] + block.pull[0][k], uy = offset_y[k] + block.pull[1][k],
-                 uz = offset_z[k] + block.pull[2][k];
-    const double vx = velocity_x[k] + block.pull[0][k] * inv_h, vy = velocity_y[k] + block.pull[1][k] * inv_h,
-                 vz = velocity_z[k] + block.pull[2][k] * inv_h;
+    const uint32_t c = air_cluster[k], row = in.pull_row[k];
+    const double px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+    const double ux = offset_x[k] + px, uy = offset_y[k] + py, uz = offset_z[k] + pz;
+    const double vx = velocity_x[k] + px * inv_h, vy = velocity_y[k] + py * inv_h, vz = velocity_z[k] + pz * inv_h;
     const double rx = air[0][c] - vx, ry = air[1][c] - vy, rz = air[2][c] - vz;
     // Quadratic drag integrated exactly over the step for constant air velocity:
     // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
     // the air velocity, whatever the wind speed or step.
-    const double kuh = block.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
+    const double kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
     const double share = kuh / (1 + kuh);
     // A flying leaf falls (its global rate is 0); an attached vertex is pulled back.
-    const double damping = block.damping[k], falling = block.falling[k], pull_back = block.pull_back[k];
+    const double damping = in.damping[k], falling = static_cast<double>(in.flying[k]), pull_back = in.global[k] * inv_h;
     const double nx = ((vx * damping + rx * share) + falling * gravity_step[0]) - pull_back * ux;
     const double ny = ((vy * damping + ry * share) + falling * gravity_step[1]) - pull_back * uy;
     const double nz = ((vz * damping + rz * share) + falling * gravity_step[2]) - pull_back * uz;
