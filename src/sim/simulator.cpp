@@ -97,9 +97,8 @@ struct Simulator::Impl {
   // (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
   std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
   Eigen::MatrixX3d member_offset;          // (M x 3) m, rest offset q = x0 - t0 from the cluster's rest centre
-  // (M x 3) 1/m, s q with s = w / sum(w |q|^2): the rest offset weighted so that A_pq is
-  // of order 1 for any cluster size
-  Eigen::MatrixX3d member_weighted_offset;
+  // (M) 1/m^2, s = w / sum(w |q|^2): the weight that makes A_pq of order 1 for any cluster size
+  std::vector<double> member_match_weight;
   std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
   // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
@@ -237,7 +236,7 @@ void Simulator::Impl::precompute_members() {
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
       member_cluster[s] = static_cast<uint32_t>(c);
   member_offset.setZero(M, 3);
-  member_weighted_offset.setZero(M, 3);
+  member_match_weight.assign(M, 0);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
   member_correction.setZero(M + 1, 3);
@@ -292,7 +291,7 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
     const double match_weight = total > 0 ? weight(s) * inv_spread : 0.0;
     const Eigen::Vector3d q = member_offset.row(s).transpose();
     member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
-    member_weighted_offset.row(s) = match_weight * q.transpose();
+    member_match_weight[s] = match_weight;
     offset_sum += match_weight * q;
     centre_offset += member_centre_weight[s] * q;
     // Each entry as s (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
@@ -661,15 +660,23 @@ bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R,
   // t - t0 = sum (w / sum w) u_p + sum (w / sum w) q and A' = sum s d q^T = sum u_p (s q)^T +
   // sum s q q^T; then A_pq = A' - shift (sum s q)^T, with the computed sum s q (0 but for
   // round-off). At the rest pose u_p = 0 and A_pq is the exactly symmetric rest moment.
-  Eigen::Vector3d centre_shift = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  // q is read here and again by write_corrections, while it is in cache.
+  double a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
+  double sx = 0, sy = 0, sz = 0;
   for (uint32_t s = begin; s < end; ++s) {
-    const Eigen::Vector3d u = predicted_offset.row(model.cluster_members[s]).transpose();
-    const Eigen::Vector3d weighted_q = member_weighted_offset.row(s).transpose();
-    centre_shift += member_centre_weight[s] * u;
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) A(i, j) += u[i] * weighted_q[j];
+    const uint32_t v = model.cluster_members[s];
+    const double x = predicted_offset(v, 0), y = predicted_offset(v, 1), z = predicted_offset(v, 2);
+    const double weight = member_match_weight[s];
+    const double wx = weight * member_offset(s, 0), wy = weight * member_offset(s, 1), wz = weight * member_offset(s, 2);
+    const double centre = member_centre_weight[s];
+    sx += centre * x, sy += centre * y, sz += centre * z;
+    a00 += x * wx, a01 += x * wy, a02 += x * wz;
+    a10 += y * wx, a11 += y * wy, a12 += y * wz;
+    a20 += z * wx, a21 += z * wy, a22 += z * wz;
   }
+  const Eigen::Vector3d centre_shift(sx, sy, sz);
+  Eigen::Matrix3d A;
+  A << a00, a01, a02, a10, a11, a12, a20, a21, a22;
   shift = centre_shift + cluster_centre_offset.col(c);
   A += Eigen::Map<const Eigen::Matrix3d>(&cluster_rest_moment(0, c));
   A -= shift * cluster_offset_sum.col(c).transpose();
