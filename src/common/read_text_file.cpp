@@ -1,45 +1,35 @@
 #include "common/read_text_file.h"
 
 #include <fstream>
+#include <utility>
 
 namespace treeanim {
 
 bool read_text_file(const std::filesystem::path& path, std::string& text, std::string& reason,
                     std::uintmax_t max_bytes) {
   text.clear();
+  auto fail = [&](std::string why) {
+    text.clear();
+    reason = std::move(why);
+    return false;
+  };
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
-  if (!std::filesystem::exists(status)) {
-    reason = "no such file";
-    return false;
-  }
+  if (!std::filesystem::exists(status)) return fail("no such file");
   std::ifstream in(path, std::ios::binary);
-  if (!in || std::filesystem::is_directory(status)) {
-    reason = "not a readable file";
-    return false;
-  }
+  if (!in || std::filesystem::is_directory(status)) return fail("not a readable file");
   const std::string too_large =
       "larger than " + (max_bytes % (1 << 20) == 0 ? std::to_string(max_bytes >> 20) + " MiB"
                                                    : std::to_string(max_bytes) + " bytes");
-  if (std::filesystem::is_regular_file(status) && std::filesystem::file_size(path, error) > max_bytes && !error) {
-    reason = too_large;
-    return false;
-  }
+  if (std::filesystem::is_regular_file(status) && std::filesystem::file_size(path, error) > max_bytes && !error)
+    return fail(too_large);
   // Chunks up to the cap: the size of a device or pipe is not known in advance.
   char chunk[1 << 16];
   while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
     text.append(chunk, static_cast<size_t>(in.gcount()));
-    if (text.size() > max_bytes) {
-      text.clear();
-      reason = too_large;
-      return false;
-    }
+    if (text.size() > max_bytes) return fail(too_large);
   }
-  if (in.bad()) {
-    text.clear();
-    reason = "not a readable file";
-    return false;
-  }
+  if (in.bad()) return fail("not a readable file");
   return true;
 }
 

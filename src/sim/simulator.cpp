@@ -470,14 +470,16 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
     // a frame starts from the state, each block is gathered lane by lane.
     const bool direct = pass != Pass::kStart && !any_asleep;
     if (direct) average_shared_pulls(first, last);
+    const double* corrections[3] = {member_correction.col(0).data(), member_correction.col(1).data(),
+                                    member_correction.col(2).data()};
     VertexBlock block;
     for (size_t begin = first; begin < last; begin += kVertexBlock) {
       const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
       VertexInputs in;
       if (direct) {
-        for (int i = 0; i < 3; ++i) in.pull[i] = member_correction.col(i).data();
-        in = {{in.pull[0], in.pull[1], in.pull[2]}, vertex_pull_row.data() + begin, vertex_drag.data() + begin,
-              vertex_damping.data() + begin, vertex_global.data() + begin, vertex_flying.data() + begin};
+        in = {{corrections[0], corrections[1], corrections[2]}, vertex_pull_row.data() + begin,
+              vertex_drag.data() + begin, vertex_damping.data() + begin, vertex_global.data() + begin,
+              vertex_flying.data() + begin};
         std::fill(block.moving, block.moving + n, uint8_t(1));
       } else {
         gather_block(state, pass, any_asleep, begin, n, block);
@@ -513,18 +515,18 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
       }
     }
   }
-  if (bad != kNone)
-    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-                          std::to_string(vertex_air_cluster[bad]) + " (vertex " + std::to_string(bad) +
-                          "): non-finite position or velocity");
+  // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
+  auto where = [&](uint32_t v) {
+    return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+           std::to_string(vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
+  };
+  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
   if (runaway != kNone) {
     char distances[96];
     std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m)",
                   (state.positions.col(runaway) - model.rest_positions.col(runaway)).norm(),
                   std::sqrt(runaway_distance2) / 2);
-    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-                          std::to_string(vertex_air_cluster[runaway]) + " (vertex " + std::to_string(runaway) +
-                          "): " + distances +
+    throw SimulationError(where(runaway) + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
   }
   return any_asleep;
@@ -581,10 +583,6 @@ template <bool kEnd, bool kDetach>
 bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in, VertexBlock& block) {
   const double inv_h = 1.0 / h, step = h;
   const double gravity_step[3] = {options.gravity.x() * h, options.gravity.y() * h, options.gravity.z() * h};
-  double* offset[3] = {predicted_offset.col(0).data() + begin, predicted_offset.col(1).data() + begin,
-                       predicted_offset.col(2).data() + begin};
-  double* velocity[3] = {step_velocity.col(0).data() + begin, step_velocity.col(1).data() + begin,
-                         step_velocity.col(2).data() + begin};
   const double* air[3] = {cluster_air.col(0).data(), cluster_air.col(1).data(), cluster_air.col(2).data()};
   double* force[3] = {nullptr, nullptr, nullptr};
   if constexpr (kDetach)
@@ -592,12 +590,10 @@ bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in,
   const uint32_t* air_cluster = vertex_air_cluster.data() + begin;
   const double* mass = model.vertex_mass.data() + begin;
   const double limit2 = runaway_distance2;
-  double* offset_x = offset[0];
-  double* offset_y = offset[1];
-  double* offset_z = offset[2];
-  double* velocity_x = velocity[0];
-  double* velocity_y = velocity[1];
-  double* velocity_z = velocity[2];
+  double *offset_x = predicted_offset.col(0).data() + begin, *offset_y = predicted_offset.col(1).data() + begin,
+         *offset_z = predicted_offset.col(2).data() + begin;
+  double *velocity_x = step_velocity.col(0).data() + begin, *velocity_y = step_velocity.col(1).data() + begin,
+         *velocity_z = step_velocity.col(2).data() + begin;
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
     const uint32_t c = air_cluster[k], row = in.pull_row[k];

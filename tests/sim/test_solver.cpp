@@ -248,7 +248,6 @@ TEST(Solver, DegenerateClustersStayFinite) {
   EXPECT_TRUE(state.positions.allFinite());
 }
 
-}  // namespace
 // The last step of a frame predicts the next frame's first step for the state it wrote
 // (SimState::prediction_stamp). A copy taken mid-bake and resumed by another simulator, and a
 // state edited by hand with the stamp reset, must be predicted from their positions instead.
@@ -282,4 +281,5 @@ TEST(Solver, ResumedAndEditedStatesArePredictedFromTheirPositions) {
   EXPECT_EQ((edited.velocities - fresh_copy.velocities).cwiseAbs().maxCoeff(), 0.0);
 }
 
+}  // namespace
 }  // namespace treeanim
