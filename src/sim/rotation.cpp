@@ -39,19 +39,29 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
     const double trace = R.col(0).dot(A.col(0)) + R.col(1).dot(A.col(1)) + R.col(2).dot(A.col(2));
     // Converged (cheap test first): the gradient step is below 1e-12 rad, so even the Newton
     // step about the long axis of a 1000:1 cluster is below 1e-9 rad.
-    if (!(torque.norm() >= 1e-12 * (std::abs(trace) + kEps))) break;
+    const double scale = std::abs(trace) + kEps;
+    if (!(torque.squaredNorm() >= 1e-24 * scale * scale)) break;
+    // H = tr(M)(1 + eps) I - sym(M), M = A R^T: symmetric, so six cofactors give its
+    // determinant, Sylvester's leading minors and the Newton step adj(H) torque / det(H).
     const Eigen::Matrix3d M = A * R.transpose();
-    Eigen::Matrix3d H = -0.5 * (M + M.transpose());
-    H.diagonal().array() += trace * (1 + kEps);
+    const double diagonal = trace * (1 + kEps);
+    const double h00 = diagonal - M(0, 0), h11 = diagonal - M(1, 1), h22 = diagonal - M(2, 2);
+    const double h01 = -0.5 * (M(0, 1) + M(1, 0)), h02 = -0.5 * (M(0, 2) + M(2, 0)), h12 = -0.5 * (M(1, 2) + M(2, 1));
+    const double c00 = h11 * h22 - h12 * h12, c01 = h02 * h12 - h01 * h22, c02 = h01 * h12 - h02 * h11;
+    const double c11 = h00 * h22 - h02 * h02, c12 = h01 * h02 - h00 * h12, c22 = h00 * h11 - h01 * h01;
+    const double det = h00 * c00 + h01 * c01 + h02 * c02;
     // Sylvester's criterion: H positive definite => the Newton step is an ascent step.
-    const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
-    const double det = H.determinant();
+    const bool newton = trace > 0 && h00 > 0 && c22 > 0 && det > 0;
     Eigen::Vector3d omega;
-    const bool newton = trace > 0 && H(0, 0) > 0 && minor2 > 0 && det > 0;
-    if (newton)
-      omega = H.inverse() * torque;
-    else
-      omega = torque * (1.0 / (std::abs(trace) + kEps));
+    if (newton) {
+      const double inv_det = 1 / det;
+      omega = Eigen::Vector3d(c00 * torque.x() + c01 * torque.y() + c02 * torque.z(),
+                              c01 * torque.x() + c11 * torque.y() + c12 * torque.z(),
+                              c02 * torque.x() + c12 * torque.y() + c22 * torque.z()) *
+              inv_det;
+    } else {
+      omega = torque * (1.0 / scale);
+    }
     double angle = omega.norm();
     if (!(angle >= kEps)) break;  // also stops on NaN: the caller checks the result
     if (angle > kMaxStep) {

@@ -88,6 +88,8 @@ SimOptions read_sim_options(SceneObject section) {
   o.sleep_distance = section.number("sleep_distance", o.sleep_distance, Range::positive());
   o.rotation_iterations =
       static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
+  o.precision = section.choice("precision", "double", {"double", "float"}) == "double" ? Precision::kDouble
+                                                                                       : Precision::kFloat;
   // Per-step rates of 0 for both terms leave nothing holding the tree: refuse, not bake a
   // tree that blows away.
   if (o.stiffness == StiffnessMode::kPerStep && o.alpha == 0 && (o.k_d == 0 || !o.global_matching))

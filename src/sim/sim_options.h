@@ -17,6 +17,12 @@ enum class StiffnessMode : uint8_t {
   kPerStep,   // the paper's alpha and k_d, used as given at every step
 };
 
+// What the solver stores its step state in (docs/solver.md, "Precision").
+enum class Precision : uint8_t {
+  kDouble,  // the reference: exact rigid motions, bit-stable golden files
+  kFloat,   // half the memory traffic; ~1e-7 relative round-off, far below the step's error
+};
+
 struct SimOptions {
   // Filled from /hsm by read_sim_options.
   bool global_matching = true;           // paper Eq. 8 on/off
@@ -35,6 +41,7 @@ struct SimOptions {
   double sleep_velocity = 1e-6;          // m/s, every vertex slower than this ...
   double sleep_distance = 1e-6;          // m, ... and closer than this to rest => island sleeps
   int rotation_iterations = 12;          // max iterations of the rotation extraction per step
+  Precision precision = Precision::kDouble;  // storage of the step state
 };
 
 // One key of the wind time series; between keys the wind vector speed*direction and the gust

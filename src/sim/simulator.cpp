@@ -53,32 +53,52 @@ const std::array<uint32_t, kVertexBlock> kLaneIndex = [] {
 }();
 // Where predict_block reads a block's vertices: the mean correction of vertex k is row
 // pull_row[k] of `pull`; the factors are per vertex.
+template <typename Real>
 struct VertexInputs {
-  const double* pull[3];
+  const Real* pull[3];
   const uint32_t* pull_row;
-  const double *drag, *damping, *global;
+  const Real *drag, *damping, *global;
   const uint8_t* flying;
 };
 
+template <typename Real>
 struct VertexBlock {
-  uint8_t moving[kVertexBlock];              // 1: the vertex steps; 0: anchored, asleep, no cluster
-  double pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
+  uint8_t moving[kVertexBlock];            // 1: the vertex steps; 0: anchored, asleep, no cluster
+  Real pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
   // Per-step factors of each vertex; a vertex that does not move gets those of a still
   // point (damping 1, no drag, no pull, no fall), which map its u = 0, v = 0 onto themselves
   // exactly, so that the loop needs no branch.
-  double drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
-  double damping[kVertexBlock];              // velocity factor
-  double global[kVertexBlock];               // global rate per step
-  uint8_t flying[kVertexBlock];              // 1 on a flying leaf
-  double end_offset[3][kVertexBlock];        // m, corrected u at the end of a frame (kEnd)
-  double end_velocity[3][kVertexBlock];      // m/s, corrected v at the end of a frame (kEnd)
-  double check[kVertexBlock];                // sum of the new values: finite iff all are
-  double excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
+  Real drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
+  Real damping[kVertexBlock];              // velocity factor
+  Real global[kVertexBlock];               // global rate per step
+  uint8_t flying[kVertexBlock];            // 1 on a flying leaf
+  Real end_offset[3][kVertexBlock];        // m, corrected u at the end of a frame (kEnd)
+  Real end_velocity[3][kVertexBlock];      // m/s, corrected v at the end of a frame (kEnd)
+  Real check[kVertexBlock];                // sum of the new values: finite iff all are
+  Real excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
 };
 
 }  // namespace
 
+// What the Simulator forwards to: the solver in the precision the options ask for.
 struct Simulator::Impl {
+  virtual ~Impl() = default;
+  virtual SimState initial_state(double time) const = 0;
+  virtual void advance_frame(SimState& state, long long frame) = 0;
+};
+
+namespace {
+
+// The solver, its step state stored in `Real` (docs/solver.md, "Precision"): rest offsets,
+// predicted offsets, velocities, corrections and per-vertex factors, the arrays every step
+// streams through. Sums that decide a rotation (A_pq, the centre), rates and the state
+// handed out stay in double.
+template <typename Real>
+struct Solver final : Simulator::Impl {
+  using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;  // (n x 3), a column per axis
+  using Vector3 = Eigen::Matrix<Real, 3, 1>;
+  using Inputs = VertexInputs<Real>;
+  using Block = VertexBlock<Real>;
   const TreeModel& model;
   SimOptions options;
   WindField wind;
@@ -96,26 +116,28 @@ struct Simulator::Impl {
   // Arrays of 3-vectors read or written in the step are (n x 3): a column per axis
   // (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
   std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
-  Eigen::MatrixX3d member_offset;          // (M x 3) m, rest offset q = x0 - t0 from the cluster's rest centre
-  // (M) 1/m^2, s = w / sum(w |q|^2): the weight that makes A_pq of order 1 for any cluster size
-  std::vector<double> member_match_weight;
-  std::vector<double> member_centre_weight;// (M) w / sum(w): mass share in the cluster's centre
+  Rows3 member_offset;                     // (M x 3) m, rest offset q = x0 - t0 from the cluster's rest centre
+  // (M) w / sum(w): mass share in the cluster's centre; times cluster_match_scale, the weight
+  // of the member in A_pq
+  std::vector<Real> member_centre_weight;
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
   // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
   // anchor). Before the vertex prediction, the first membership's row of a shared vertex
   // takes the vertex's mean correction (average_shared_pulls).
-  Eigen::MatrixX3d member_correction;
+  Rows3 member_correction;
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
+  // (C) 1/m^2, 1 / sum((w / sum w) |q|^2): A_pq = sum s d q^T with s = (w / sum w) times it
+  // is of order 1 for any cluster size
+  std::vector<double> cluster_match_scale;
   Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s q over the members: round-off only
-  Eigen::Matrix3Xd cluster_centre_offset;  // (3 x C) m, sum of (w / sum w) q: round-off only
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s q q^T, column-major: A_pq at rest
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
   std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
-  Eigen::MatrixX3d cluster_air;            // (C x 3) m/s, air velocity at the cluster this step
+  Rows3 cluster_air;                       // (C x 3) m/s, air velocity at the cluster this step
   Eigen::Matrix3Xd cluster_shift;          // (3 x C) m, t - t0: the centre of the last fit from the rest centre
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of the last fit, column-major
   std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
@@ -123,23 +145,23 @@ struct Simulator::Impl {
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
 
   // --- per vertex (V) ---
-  std::vector<double> vertex_global;       // (V) global rate per step (0: off, anchored, flying)
-  std::vector<double> vertex_damping;      // (V) velocity factor per step
-  std::vector<double> vertex_drag;         // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
-  std::vector<double> vertex_inv_count;    // (V) 1 / number of active memberships (0: none)
+  std::vector<Real> vertex_global;         // (V) global rate per step (0: off, anchored, flying)
+  std::vector<Real> vertex_damping;        // (V) velocity factor per step
+  std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
   std::vector<uint32_t> vertex_pull_row;   // (V) row of member_correction with its mean correction (M: anchored)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
-  Eigen::MatrixX3d vertex_drag_force;      // (V x 3) N, drag of the last step; only with detachment
+  Rows3 vertex_drag_force;                 // (V x 3) N, drag of the last step; only with detachment
   // (V x 3) m, u = p - x0: the predicted position p = x + h v* of the current step as a
   // displacement from rest. Small numbers wherever the tree stands, and x0 is not read
   // again until the frame ends.
-  Eigen::MatrixX3d predicted_offset;
+  Rows3 predicted_offset;
   // (V x 3) m/s, v* of the current step; the state holds v at the end of a frame. After
   // the last step it holds v* of the next frame's first step (see frame()).
-  Eigen::MatrixX3d step_velocity;
+  Rows3 step_velocity;
 
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   size_t I = 0;
@@ -164,7 +186,9 @@ struct Simulator::Impl {
   double air_scale = 0;                                // m/s, turbulence amplitude
   double turbulence_sin_b[kMaxModes], turbulence_cos_b[kMaxModes];
 
-  Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n);
+  Solver(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n);
+  SimState initial_state(double time) const override;
+  void advance_frame(SimState& state, long long frame) override;
   void precompute_members();
   void rebuild_cluster_rest(uint32_t c);
   void precompute_drag(const WindOptions& w);
@@ -178,9 +202,9 @@ struct Simulator::Impl {
   void sample_air(const SimState& state);
   enum class Pass { kStart, kStep, kEnd };
   bool vertex_pass(SimState& state, Pass pass, long long frame, int substep);
-  void gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n, VertexBlock& block);
+  void gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n, Block& block);
   template <bool kEnd, bool kDetach>
-  bool predict_block(size_t begin, int n, const VertexInputs& in, VertexBlock& block);
+  bool predict_block(size_t begin, int n, const Inputs& in, Block& block);
   void average_shared_pulls(size_t first, size_t last);
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
@@ -193,7 +217,8 @@ struct Simulator::Impl {
   }
 };
 
-Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n)
+template <typename Real>
+Solver<Real>::Solver(const TreeModel& m, const SimOptions& o, const WindOptions& w, double dt, int n)
     : model(m), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n),
       V(m.vertex_count()), C(m.cluster_count()), M(m.membership_count()), L(m.leaf_count()),
       detach_enabled(o.leaf_detach_force > 0 && m.leaf_count() > 0),
@@ -205,8 +230,8 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
   precompute_members();
   const StepRates rates = compute_step_rates(model, options, h);
   cluster_alpha = rates.cluster_alpha;
-  vertex_global = rates.vertex_global;
-  vertex_damping = rates.vertex_damping;
+  vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
+  vertex_damping.assign(rates.vertex_damping.begin(), rates.vertex_damping.end());
   precompute_drag(w);
   precompute_islands();
   island_fell_asleep.assign(I, 0);
@@ -230,19 +255,19 @@ Simulator::Impl::Impl(const TreeModel& m, const SimOptions& o, const WindOptions
 }
 
 // Model CSR => per-membership cluster ids, rest offsets, weights; per-vertex counts.
-void Simulator::Impl::precompute_members() {
+template <typename Real>
+void Solver<Real>::precompute_members() {
   member_cluster.resize(M);
   for (size_t c = 0; c < C; ++c)
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
       member_cluster[s] = static_cast<uint32_t>(c);
   member_offset.setZero(M, 3);
-  member_match_weight.assign(M, 0);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
   member_correction.setZero(M + 1, 3);
   cluster_rest_centre.setZero(3, C);
+  cluster_match_scale.assign(C, 0);
   cluster_offset_sum.setZero(3, C);
-  cluster_centre_offset.setZero(3, C);
   cluster_rest_moment.setZero(9, C);
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   vertex_inv_count.assign(V, 0);
@@ -250,7 +275,7 @@ void Simulator::Impl::precompute_members() {
   vertex_pull_row.assign(V, static_cast<uint32_t>(M));
   for (size_t v = 0; v < V; ++v) {
     const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
-    vertex_inv_count[v] = end > begin ? 1.0 / double(end - begin) : 0.0;
+    vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
     vertex_air_cluster[v] = end > begin ? member_cluster[model.vertex_memberships[begin]] : 0;
     if (model.vertex_anchored[v] || end == begin) continue;
     vertex_pull_row[v] = model.vertex_memberships[begin];
@@ -261,7 +286,8 @@ void Simulator::Impl::precompute_members() {
 // Active members of cluster c => its rest centre, rest offsets and normalised weights.
 // Weights are vertex masses; a cluster without mass (all members anchored or massless)
 // falls back to equal weights, so its shape is still defined.
-void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
+template <typename Real>
+void Solver<Real>::rebuild_cluster_rest(uint32_t c) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   double total = 0;
   for (uint32_t s = begin; s < end; ++s)
@@ -277,45 +303,46 @@ void Simulator::Impl::rebuild_cluster_rest(uint32_t c) {
   for (uint32_t s = begin; s < end; ++s)
     centre += (weight(s) / total) * model.rest_positions.col(model.cluster_members[s]);
   cluster_rest_centre.col(c) = centre;
-  double spread = 0;  // sum w |q|^2, kg m^2
-  for (uint32_t s = begin; s < end; ++s) {
-    member_offset.row(s) = member_active[s] ? Eigen::RowVector3d((model.rest_positions.col(model.cluster_members[s]) - centre).transpose())
-                                            : Eigen::RowVector3d::Zero();
-    spread += weight(s) * member_offset.row(s).squaredNorm();
-  }
-  // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
-  const double inv_spread = spread > 0 ? 1.0 / spread : 0.0;
-  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero(), centre_offset = Eigen::Vector3d::Zero();
+  // The sums below are taken over the stored (Real) q and weights, the values the step reads.
+  double spread = 0;  // sum (w / sum w) |q|^2, m^2
+  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
-    const double match_weight = total > 0 ? weight(s) * inv_spread : 0.0;
-    const Eigen::Vector3d q = member_offset.row(s).transpose();
-    member_centre_weight[s] = total > 0 ? weight(s) / total : 0.0;
-    member_match_weight[s] = match_weight;
-    offset_sum += match_weight * q;
-    centre_offset += member_centre_weight[s] * q;
-    // Each entry as s (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
+    const Eigen::Vector3d exact = member_active[s] ? Eigen::Vector3d(model.rest_positions.col(model.cluster_members[s]) - centre)
+                                                   : Eigen::Vector3d::Zero();
+    member_offset.row(s) = exact.transpose().template cast<Real>();
+    member_centre_weight[s] = static_cast<Real>(total > 0 ? weight(s) / total : 0.0);
+    const double share = member_centre_weight[s];
+    const Eigen::Vector3d q = member_offset.row(s).transpose().template cast<double>();
+    spread += share * q.squaredNorm();
+    offset_sum += share * q;
+    // Each entry as w (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) moment(i, j) += match_weight * (q[i] * q[j]);
+      for (int i = 0; i < 3; ++i) moment(i, j) += share * (q[i] * q[j]);
   }
-  cluster_offset_sum.col(c) = offset_sum;
-  cluster_centre_offset.col(c) = centre_offset;
+  // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
+  const double scale = spread > 0 ? 1.0 / spread : 0.0;
+  cluster_match_scale[c] = scale;
+  moment *= scale;
+  cluster_offset_sum.col(c) = scale * offset_sum;
   Eigen::Map<Eigen::Matrix3d>(&cluster_rest_moment(0, c)) = moment;
 }
 
 // Drag areas and coefficients => per-vertex drag constants.
-void Simulator::Impl::precompute_drag(const WindOptions& w) {
+template <typename Real>
+void Solver<Real>::precompute_drag(const WindOptions& w) {
   vertex_drag.assign(V, 0);
   for (size_t v = 0; v < V; ++v) {
     const double mass = model.vertex_mass[v];
     if (model.vertex_anchored[v] || !(mass > 0)) continue;
     const double cd = model.vertex_leaf[v] >= 0 ? w.leaf_drag_coefficient : w.branch_drag_coefficient;
-    vertex_drag[v] = 0.5 * w.air_density * cd * model.vertex_drag_area[v] / mass;
+    vertex_drag[v] = static_cast<Real>(0.5 * w.air_density * cd * model.vertex_drag_area[v] / mass);
   }
 }
 
 // Clusters sharing a non-anchored vertex => one island (anchors hold, they do not couple).
-void Simulator::Impl::precompute_islands() {
+template <typename Real>
+void Solver<Real>::precompute_islands() {
   std::vector<uint32_t> parent(C);
   std::iota(parent.begin(), parent.end(), 0u);
   for (size_t v = 0; v < V; ++v) {
@@ -352,7 +379,8 @@ void Simulator::Impl::precompute_islands() {
 
 // Leaves => the membership slots that pin each attached leaf to its branch (see match_clusters).
 // A leaf whose shared vertex is in no other cluster is matched like a branch.
-void Simulator::Impl::precompute_pins() {
+template <typename Real>
+void Solver<Real>::precompute_pins() {
   cluster_pin_slot.assign(C, kNone);
   cluster_pin_own_slot.assign(C, kNone);
   for (size_t l = 0; l < L; ++l) {
@@ -373,7 +401,8 @@ void Simulator::Impl::precompute_pins() {
 // Releases leaf `leaf` from its branch (paper 4.2): the shared vertex stays with the side it
 // was built for (a leaf vertex leaves its branch clusters; a branch vertex leaves the leaf),
 // the clusters that lost a member get new rest data, and the leaf's vertices fly.
-void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
+template <typename Real>
+void Solver<Real>::detach_leaf(SimState& state, size_t leaf) {
   const uint32_t c = model.leaf_cluster[leaf];
   const uint32_t a = model.leaf_attachment_vertex[leaf];
   const bool goes_with_leaf = model.vertex_leaf[a] == static_cast<int32_t>(leaf);
@@ -408,7 +437,8 @@ void Simulator::Impl::detach_leaf(SimState& state, size_t leaf) {
 
 // state.leaf_attached => the arrays of this simulator (a state may come from a checkpoint);
 // true when a leaf was detached here.
-bool Simulator::Impl::sync_detachments(SimState& state) {
+template <typename Real>
+bool Solver<Real>::sync_detachments(SimState& state) {
   bool changed = false;
   for (size_t l = 0; l < L; ++l) {
     if (state.leaf_attached[l] == applied_attached[l]) continue;
@@ -421,28 +451,32 @@ bool Simulator::Impl::sync_detachments(SimState& state) {
 
 // t => the wind terms shared by every cluster at t (base wind, turbulence amplitude and
 // temporal phases), for sample_cluster_air.
-void Simulator::Impl::set_air_time(double t) {
+template <typename Real>
+void Solver<Real>::set_air_time(double t) {
   air_base = wind.base(t);
   air_scale = wind.temporal_phases(t, turbulence_sin_b, turbulence_cos_b);
 }
 
 // Air velocity at cluster c (its rest centre; a flying leaf: its centre of the last fit).
-void Simulator::Impl::sample_cluster_air(size_t c) {
+template <typename Real>
+void Solver<Real>::sample_cluster_air(size_t c) {
   const int N = wind.mode_count();
   if (cluster_flying[c]) {
     double sin_a[kMaxModes], cos_a[kMaxModes];
     wind.spatial_phases(Eigen::Vector3d(cluster_rest_centre.col(c) + cluster_shift.col(c)), sin_a, cos_a);
-    cluster_air.row(c) = (air_base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, air_scale)).transpose();
+    const Eigen::Vector3d air = air_base + wind.turbulence(sin_a, cos_a, turbulence_sin_b, turbulence_cos_b, air_scale);
+    cluster_air.row(c) = air.transpose().template cast<Real>();
   } else {
-    cluster_air.row(c) = (air_base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
-                                                     turbulence_sin_b, turbulence_cos_b, air_scale))
-                             .transpose();
+    const Eigen::Vector3d air = air_base + wind.turbulence(&cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N],
+                                                           turbulence_sin_b, turbulence_cos_b, air_scale);
+    cluster_air.row(c) = air.transpose().template cast<Real>();
   }
 }
 
 // Air velocity of every awake cluster (at the start of a frame; later steps sample it in
 // match_clusters, saving a parallel region per step).
-void Simulator::Impl::sample_air(const SimState& state) {
+template <typename Real>
+void Solver<Real>::sample_air(const SimState& state) {
 #pragma omp parallel for schedule(static) if (parallel)
   for (size_t c = 0; c < C; ++c)
     if (cluster_awake(state, c)) sample_cluster_air(c);
@@ -457,7 +491,8 @@ void Simulator::Impl::sample_air(const SimState& state) {
 // positions and velocities to the state, and its prediction is the next frame's first.
 // Returns whether an island was asleep (its vertices were skipped, so their prediction is
 // not current).
-bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, int substep) {
+template <typename Real>
+bool Solver<Real>::vertex_pass(SimState& state, Pass pass, long long frame, int substep) {
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
   uint32_t bad = kNone, runaway = kNone;
@@ -470,12 +505,12 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
     // a frame starts from the state, each block is gathered lane by lane.
     const bool direct = pass != Pass::kStart && !any_asleep;
     if (direct) average_shared_pulls(first, last);
-    const double* corrections[3] = {member_correction.col(0).data(), member_correction.col(1).data(),
+    const Real* corrections[3] = {member_correction.col(0).data(), member_correction.col(1).data(),
                                     member_correction.col(2).data()};
-    VertexBlock block;
+    Block block;
     for (size_t begin = first; begin < last; begin += kVertexBlock) {
       const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
-      VertexInputs in;
+      Inputs in;
       if (direct) {
         in = {{corrections[0], corrections[1], corrections[2]}, vertex_pull_row.data() + begin,
               vertex_drag.data() + begin, vertex_damping.data() + begin, vertex_global.data() + begin,
@@ -491,15 +526,19 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
                                                  : predict_block<true, false>(begin, n, in, block))
                                : (detach_enabled ? predict_block<false, true>(begin, n, in, block)
                                                  : predict_block<false, false>(begin, n, in, block));
-      if (end)
-        for (int k = 0; k < n; ++k) {
-          if (!block.moving[k]) continue;
-          const size_t v = begin + k;
+      if (end) {
+        // (3 x V) columns: x, y, z of a vertex are adjacent. A still lane keeps its value.
+        double* positions = state.positions.data() + 3 * begin;
+        double* velocities = state.velocities.data() + 3 * begin;
+        const double* rest = model.rest_positions.data() + 3 * begin;
+#pragma omp simd
+        for (int k = 0; k < n; ++k)
           for (int i = 0; i < 3; ++i) {
-            state.positions(i, v) = model.rest_positions(i, v) + block.end_offset[i][k];
-            state.velocities(i, v) = block.end_velocity[i][k];
+            const bool moving = block.moving[k] != 0;
+            positions[3 * k + i] = moving ? rest[3 * k + i] + double(block.end_offset[i][k]) : positions[3 * k + i];
+            velocities[3 * k + i] = moving ? double(block.end_velocity[i][k]) : velocities[3 * k + i];
           }
-        }
+      }
       if (flagged) {  // rare: find the first vertex at fault, as the scalar tests would
         for (int k = 0; k < n; ++k) {
           if (!block.moving[k]) continue;
@@ -507,8 +546,9 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
           if (!predicted_offset.row(v).allFinite() || !step_velocity.row(v).allFinite() ||
               (end && !(state.positions.col(v).allFinite() && state.velocities.col(v).allFinite())))
             bad = std::min(bad, v);
-          const double moved2 = end ? Eigen::Vector3d(block.end_offset[0][k], block.end_offset[1][k],
-                                                      block.end_offset[2][k]).squaredNorm()
+          const double moved2 = end ? Vector3(block.end_offset[0][k], block.end_offset[1][k], block.end_offset[2][k])
+                                          .template cast<double>()
+                                          .squaredNorm()
                                     : 0.0;
           if (!vertex_flying[v] && moved2 > runaway_distance2) runaway = std::min(runaway, v);
         }
@@ -534,12 +574,13 @@ bool Simulator::Impl::vertex_pass(SimState& state, Pass pass, long long frame, i
 
 // Shared vertices in [first, last) => the mean of their corrections (in membership order,
 // never the sum) in the row of their first membership, read by the direct vertex pass.
-void Simulator::Impl::average_shared_pulls(size_t first, size_t last) {
+template <typename Real>
+void Solver<Real>::average_shared_pulls(size_t first, size_t last) {
   const auto from = std::lower_bound(shared_vertices.begin(), shared_vertices.end(), first);
   const auto to = std::lower_bound(from, shared_vertices.end(), last);
   for (auto it = from; it != to; ++it) {
     const uint32_t v = *it;
-    Eigen::RowVector3d pull = Eigen::RowVector3d::Zero();
+    Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
     for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
       pull += member_correction.row(model.vertex_memberships[s]);
     member_correction.row(vertex_pull_row[v]) = pull * vertex_inv_count[v];
@@ -550,21 +591,22 @@ void Simulator::Impl::average_shared_pulls(size_t first, size_t last) {
 // asleep) and block.pull, the mean of each vertex's corrections in membership order (never
 // the sum); kStart: 0, after loading u = x - x0 and v from the state (anchors included: they
 // hold where they are).
-void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n,
-                                   VertexBlock& block) {
+template <typename Real>
+void Solver<Real>::gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n,
+                                   Block& block) {
   for (int k = 0; k < n; ++k) {
     const size_t v = begin + k;
     const bool still = model.vertex_anchored[v] || vertex_inv_count[v] == 0 ||
                        (any_asleep && !vertex_flying[v] && state.island_asleep[vertex_island[v]]);
     block.moving[k] = still ? 0 : 1;
-    block.drag[k] = still ? 0.0 : vertex_drag[v];
-    block.damping[k] = still ? 1.0 : vertex_damping[v];
-    block.global[k] = still ? 0.0 : vertex_global[v];
+    block.drag[k] = still ? Real(0) : vertex_drag[v];
+    block.damping[k] = still ? Real(1) : vertex_damping[v];
+    block.global[k] = still ? Real(0) : vertex_global[v];
     block.flying[k] = still ? 0 : vertex_flying[v];
-    Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+    Vector3 pull = Vector3::Zero();
     if (pass == Pass::kStart) {
-      predicted_offset.row(v) = (state.positions.col(v) - model.rest_positions.col(v)).transpose();
-      step_velocity.row(v) = state.velocities.col(v).transpose();
+      predicted_offset.row(v) = (state.positions.col(v) - model.rest_positions.col(v)).transpose().template cast<Real>();
+      step_velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
     } else if (!still) {
       for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
         pull += member_correction.row(model.vertex_memberships[s]).transpose();
@@ -579,39 +621,41 @@ void Simulator::Impl::gather_block(const SimState& state, Pass pass, bool any_as
 // branches, vectorised across vertices: the drag's square root and division dominate it.
 // Returns true when some moving vertex turned non-finite or (kEnd) ran away; the caller
 // finds which.
+template <typename Real>
 template <bool kEnd, bool kDetach>
-bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in, VertexBlock& block) {
-  const double inv_h = 1.0 / h, step = h;
-  const double gravity_step[3] = {options.gravity.x() * h, options.gravity.y() * h, options.gravity.z() * h};
-  const double* air[3] = {cluster_air.col(0).data(), cluster_air.col(1).data(), cluster_air.col(2).data()};
-  double* force[3] = {nullptr, nullptr, nullptr};
+bool Solver<Real>::predict_block(size_t begin, int n, const Inputs& in, Block& block) {
+  const Real inv_h = static_cast<Real>(1.0 / h), step = static_cast<Real>(h);
+  const Real gravity_step[3] = {static_cast<Real>(options.gravity.x() * h), static_cast<Real>(options.gravity.y() * h),
+                                static_cast<Real>(options.gravity.z() * h)};
+  const Real* air[3] = {cluster_air.col(0).data(), cluster_air.col(1).data(), cluster_air.col(2).data()};
+  Real* force[3] = {nullptr, nullptr, nullptr};
   if constexpr (kDetach)
     for (int i = 0; i < 3; ++i) force[i] = vertex_drag_force.col(i).data() + begin;
   const uint32_t* air_cluster = vertex_air_cluster.data() + begin;
   const double* mass = model.vertex_mass.data() + begin;
-  const double limit2 = runaway_distance2;
-  double *offset_x = predicted_offset.col(0).data() + begin, *offset_y = predicted_offset.col(1).data() + begin,
+  const Real limit2 = static_cast<Real>(runaway_distance2);
+  Real *offset_x = predicted_offset.col(0).data() + begin, *offset_y = predicted_offset.col(1).data() + begin,
          *offset_z = predicted_offset.col(2).data() + begin;
-  double *velocity_x = step_velocity.col(0).data() + begin, *velocity_y = step_velocity.col(1).data() + begin,
+  Real *velocity_x = step_velocity.col(0).data() + begin, *velocity_y = step_velocity.col(1).data() + begin,
          *velocity_z = step_velocity.col(2).data() + begin;
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
     const uint32_t c = air_cluster[k], row = in.pull_row[k];
-    const double px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
-    const double ux = offset_x[k] + px, uy = offset_y[k] + py, uz = offset_z[k] + pz;
-    const double vx = velocity_x[k] + px * inv_h, vy = velocity_y[k] + py * inv_h, vz = velocity_z[k] + pz * inv_h;
-    const double rx = air[0][c] - vx, ry = air[1][c] - vy, rz = air[2][c] - vz;
+    const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+    const Real ux = offset_x[k] + px, uy = offset_y[k] + py, uz = offset_z[k] + pz;
+    const Real vx = velocity_x[k] + px * inv_h, vy = velocity_y[k] + py * inv_h, vz = velocity_z[k] + pz * inv_h;
+    const Real rx = air[0][c] - vx, ry = air[1][c] - vy, rz = air[2][c] - vz;
     // Quadratic drag integrated exactly over the step for constant air velocity:
     // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
     // the air velocity, whatever the wind speed or step.
-    const double kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
-    const double share = kuh / (1 + kuh);
+    const Real kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
+    const Real share = kuh / (1 + kuh);
     // A flying leaf falls (its global rate is 0); an attached vertex is pulled back.
-    const double damping = in.damping[k], falling = static_cast<double>(in.flying[k]), pull_back = in.global[k] * inv_h;
-    const double nx = ((vx * damping + rx * share) + falling * gravity_step[0]) - pull_back * ux;
-    const double ny = ((vy * damping + ry * share) + falling * gravity_step[1]) - pull_back * uy;
-    const double nz = ((vz * damping + rz * share) + falling * gravity_step[2]) - pull_back * uz;
-    const double ax = ux + step * nx, ay = uy + step * ny, az = uz + step * nz;
+    const Real damping = in.damping[k], falling = static_cast<Real>(in.flying[k]), pull_back = in.global[k] * inv_h;
+    const Real nx = ((vx * damping + rx * share) + falling * gravity_step[0]) - pull_back * ux;
+    const Real ny = ((vy * damping + ry * share) + falling * gravity_step[1]) - pull_back * uy;
+    const Real nz = ((vz * damping + rz * share) + falling * gravity_step[2]) - pull_back * uz;
+    const Real ax = ux + step * nx, ay = uy + step * ny, az = uz + step * nz;
     velocity_x[k] = nx;
     velocity_y[k] = ny;
     velocity_z[k] = nz;
@@ -619,13 +663,13 @@ bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in,
     offset_y[k] = ay;
     offset_z[k] = az;
     if constexpr (kDetach) {
-      const double scale = mass[k] * inv_h;
+      const Real scale = static_cast<Real>(mass[k]) * inv_h;
       force[0][k] = rx * share * scale;
       force[1][k] = ry * share * scale;
       force[2][k] = rz * share * scale;
     }
-    double sum = ((ax + nx) + (ay + ny)) + (az + nz);
-    double excess = 0;  // > 0: an attached vertex ran away (kEnd)
+    Real sum = ((ax + nx) + (ay + ny)) + (az + nz);
+    Real excess = 0;  // > 0: an attached vertex ran away (kEnd)
     if constexpr (kEnd) {
       block.end_offset[0][k] = ux;
       block.end_offset[1][k] = uy;
@@ -639,41 +683,52 @@ bool Simulator::Impl::predict_block(size_t begin, int n, const VertexInputs& in,
     block.check[k] = sum;
     block.excess[k] = excess;
   }
-  // One test for all values: a sum is finite only if every term is (or past 1e308 m). Kept
-  // out of the loop above: a reduction there stops GCC from vectorising it.
-  bool flagged = false;
-  for (int k = 0; k < n; ++k) flagged |= !(block.check[k] - block.check[k] == 0) || block.excess[k] > 0;
-  return flagged;
+  // One test for the block: a sum of finite values is finite (it only overflows far past any
+  // tree, and then the caller's rescan finds nothing). Kept out of the loop above: a
+  // reduction there stops GCC from vectorising it. The order of the sum decides nothing.
+  Real total = 0, worst = 0;
+#pragma omp simd reduction(+ : total) reduction(max : worst)
+  for (int k = 0; k < n; ++k) {
+    total += block.check[k];
+    worst = std::max(worst, block.excess[k]);
+  }
+  return !(total - total == 0) || worst > 0;
 }
 
 // Shape match of cluster c on the predicted positions => its rotation R (warm start
 // updated) and its centre as t - t0; false when a value is not finite.
-bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
+template <typename Real>
+bool Solver<Real>::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
   // numbers wherever the tree stands and however far it travelled. With the rest terms
   // precomputed, one pass over the displacements sums the centre shift
-  // t - t0 = sum (w / sum w) u_p + sum (w / sum w) q and A' = sum s d q^T = sum u_p (s q)^T +
-  // sum s q q^T; then A_pq = A' - shift (sum s q)^T, with the computed sum s q (0 but for
-  // round-off). At the rest pose u_p = 0 and A_pq is the exactly symmetric rest moment.
+  // t - t0 = sum (w / sum w) u_p and A' = sum s d q^T = sum u_p (s q)^T + sum s q q^T,
+  // s = (w / sum w) k with the cluster's match scale k; then A_pq = A' - shift (sum s q)^T.
+  // sum q (w / sum w) and sum s q are 0 but for the round-off of the stored q; the shift
+  // leaves that residue out, so at the rest pose (u_p = 0) the shift is exactly 0, A_pq is
+  // the exactly symmetric rest moment and no goal pulls a resting tree (in float the residue
+  // is ~1e-8 m, and the slow global term would let it creep ~1e-4 m).
+  // One weight per member serves both sums.
   // q is read here and again by write_corrections, while it is in cache.
-  double a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
-  double sx = 0, sy = 0, sz = 0;
+  // The sums run in Real: in float they carry the same ~1e-7 relative round-off as the offsets they sum.
+  Real a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
+  Real sx = 0, sy = 0, sz = 0;
   for (uint32_t s = begin; s < end; ++s) {
     const uint32_t v = model.cluster_members[s];
-    const double x = predicted_offset(v, 0), y = predicted_offset(v, 1), z = predicted_offset(v, 2);
-    const double weight = member_match_weight[s];
-    const double wx = weight * member_offset(s, 0), wy = weight * member_offset(s, 1), wz = weight * member_offset(s, 2);
-    const double centre = member_centre_weight[s];
-    sx += centre * x, sy += centre * y, sz += centre * z;
+    const Real x = predicted_offset(v, 0), y = predicted_offset(v, 1), z = predicted_offset(v, 2);
+    const Real share = member_centre_weight[s];
+    const Real wx = share * member_offset(s, 0), wy = share * member_offset(s, 1), wz = share * member_offset(s, 2);
+    sx += share * x, sy += share * y, sz += share * z;
     a00 += x * wx, a01 += x * wy, a02 += x * wz;
     a10 += y * wx, a11 += y * wy, a12 += y * wz;
     a20 += z * wx, a21 += z * wy, a22 += z * wz;
   }
   const Eigen::Vector3d centre_shift(sx, sy, sz);
   Eigen::Matrix3d A;
-  A << a00, a01, a02, a10, a11, a12, a20, a21, a22;
-  shift = centre_shift + cluster_centre_offset.col(c);
+  A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
+  A *= cluster_match_scale[c];
+  shift = centre_shift;
   A += Eigen::Map<const Eigen::Matrix3d>(&cluster_rest_moment(0, c));
   A -= shift * cluster_offset_sum.col(c).transpose();
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
@@ -687,22 +742,24 @@ bool Simulator::Impl::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R,
 
 // Goals g = R q + t of cluster c, with t given as t - t0 => per-membership corrections
 // alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p).
-void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift) {
-  const double alpha = cluster_alpha[c];
+template <typename Real>
+void Solver<Real>::write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift) {
+  const Real alpha = static_cast<Real>(cluster_alpha[c]);
   const uint32_t* members = model.cluster_members.data();
   const uint8_t* active = member_active.data();
-  const double *qx = member_offset.col(0).data(), *qy = member_offset.col(1).data(), *qz = member_offset.col(2).data();
-  const double *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
-               *uz = predicted_offset.col(2).data();
-  double *cx = member_correction.col(0).data(), *cy = member_correction.col(1).data(),
-         *cz = member_correction.col(2).data();
-  const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2);
-  const double r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2), tx = shift.x(), ty = shift.y(), tz = shift.z();
+  const Real *qx = member_offset.col(0).data(), *qy = member_offset.col(1).data(), *qz = member_offset.col(2).data();
+  const Real *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
+             *uz = predicted_offset.col(2).data();
+  Real *cx = member_correction.col(0).data(), *cy = member_correction.col(1).data(), *cz = member_correction.col(2).data();
+  const Eigen::Matrix<Real, 3, 3> r = R.template cast<Real>();
+  const Vector3 t = shift.template cast<Real>();
+  const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
+  const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
 #pragma omp simd
   for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
     const uint32_t v = members[s];
-    const double x = qx[s], y = qy[s], z = qz[s];
-    const double weight = active[s] ? alpha : 0.0;  // a released membership pulls nothing
+    const Real x = qx[s], y = qy[s], z = qz[s];
+    const Real weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
     cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
     cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
     cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
@@ -713,7 +770,8 @@ void Simulator::Impl::write_corrections(size_t c, const Eigen::Matrix3d& R, cons
 // then the attached leaves, whose translation is pinned to their branch's goal for the shared
 // vertex (hierarchical: a 1 g leaf cannot drag its branch, nor drift off it in a gale).
 // Each cluster also samples the air of the next step (set_air_time) for the prediction.
-void Simulator::Impl::match_clusters(SimState& state, long long frame, int substep) {
+template <typename Real>
+void Solver<Real>::match_clusters(SimState& state, long long frame, int substep) {
   uint32_t bad = kNone;
 #pragma omp parallel if (parallel) reduction(min : bad)
   {
@@ -741,13 +799,18 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
           continue;
         }
         // The branch's goal for the shared vertex, t0_b + shift_b + R_b q_b, must be the
-        // leaf's goal for it, t + R q_own: so t - t0 = (t0_b - t0) + shift_b + R_b q_b - R q_own.
+        // leaf's goal for it, t + R q_own: so t - t0 = (t0_b - t0) + shift_b + R_b q_b - R q_own,
+        // where (t0_b - t0) + q_b - q_own = 0 (both are the shared vertex's rest position).
+        // Written without that sum, whose round-off (~1e-8 m for float offsets) would pull
+        // every resting leaf, the pin is exactly 0 at rest.
         const uint32_t pin = cluster_pin_slot[c];
         const uint32_t branch = member_cluster[pin];
+        const Eigen::Vector3d branch_offset = member_offset.row(pin).transpose().template cast<double>();
+        const Eigen::Vector3d own_offset = member_offset.row(cluster_pin_own_slot[c]).transpose().template cast<double>();
         const Eigen::Vector3d pinned =
-            (cluster_rest_centre.col(branch) - cluster_rest_centre.col(c)) + cluster_shift.col(branch) +
-            Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * member_offset.row(pin).transpose() -
-            R * member_offset.row(cluster_pin_own_slot[c]).transpose();
+            cluster_shift.col(branch) +
+            (Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * branch_offset - branch_offset) -
+            (R * own_offset - own_offset);
         write_corrections(c, R, pinned);
       }
     }
@@ -758,14 +821,15 @@ void Simulator::Impl::match_clusters(SimState& state, long long frame, int subst
 }
 
 // Drag on each attached leaf => detach those past the threshold (in leaf order).
-void Simulator::Impl::check_detachments(SimState& state) {
+template <typename Real>
+void Solver<Real>::check_detachments(SimState& state) {
   for (size_t l = 0; l < L; ++l) {
     if (!state.leaf_attached[l]) continue;
     const uint32_t c = model.leaf_cluster[l];
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
       const uint32_t v = model.cluster_members[s];
-      if (model.vertex_leaf[v] == static_cast<int32_t>(l)) force += vertex_drag_force.row(v).transpose();
+      if (model.vertex_leaf[v] == static_cast<int32_t>(l)) force += vertex_drag_force.row(v).transpose().template cast<double>();
     }
     if (force.norm() > options.leaf_detach_force) detach_leaf(state, l);
   }
@@ -774,7 +838,8 @@ void Simulator::Impl::check_detachments(SimState& state) {
 // End of a frame at time t: an awake island in calm air whose vertices all rest (slower than
 // sleep_velocity, closer than sleep_distance to rest) is put to sleep exactly at rest;
 // true when one was.
-bool Simulator::Impl::check_sleep(SimState& state, double t) {
+template <typename Real>
+bool Solver<Real>::check_sleep(SimState& state, double t) {
   if (!wind.calm(t)) return false;
   bool fell_asleep = false;
   const double v2 = options.sleep_velocity * options.sleep_velocity;
@@ -808,14 +873,16 @@ bool Simulator::Impl::check_sleep(SimState& state, double t) {
 }
 
 // True when no island is awake and nothing flies: the frame costs nothing.
-bool Simulator::Impl::all_resting(const SimState& state) const {
+template <typename Real>
+bool Solver<Real>::all_resting(const SimState& state) const {
   return std::all_of(state.island_asleep.begin(), state.island_asleep.end(), [](uint8_t a) { return a != 0; }) &&
          std::none_of(cluster_flying.begin(), cluster_flying.end(), [](uint8_t f) { return f != 0; });
 }
 
 // One frame of `substeps` steps from state.time: predict, then per step match the clusters
 // and correct, fused with the next step's prediction.
-void Simulator::Impl::frame(SimState& state, long long frame_index) {
+template <typename Real>
+void Solver<Real>::frame(SimState& state, long long frame_index) {
   const double start = state.time;
   // The last step of the previous frame predicted this frame's first step for exactly this
   // state, unless something changed it since (the stamp is reset below until this frame ends).
@@ -847,36 +914,46 @@ void Simulator::Impl::frame(SimState& state, long long frame_index) {
   if (!skipped_sleepers) state.prediction_stamp = carried_stamp = ++stamps_issued;
 }
 
-Simulator::Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
-                     double frame_dt, int substeps)
-    : impl_(std::make_unique<Impl>(model, options, wind, frame_dt, substeps)) {}
-
-Simulator::~Simulator() = default;
-
-SimState Simulator::initial_state(double time) const {
-  const Impl& s = *impl_;
+template <typename Real>
+SimState Solver<Real>::initial_state(double time) const {
   SimState state;
-  state.positions = s.model.rest_positions;
-  state.velocities.setZero(3, s.V);
-  state.leaf_attached.assign(s.L, 1);
+  state.positions = model.rest_positions;
+  state.velocities.setZero(3, V);
+  state.leaf_attached.assign(L, 1);
   state.time = time;
-  state.cluster_rotations.resize(4, s.C);
-  for (size_t c = 0; c < s.C; ++c) state.cluster_rotations.col(c) = Eigen::Quaterniond::Identity().coeffs();
+  state.cluster_rotations.resize(4, C);
+  for (size_t c = 0; c < C; ++c) state.cluster_rotations.col(c) = Eigen::Quaterniond::Identity().coeffs();
   // At rest in calm air there is nothing to do until the wind rises.
-  state.island_asleep.assign(s.I, s.options.sleep && s.wind.calm(time) ? 1 : 0);
+  state.island_asleep.assign(I, options.sleep && wind.calm(time) ? 1 : 0);
   return state;
 }
 
-void Simulator::advance_frame(SimState& state, long long frame) {
-  Impl& s = *impl_;
-  if (state.positions.cols() != static_cast<Eigen::Index>(s.V) || state.leaf_attached.size() != s.L ||
-      state.cluster_rotations.cols() != static_cast<Eigen::Index>(s.C) || state.island_asleep.size() != s.I)
-    throw SimulationError("frame " + std::to_string(frame) + ": the state does not belong to this tree model");
-  if (s.sync_detachments(state)) state.prediction_stamp = 0;
-  s.frame(state, frame);
-  state.time += s.frame_dt;
+template <typename Real>
+void Solver<Real>::advance_frame(SimState& state, long long frame_index) {
+  if (state.positions.cols() != static_cast<Eigen::Index>(V) || state.leaf_attached.size() != L ||
+      state.cluster_rotations.cols() != static_cast<Eigen::Index>(C) || state.island_asleep.size() != I)
+    throw SimulationError("frame " + std::to_string(frame_index) + ": the state does not belong to this tree model");
+  if (sync_detachments(state)) state.prediction_stamp = 0;
+  frame(state, frame_index);
+  state.time += frame_dt;
   // An island put to sleep is moved to its rest pose: its carried prediction no longer holds.
-  if (s.options.sleep && s.check_sleep(state, state.time)) state.prediction_stamp = s.carried_stamp = 0;
+  if (options.sleep && check_sleep(state, state.time)) state.prediction_stamp = carried_stamp = 0;
 }
+
+}  // namespace
+
+Simulator::Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
+                     double frame_dt, int substeps) {
+  if (options.precision == Precision::kFloat)
+    impl_ = std::make_unique<Solver<float>>(model, options, wind, frame_dt, substeps);
+  else
+    impl_ = std::make_unique<Solver<double>>(model, options, wind, frame_dt, substeps);
+}
+
+Simulator::~Simulator() = default;
+
+SimState Simulator::initial_state(double time) const { return impl_->initial_state(time); }
+
+void Simulator::advance_frame(SimState& state, long long frame) { impl_->advance_frame(state, frame); }
 
 }  // namespace treeanim

@@ -23,8 +23,10 @@ class Simulator {
   // substep and cluster when a value becomes non-finite; `state` is then unspecified.
   void advance_frame(SimState& state, long long frame);
 
- private:
+  // The solver behind it, in the precision of options.precision (sim/simulator.cpp).
   struct Impl;
+
+ private:
   std::unique_ptr<Impl> impl_;
 };
 

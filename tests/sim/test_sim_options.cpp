@@ -43,6 +43,16 @@ TEST(SimOptions, DefaultsAreFilledIn) {
   EXPECT_EQ(o.leaf_detach_force, 0);
   EXPECT_EQ(document["hsm"]["stiffness"], "physical");
   EXPECT_EQ(document["hsm"]["youngs_modulus"], 8e9);
+  EXPECT_EQ(o.precision, Precision::kDouble);
+  EXPECT_EQ(document["hsm"]["precision"], "double");
+}
+
+TEST(SimOptions, ReadsPrecision) {
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "float"}})")).precision, Precision::kFloat);
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "double"}})")).precision, Precision::kDouble);
+  const std::string error = error_of([] { read_hsm(Json::parse(R"({"hsm": {"precision": "half"}})")); });
+  EXPECT_NE(error.find("/hsm/precision"), std::string::npos) << error;
+  EXPECT_NE(error.find("\"float\""), std::string::npos) << error;
 }
 
 TEST(SimOptions, ReadsPerStepStiffness) {
