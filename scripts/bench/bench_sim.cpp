@@ -1,6 +1,6 @@
 // Solver timing (not a test): scene file => grown tree => time per substep at the given
 // thread counts, peak memory, and the speed of a calm, settled half.
-//   bench_sim SCENE [--frames N] [--threads 1,2] [--calm-half]
+//   bench_sim SCENE [--frames N] [--threads 1,2] [--precision float|double] [--calm-half]
 #include <omp.h>
 #include <sys/resource.h>
 
@@ -42,12 +42,13 @@ double bake(Simulator& sim, SimState& state, long long first, long long last) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_sim SCENE [--frames N] [--threads 1,2] [--calm-half]\n");
+    std::fprintf(stderr, "usage: bench_sim SCENE [--frames N] [--threads 1,2] [--precision float|double] [--calm-half]\n");
     return 2;
   }
   long long frames = 48;
   std::vector<int> threads{1, 2};
   bool calm_half = false;
+  std::string precision;  // empty: the scene's /hsm/precision
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--frames" && i + 1 < argc) frames = std::atoll(argv[++i]);
@@ -55,7 +56,9 @@ int main(int argc, char** argv) {
       threads.clear();
       std::stringstream list(argv[++i]);
       for (std::string item; std::getline(list, item, ',');) threads.push_back(std::atoi(item.c_str()));
-    } else if (arg == "--calm-half") calm_half = true;
+    } else if (arg == "--precision" && i + 1 < argc && (std::string(argv[i + 1]) == "float" || std::string(argv[i + 1]) == "double"))
+      precision = argv[++i];
+    else if (arg == "--calm-half") calm_half = true;
     else {
       std::fprintf(stderr, "bench_sim: unknown argument '%s'\n", arg.c_str());
       return 2;
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
   }
   try {
     Scene scene = load_scene(argv[1], {});
+    if (!precision.empty()) scene.hsm.precision = precision == "float" ? Precision::kFloat : Precision::kDouble;
     GrowthStats growth;
     const Skeleton skeleton = grow_skeleton(scene.lsystem, &growth);
     const TreeModel model = build_tree_model(skeleton, scene.tree);
@@ -71,9 +75,9 @@ int main(int argc, char** argv) {
     const int substeps = scene.time.substeps;
     const StepRates rates = compute_step_rates(model, scene.hsm, frame_dt / substeps);
     std::printf("%s: %zu vertices, %zu clusters, %zu memberships, %zu leaves; %d substeps/frame; "
-                "%.0f%% of branch clusters at alpha = 1\n",
+                "%.0f%% of branch clusters at alpha = 1; %s precision\n",
                 argv[1], model.vertex_count(), model.cluster_count(), model.membership_count(), model.leaf_count(),
-                substeps, 100 * rates.capped_fraction);
+                substeps, 100 * rates.capped_fraction, scene.hsm.precision == Precision::kFloat ? "float" : "double");
     if (calm_half) {
       // Wind for the first half, calm for the second: time the settled tail against the
       // windy first half (sleeping on, as in the scene).
