@@ -5,7 +5,7 @@
   run_stress.py --treeanim BIN ctest-cases          every case marked "ctest"
   run_stress.py --treeanim BIN all-cases            every case
   run_stress.py --treeanim BIN random N [--seed S]  N scenes of scripts/stress-scenes
-  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4
+  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4 (double and float)
 
 A bake passes when treeanim exits 0 and its HDF5 holds only finite positions with every
 attached vertex closer to its rest position than twice the tree's size (the largest extent
@@ -156,20 +156,25 @@ def run_random(binary, count, seed):
 
 
 def run_determinism(binary):
-    """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, at 1, 2 and 4 threads."""
-    digests = {}
-    with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
-        sets = {"time.frames": 8, "outputs": [{"format": "hdf5", "path": "out.h5"}],
-                "wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
-                "hsm.leaf_detach_force": 0.3}
-        for threads in (1, 2, 4):
-            code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets, threads=threads)
-            if code != 0:
-                return False, f"OMP_NUM_THREADS={threads}: exit {code}: {err}"
-            with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
-                digests[threads] = f["/frames/positions"][()].tobytes()
-    same = digests[1] == digests[2] == digests[4]
-    return same, ("identical" if same else "DIFFERENT") + f" /frames/positions ({len(digests[1])} bytes) for 1, 2, 4 threads"
+    """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, at 1, 2 and 4
+    threads, with the solver in double and in float."""
+    texts = []
+    for precision in ("double", "float"):
+        digests = {}
+        with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
+            sets = {"time.frames": 8, "outputs": [{"format": "hdf5", "path": "out.h5"}],
+                    "wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
+                    "hsm.leaf_detach_force": 0.3, "hsm.precision": precision}
+            for threads in (1, 2, 4):
+                code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets, threads=threads)
+                if code != 0:
+                    return False, f"{precision}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
+                with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
+                    digests[threads] = f["/frames/positions"][()].tobytes()
+        if not digests[1] == digests[2] == digests[4]:
+            return False, f"DIFFERENT /frames/positions for 1, 2, 4 threads ({precision})"
+        texts.append(f"{precision} ({len(digests[1])} bytes)")
+    return True, "identical /frames/positions for 1, 2, 4 threads: " + ", ".join(texts)
 
 
 def report(name, passed, text):
