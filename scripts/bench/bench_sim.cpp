@@ -4,26 +4,19 @@
 #include <omp.h>
 #include <sys/resource.h>
 
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "lsystem/lsystem.h"
-#include "scene/scene.h"
+#include "bench_common.h"
 #include "sim/simulator.h"
 #include "sim/stiffness.h"
-#include "tree/build_tree_model.h"
 
 using namespace treeanim;
+using bench::seconds_since;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 double peak_mib() {
   rusage usage{};
@@ -41,36 +34,32 @@ double bake(Simulator& sim, SimState& state, long long first, long long last) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_sim SCENE [--frames N] [--threads 1,2] [--precision float|double] [--calm-half]\n");
-    return 2;
-  }
   long long frames = 48;
   std::vector<int> threads{1, 2};
   bool calm_half = false;
   std::string precision;  // empty: the scene's /hsm/precision
-  for (int i = 2; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--frames" && i + 1 < argc) frames = std::atoll(argv[++i]);
-    else if (arg == "--threads" && i + 1 < argc) {
-      threads.clear();
-      std::stringstream list(argv[++i]);
-      for (std::string item; std::getline(list, item, ',');) threads.push_back(std::atoi(item.c_str()));
-    } else if (arg == "--precision" && i + 1 < argc && (std::string(argv[i + 1]) == "float" || std::string(argv[i + 1]) == "double"))
-      precision = argv[++i];
-    else if (arg == "--calm-half") calm_half = true;
-    else {
-      std::fprintf(stderr, "bench_sim: unknown argument '%s'\n", arg.c_str());
-      return 2;
-    }
-  }
+  const bool parsed = bench::parse_arguments(
+      argc, argv, "[--frames N] [--threads 1,2] [--precision float|double] [--calm-half]", frames,
+      [&](const std::string& arg, int& i) {
+        if (arg == "--threads" && i + 1 < argc) {
+          threads.clear();
+          std::stringstream list(argv[++i]);
+          for (std::string item; std::getline(list, item, ',');) threads.push_back(std::atoi(item.c_str()));
+        } else if (arg == "--precision" && i + 1 < argc &&
+                   (std::string(argv[i + 1]) == "float" || std::string(argv[i + 1]) == "double")) {
+          precision = argv[++i];
+        } else if (arg == "--calm-half") {
+          calm_half = true;
+        } else {
+          return false;
+        }
+        return true;
+      });
+  if (!parsed) return 2;
   try {
     Scene scene = load_scene(argv[1], {});
     if (!precision.empty()) scene.hsm.precision = precision == "float" ? Precision::kFloat : Precision::kDouble;
-    GrowthStats growth;
-    const Skeleton skeleton = grow_skeleton(scene.lsystem, &growth);
-    const TreeModel model = build_tree_model(skeleton, scene.tree);
-    validate_tree_model(model);
+    const TreeModel model = bench::scene_model(scene);
     const double frame_dt = 1.0 / scene.time.fps;
     const int substeps = scene.time.substeps;
     const StepRates rates = compute_step_rates(model, scene.hsm, frame_dt / substeps);
