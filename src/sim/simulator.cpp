@@ -91,8 +91,8 @@ namespace {
 
 // The solver, its step state stored in `Real` (docs/solver.md, "Precision"): rest offsets,
 // predicted offsets, velocities, corrections and per-vertex factors, the arrays every step
-// streams through. Sums that decide a rotation (A_pq, the centre), rates and the state
-// handed out stay in double.
+// streams through, and the fit's sums over them. A_pq once assembled, the rest moments, the
+// rotation, the cluster centres and shifts, the rates and the state handed out stay double.
 template <typename Real>
 struct Solver final : Simulator::Impl {
   using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;  // (n x 3), a column per axis
