@@ -206,6 +206,14 @@ struct Solver final : Simulator::Impl {
   template <bool kEnd, bool kDetach>
   bool predict_block(size_t begin, int n, const Inputs& in, Block& block);
   void average_shared_pulls(size_t first, size_t last);
+  // Vertex v => the mean of its clusters' corrections, summed in membership order (never the
+  // sum: Eq. 7 with overlaps). Defined here so that it inlines into the vertex pass.
+  Eigen::Matrix<Real, 1, 3> mean_correction(uint32_t v) const {
+    Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
+    for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
+      pull += member_correction.row(model.vertex_memberships[s]);
+    return pull * vertex_inv_count[v];
+  }
   bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
   void match_clusters(SimState& state, long long frame, int substep);
@@ -572,25 +580,18 @@ bool Solver<Real>::vertex_pass(SimState& state, Pass pass, long long frame, int 
   return any_asleep;
 }
 
-// Shared vertices in [first, last) => the mean of their corrections (in membership order,
-// never the sum) in the row of their first membership, read by the direct vertex pass.
+// Shared vertices in [first, last) => their mean correction in the row of their first
+// membership, read by the direct vertex pass.
 template <typename Real>
 void Solver<Real>::average_shared_pulls(size_t first, size_t last) {
   const auto from = std::lower_bound(shared_vertices.begin(), shared_vertices.end(), first);
   const auto to = std::lower_bound(from, shared_vertices.end(), last);
-  for (auto it = from; it != to; ++it) {
-    const uint32_t v = *it;
-    Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
-    for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
-      pull += member_correction.row(model.vertex_memberships[s]);
-    member_correction.row(vertex_pull_row[v]) = pull * vertex_inv_count[v];
-  }
+  for (auto it = from; it != to; ++it) member_correction.row(vertex_pull_row[*it]) = mean_correction(*it);
 }
 
 // Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
-// asleep) and block.pull, the mean of each vertex's corrections in membership order (never
-// the sum); kStart: 0, after loading u = x - x0 and v from the state (anchors included: they
-// hold where they are).
+// asleep) and block.pull, each vertex's mean correction; kStart: 0, after loading u = x - x0
+// and v from the state (anchors included: they hold where they are).
 template <typename Real>
 void Solver<Real>::gather_block(const SimState& state, Pass pass, bool any_asleep, size_t begin, int n,
                                    Block& block) {
@@ -608,9 +609,7 @@ void Solver<Real>::gather_block(const SimState& state, Pass pass, bool any_aslee
       predicted_offset.row(v) = (state.positions.col(v) - model.rest_positions.col(v)).transpose().template cast<Real>();
       step_velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
     } else if (!still) {
-      for (uint32_t s = model.vertex_cluster_offsets[v]; s < model.vertex_cluster_offsets[v + 1]; ++s)
-        pull += member_correction.row(model.vertex_memberships[s]).transpose();
-      pull *= vertex_inv_count[v];
+      pull = mean_correction(static_cast<uint32_t>(v)).transpose();
     }
     for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
   }
@@ -708,10 +707,9 @@ bool Solver<Real>::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Ei
   // sum q (w / sum w) and sum s q are 0 but for the round-off of the stored q; the shift
   // leaves that residue out, so at the rest pose (u_p = 0) the shift is exactly 0, A_pq is
   // the exactly symmetric rest moment and no goal pulls a resting tree (in float the residue
-  // is ~1e-8 m, and the slow global term would let it creep ~1e-4 m).
-  // One weight per member serves both sums.
-  // q is read here and again by write_corrections, while it is in cache.
-  // The sums run in Real: in float they carry the same ~1e-7 relative round-off as the offsets they sum.
+  // is ~1e-8 m, and the slow global term would let it creep ~1e-4 m). One weight per member
+  // serves both sums; they run in Real, with the round-off of the values they sum. q is read
+  // here and again by write_corrections, while it is in cache.
   Real a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
   Real sx = 0, sy = 0, sz = 0;
   for (uint32_t s = begin; s < end; ++s) {
@@ -724,11 +722,10 @@ bool Solver<Real>::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Ei
     a10 += y * wx, a11 += y * wy, a12 += y * wz;
     a20 += z * wx, a21 += z * wy, a22 += z * wz;
   }
-  const Eigen::Vector3d centre_shift(sx, sy, sz);
+  shift = Eigen::Vector3d(sx, sy, sz);
   Eigen::Matrix3d A;
   A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
   A *= cluster_match_scale[c];
-  shift = centre_shift;
   A += Eigen::Map<const Eigen::Matrix3d>(&cluster_rest_moment(0, c));
   A -= shift * cluster_offset_sum.col(c).transpose();
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));

@@ -43,6 +43,11 @@ SimOptions awake() {
   return options;
 }
 
+// Frames [first, last] of a bake.
+void advance(Simulator& sim, SimState& state, int first, int last) {
+  for (int f = first; f <= last; ++f) sim.advance_frame(state, f);
+}
+
 // One free (unanchored) branch cluster of two rings, far from the origin.
 TreeModel single_cluster(const Eigen::Vector3d& origin) {
   ModelBuilder b;
@@ -142,10 +147,9 @@ TEST(Solver, SharedVertexTakesTheAverageOfItsGoals) {
 TEST(Solver, AnchoredVerticesNeverMove) {
   const TreeModel model = small_tree(1);
   const WindOptions wind = steady_wind(25, Eigen::Vector3d{1, 0, 0.3}, 5);
-  SimOptions options = awake();
-  Simulator sim(model, options, wind, 1.0 / 24, 4);
+  Simulator sim(model, awake(), wind, 1.0 / 24, 4);
   SimState state = sim.initial_state(0);
-  for (int f = 1; f <= 24; ++f) sim.advance_frame(state, f);
+  advance(sim, state, 1, 24);
   double moved = 0;
   for (size_t v = 0; v < model.vertex_count(); ++v) {
     if (model.vertex_anchored[v]) EXPECT_EQ((state.positions.col(v) - model.rest_positions.col(v)).norm(), 0.0);
@@ -258,17 +262,15 @@ TEST(Solver, DegenerateClustersStayFinite) {
 TEST(Solver, ResumedAndEditedStatesArePredictedFromTheirPositions) {
   const TreeModel model = small_tree(3);
   const WindOptions wind = steady_wind(12, Eigen::Vector3d{1, 0, 0.2}, 3);
-  SimOptions options = awake();
+  const SimOptions options = awake();
   Simulator whole(model, options, wind, 1.0 / 24, 4);
   SimState state = whole.initial_state(0);
-  SimState checkpoint;
-  for (int f = 1; f <= 48; ++f) {
-    whole.advance_frame(state, f);
-    if (f == 24) checkpoint = state;
-  }
+  advance(whole, state, 1, 24);
+  SimState checkpoint = state;
+  advance(whole, state, 25, 48);
   // Resumed elsewhere: the same motion (not the same bits: u is recomputed as x - x0).
   Simulator resumed(model, options, wind, 1.0 / 24, 4);
-  for (int f = 25; f <= 48; ++f) resumed.advance_frame(checkpoint, f);
+  advance(resumed, checkpoint, 25, 48);
   EXPECT_LT((checkpoint.positions - state.positions).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_GT((state.positions - model.rest_positions).cwiseAbs().maxCoeff(), 1e-3);  // it moved
 
