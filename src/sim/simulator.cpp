@@ -121,6 +121,9 @@ struct Solver final : Simulator::Impl {
   // of the member in A_pq
   std::vector<Real> member_centre_weight;
   std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
+  // (M) 1 where the member's mass counts in its cluster's fit: active, and not an attached
+  // leaf's shared vertex in its branch (see precompute_pins)
+  std::vector<uint8_t> member_in_fit;
   // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
   // anchor). Before the vertex prediction, the first membership's row of a shared vertex
   // takes the vertex's mean correction (average_shared_pulls).
@@ -128,11 +131,14 @@ struct Solver final : Simulator::Impl {
 
   // --- per cluster (C) ---
   Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
-  // (C) 1/m^2, 1 / sum((w / sum w) |q|^2): A_pq = sum s d q^T with s = (w / sum w) times it
-  // is of order 1 for any cluster size
+  // (3 x C) m, rest position minus t0 of the point the fit rotates about, o: 0 (the centre)
+  // but for an attached leaf, which turns about its shared vertex (see match_clusters)
+  Eigen::Matrix3Xd cluster_match_point;
+  // (C) 1/m^2, 1 / sum((w / sum w) |q - o|^2): A_pq = sum s d (q - o)^T with s = (w / sum w)
+  // times it is of order 1 for any cluster size
   std::vector<double> cluster_match_scale;
-  Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s q over the members: round-off only
-  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s q q^T, column-major: A_pq at rest
+  Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s (q - o) over the members (o = 0: round-off only)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s (q - o)(q - o)^T, column-major: A_pq at rest
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
@@ -214,7 +220,8 @@ struct Solver final : Simulator::Impl {
       pull += member_correction.row(model.vertex_memberships[s]);
     return pull * vertex_inv_count[v];
   }
-  bool fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
+  bool fit_cluster(SimState& state, size_t c, const Eigen::Vector3d* pinned_point, Eigen::Matrix3d& R,
+                   Eigen::Vector3d& shift);
   void write_corrections(size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift);
   void match_clusters(SimState& state, long long frame, int substep);
   void precompute_pins();
@@ -236,6 +243,8 @@ Solver<Real>::Solver(const TreeModel& m, const SimOptions& o, const WindOptions&
   const bool anchored = std::any_of(m.vertex_anchored.begin(), m.vertex_anchored.end(), [](auto a) { return a != 0; });
   runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
   precompute_members();
+  precompute_pins();
+  for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   const StepRates rates = compute_step_rates(model, options, h);
   cluster_alpha = rates.cluster_alpha;
   vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
@@ -248,7 +257,6 @@ Solver<Real>::Solver(const TreeModel& m, const SimOptions& o, const WindOptions&
   cluster_rotation_matrix.setZero(9, C);
   predicted_offset.setZero(V, 3);
   step_velocity.setZero(V, 3);
-  precompute_pins();
   cluster_flying.assign(C, 0);
   vertex_flying.assign(V, 0);
   applied_attached.assign(L, 1);
@@ -262,7 +270,8 @@ Solver<Real>::Solver(const TreeModel& m, const SimOptions& o, const WindOptions&
     wind.spatial_phases(cluster_rest_centre.col(c), &cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N]);
 }
 
-// Model CSR => per-membership cluster ids, rest offsets, weights; per-vertex counts.
+// Model CSR => per-membership cluster ids and state, per-vertex counts and correction rows
+// (the rest data comes from rebuild_cluster_rest, once the pins are known).
 template <typename Real>
 void Solver<Real>::precompute_members() {
   member_cluster.resize(M);
@@ -272,12 +281,13 @@ void Solver<Real>::precompute_members() {
   member_offset.setZero(M, 3);
   member_centre_weight.assign(M, 0);
   member_active.assign(M, 1);
+  member_in_fit.assign(M, 1);
   member_correction.setZero(M + 1, 3);
   cluster_rest_centre.setZero(3, C);
+  cluster_match_point.setZero(3, C);
   cluster_match_scale.assign(C, 0);
   cluster_offset_sum.setZero(3, C);
   cluster_rest_moment.setZero(9, C);
-  for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(static_cast<uint32_t>(c));
   vertex_inv_count.assign(V, 0);
   vertex_air_cluster.assign(V, 0);
   vertex_pull_row.assign(V, static_cast<uint32_t>(M));
@@ -291,7 +301,8 @@ void Solver<Real>::precompute_members() {
   }
 }
 
-// Active members of cluster c => its rest centre, rest offsets and normalised weights.
+// Active members of cluster c => its rest centre, rest offsets and normalised weights, and
+// the rest moment about its match point (an attached leaf's shared vertex, else the centre).
 // Weights are vertex masses; a cluster without mass (all members anchored or massless)
 // falls back to equal weights, so its shape is still defined.
 template <typename Real>
@@ -299,10 +310,10 @@ void Solver<Real>::rebuild_cluster_rest(uint32_t c) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   double total = 0;
   for (uint32_t s = begin; s < end; ++s)
-    if (member_active[s]) total += model.vertex_mass[model.cluster_members[s]];
+    if (member_in_fit[s]) total += model.vertex_mass[model.cluster_members[s]];
   const bool uniform = !(total > 0);
   auto weight = [&](uint32_t s) {
-    return !member_active[s] ? 0.0 : uniform ? 1.0 : model.vertex_mass[model.cluster_members[s]];
+    return !member_in_fit[s] ? 0.0 : uniform ? 1.0 : model.vertex_mass[model.cluster_members[s]];
   };
   if (uniform) total = 0;
   if (uniform)
@@ -311,17 +322,23 @@ void Solver<Real>::rebuild_cluster_rest(uint32_t c) {
   for (uint32_t s = begin; s < end; ++s)
     centre += (weight(s) / total) * model.rest_positions.col(model.cluster_members[s]);
   cluster_rest_centre.col(c) = centre;
-  // The sums below are taken over the stored (Real) q and weights, the values the step reads.
-  double spread = 0;  // sum (w / sum w) |q|^2, m^2
-  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
   for (uint32_t s = begin; s < end; ++s) {
     const Eigen::Vector3d exact = member_active[s] ? Eigen::Vector3d(model.rest_positions.col(model.cluster_members[s]) - centre)
                                                    : Eigen::Vector3d::Zero();
     member_offset.row(s) = exact.transpose().template cast<Real>();
     member_centre_weight[s] = static_cast<Real>(total > 0 ? weight(s) / total : 0.0);
+  }
+  const Eigen::Vector3d point = cluster_pin_slot[c] == kNone
+                                    ? Eigen::Vector3d::Zero()
+                                    : Eigen::Vector3d(member_offset.row(cluster_pin_own_slot[c]).transpose().template cast<double>());
+  cluster_match_point.col(c) = point;
+  // The sums below are taken over the stored (Real) q and weights, the values the step reads.
+  double spread = 0;  // sum (w / sum w) |q - o|^2, m^2
+  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+  for (uint32_t s = begin; s < end; ++s) {
     const double share = member_centre_weight[s];
-    const Eigen::Vector3d q = member_offset.row(s).transpose().template cast<double>();
+    const Eigen::Vector3d q = member_offset.row(s).transpose().template cast<double>() - point;
     spread += share * q.squaredNorm();
     offset_sum += share * q;
     // Each entry as w (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
@@ -386,7 +403,12 @@ void Solver<Real>::precompute_islands() {
 }
 
 // Leaves => the membership slots that pin each attached leaf to its branch (see match_clusters).
-// A leaf whose shared vertex is in no other cluster is matched like a branch.
+// A leaf whose shared vertex is in no other cluster is matched like a branch. The shared
+// vertex, where it is the leaf's own, does not count in its branch's fit: it carries leaf
+// mass and leaf drag, and a leaf does not load its branch (docs/solver.md, "Leaves"). Counted,
+// its lag behind its goal (held by the leaf at rate 1, by the branch at alpha_b) let a
+// share alpha_b of its drag through, so the branch's rest shape in a steady wind changed with
+// the step as (omega_b h)^2.
 template <typename Real>
 void Solver<Real>::precompute_pins() {
   cluster_pin_slot.assign(C, kNone);
@@ -403,6 +425,7 @@ void Solver<Real>::precompute_pins() {
     cluster_pin_slot[c] = pin;
     cluster_pin_own_slot[c] = own;
     pinned_leaf_clusters.push_back(c);
+    if (model.vertex_leaf[a] == static_cast<int32_t>(l)) member_in_fit[pin] = 0;
   }
 }
 
@@ -414,11 +437,14 @@ void Solver<Real>::detach_leaf(SimState& state, size_t leaf) {
   const uint32_t c = model.leaf_cluster[leaf];
   const uint32_t a = model.leaf_attachment_vertex[leaf];
   const bool goes_with_leaf = model.vertex_leaf[a] == static_cast<int32_t>(leaf);
+  cluster_pin_slot[c] = kNone;  // a flying leaf turns about its centre
+  rebuild_cluster_rest(c);
   for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
     const uint32_t slot = model.vertex_memberships[s];
     const uint32_t owner = member_cluster[slot];
     if ((owner == c) == goes_with_leaf || !member_active[slot]) continue;
     member_active[slot] = 0;
+    member_in_fit[slot] = 0;
     member_correction.row(slot).setZero();
     rebuild_cluster_rest(owner);
   }
@@ -432,7 +458,6 @@ void Solver<Real>::detach_leaf(SimState& state, size_t leaf) {
   vertex_inv_count[a] = active ? 1.0 / active : 0.0;
   if (first != kNone) vertex_air_cluster[a] = first;
   cluster_flying[c] = 1;
-  cluster_pin_slot[c] = kNone;
   for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s) {
     const uint32_t v = model.cluster_members[s];
     if (!member_active[s] || model.vertex_leaf[v] != static_cast<int32_t>(leaf) || model.vertex_anchored[v]) continue;
@@ -694,22 +719,27 @@ bool Solver<Real>::predict_block(size_t begin, int n, const Inputs& in, Block& b
   return !(total - total == 0) || worst > 0;
 }
 
-// Shape match of cluster c on the predicted positions => its rotation R (warm start
-// updated) and its centre as t - t0; false when a value is not finite.
+// Shape match of cluster c on the predicted positions, pinned_point: the displacement from
+// rest of its match point o where that point is held (an attached leaf), nullptr where the
+// point is the centre and follows the members => its rotation R (warm start updated) and its
+// translation as t - t0, for goals R q + t; false when a value is not finite.
 template <typename Real>
-bool Solver<Real>::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
+bool Solver<Real>::fit_cluster(SimState& state, size_t c, const Eigen::Vector3d* pinned_point, Eigen::Matrix3d& R,
+                               Eigen::Vector3d& shift) {
   const uint32_t begin = model.cluster_offsets[c], end = model.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
   // numbers wherever the tree stands and however far it travelled. With the rest terms
   // precomputed, one pass over the displacements sums the centre shift
-  // t - t0 = sum (w / sum w) u_p and A' = sum s d q^T = sum u_p (s q)^T + sum s q q^T,
-  // s = (w / sum w) k with the cluster's match scale k; then A_pq = A' - shift (sum s q)^T.
-  // sum q (w / sum w) and sum s q are 0 but for the round-off of the stored q; the shift
-  // leaves that residue out, so at the rest pose (u_p = 0) the shift is exactly 0, A_pq is
-  // the exactly symmetric rest moment and no goal pulls a resting tree (in float the residue
-  // is ~1e-8 m, and the slow global term would let it creep ~1e-4 m). One weight per member
-  // serves both sums; they run in Real, with the round-off of the values they sum. q is read
-  // here and again by write_corrections, while it is in cache.
+  // t - t0 = sum (w / sum w) u_p and sum s u_p q^T, s = (w / sum w) k with the cluster's
+  // match scale k. About the match point o, displaced by w (the centre shift, or the pin):
+  // A_pq = sum s (d - o - w)(q - o)^T = sum s u_p q^T - k shift o^T + sum s (q - o)(q - o)^T
+  //        - w (sum s (q - o))^T,
+  // the third term precomputed. About the centre, sum s q is 0 but for the round-off of the
+  // stored q; the shift leaves that residue out, so at the rest pose (u_p = 0) the shift is
+  // exactly 0, A_pq is the exactly symmetric rest moment and no goal pulls a resting tree (in
+  // float the residue is ~1e-8 m, and the slow global term would let it creep ~1e-4 m). One
+  // weight per member serves both sums; they run in Real, with the round-off of the values
+  // they sum. q is read here and again by write_corrections, while it is in cache.
   Real a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
   Real sx = 0, sy = 0, sz = 0;
   for (uint32_t s = begin; s < end; ++s) {
@@ -722,16 +752,21 @@ bool Solver<Real>::fit_cluster(SimState& state, size_t c, Eigen::Matrix3d& R, Ei
     a10 += y * wx, a11 += y * wy, a12 += y * wz;
     a20 += z * wx, a21 += z * wy, a22 += z * wz;
   }
-  shift = Eigen::Vector3d(sx, sy, sz);
+  const Eigen::Vector3d centre_shift(sx, sy, sz);
+  const Eigen::Vector3d point = cluster_match_point.col(c);
+  const Eigen::Vector3d point_shift = pinned_point ? *pinned_point : centre_shift;
   Eigen::Matrix3d A;
   A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
+  A -= centre_shift * point.transpose();  // 0 about the centre
   A *= cluster_match_scale[c];
   A += Eigen::Map<const Eigen::Matrix3d>(&cluster_rest_moment(0, c));
-  A -= shift * cluster_offset_sum.col(c).transpose();
+  A -= point_shift * cluster_offset_sum.col(c).transpose();
   Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
   extract_rotation(A, rotation, options.rotation_iterations);
   state.cluster_rotations.col(c) = rotation.coeffs();
   R = rotation.toRotationMatrix();
+  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
+  shift = point_shift - (R * point - point);
   cluster_shift.col(c) = shift;
   Eigen::Map<Eigen::Matrix3d>(&cluster_rotation_matrix(0, c)) = R;
   return R.allFinite() && shift.allFinite();
@@ -778,7 +813,7 @@ void Solver<Real>::match_clusters(SimState& state, long long frame, int substep)
       if (cluster_pin_slot[c] == kNone) {
         Eigen::Matrix3d R;
         Eigen::Vector3d shift;
-        if (fit_cluster(state, c, R, shift)) write_corrections(c, R, shift);
+        if (fit_cluster(state, c, nullptr, R, shift)) write_corrections(c, R, shift);
         else bad = std::min(bad, static_cast<uint32_t>(c));
       }
       sample_cluster_air(c);
@@ -789,26 +824,28 @@ void Solver<Real>::match_clusters(SimState& state, long long frame, int substep)
       for (size_t k = 0; k < pinned_leaf_clusters.size(); ++k) {
         const uint32_t c = pinned_leaf_clusters[k];
         if (cluster_pin_slot[c] == kNone || !cluster_awake(state, c)) continue;
-        Eigen::Matrix3d R;
-        Eigen::Vector3d shift;
-        if (!fit_cluster(state, c, R, shift)) {
-          bad = std::min(bad, c);
-          continue;
-        }
-        // The branch's goal for the shared vertex, t0_b + shift_b + R_b q_b, must be the
-        // leaf's goal for it, t + R q_own: so t - t0 = (t0_b - t0) + shift_b + R_b q_b - R q_own,
-        // where (t0_b - t0) + q_b - q_own = 0 (both are the shared vertex's rest position).
-        // Written without that sum, whose round-off (~1e-8 m for float offsets) would pull
-        // every resting leaf, the pin is exactly 0 at rest.
+        // The leaf turns about its shared vertex, held at its branch's goal for it,
+        // t0_b + shift_b + R_b q_b: as a displacement from the vertex's rest position
+        // t0_b + q_b that is shift_b + (R_b - I) q_b, written without the rest terms that
+        // cancel (their round-off, ~1e-8 m for float offsets, would pull every resting leaf).
+        // About that vertex, not about the leaf's centre: a rigid leaf pinned at its petiole
+        // turns by the torque about the petiole, and the pinned vertex itself, which never
+        // quite reaches its goal (its branch corrects it by alpha_b per step), has no lever.
+        // About the centre, that lag entered the leaf's torque and the leaf's rest angle in a
+        // steady wind changed with the step as (omega_b h)^2 (docs/solver.md, "Leaves").
         const uint32_t pin = cluster_pin_slot[c];
         const uint32_t branch = member_cluster[pin];
         const Eigen::Vector3d branch_offset = member_offset.row(pin).transpose().template cast<double>();
-        const Eigen::Vector3d own_offset = member_offset.row(cluster_pin_own_slot[c]).transpose().template cast<double>();
-        const Eigen::Vector3d pinned =
+        const Eigen::Vector3d held =
             cluster_shift.col(branch) +
-            (Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * branch_offset - branch_offset) -
-            (R * own_offset - own_offset);
-        write_corrections(c, R, pinned);
+            (Eigen::Map<const Eigen::Matrix3d>(&cluster_rotation_matrix(0, branch)) * branch_offset - branch_offset);
+        Eigen::Matrix3d R;
+        Eigen::Vector3d shift;
+        if (!fit_cluster(state, c, &held, R, shift)) {
+          bad = std::min(bad, c);
+          continue;
+        }
+        write_corrections(c, R, shift);
       }
     }
   }

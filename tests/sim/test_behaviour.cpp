@@ -159,6 +159,30 @@ TEST(Behaviour, NoDetachmentByDefault) {
   for (uint8_t a : state.leaf_attached) EXPECT_EQ(a, 1);
 }
 
+TEST(Behaviour, LeafDragDoesNotBendItsBranch) {
+  // A leaf turns about its petiole and does not load its branch (docs/solver.md, "Leaves"):
+  // the branch vertices move the same with and without drag on the leaves, to the bit. When
+  // the petiole vertex still counted in its branch's fit, a share alpha_b of the leaf's drag
+  // came through, so that the branch's shape depended on the step.
+  const TreeModel model = testing::small_tree(6);
+  WindOptions wind = gust_then_calm(12, 2, 2.5);
+  std::vector<Eigen::Matrix3Xd> bakes;
+  for (double leaf_drag : {0.6, 0.0}) {
+    wind.leaf_drag_coefficient = leaf_drag;
+    Simulator sim(model, SimOptions{}, wind, 1.0 / 24, 4);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 36; ++f) sim.advance_frame(state, f);
+    bakes.push_back(state.positions);
+  }
+  double leaf_difference = 0;
+  for (size_t v = 0; v < model.vertex_count(); ++v) {
+    const double difference = (bakes[0].col(v) - bakes[1].col(v)).norm();
+    if (model.vertex_leaf[v] < 0) EXPECT_EQ(difference, 0.0) << "branch vertex " << v;
+    else leaf_difference = std::max(leaf_difference, difference);
+  }
+  EXPECT_GT(leaf_difference, 1e-3);  // the leaves themselves do feel their drag
+}
+
 TEST(Behaviour, SleepingBakeMatchesTheFullBake) {
   const TreeModel model = grown_tree(5, 2, 4);
   const WindOptions wind = gust_then_calm(10, 2, 2.5);
