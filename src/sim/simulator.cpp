@@ -668,17 +668,21 @@ bool Solver<Real>::predict_block(size_t begin, int n, const Inputs& in, Block& b
     const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
     const Real ux = offset_x[k] + px, uy = offset_y[k] + py, uz = offset_z[k] + pz;
     const Real vx = velocity_x[k] + px * inv_h, vy = velocity_y[k] + py * inv_h, vz = velocity_z[k] + pz * inv_h;
-    const Real rx = air[0][c] - vx, ry = air[1][c] - vy, rz = air[2][c] - vz;
-    // Quadratic drag integrated exactly over the step for constant air velocity:
-    // du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h), so the change never overshoots
-    // the air velocity, whatever the wind speed or step.
+    // A flying leaf falls (its global rate is 0); an attached vertex is pulled back. These
+    // impulses first, then the quadratic drag integrated exactly over the step for constant
+    // air velocity from the velocity they left: du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h),
+    // so the change never overshoots the air velocity, whatever the wind speed or step. In
+    // this order the drag damps the whole step (for linear drag: backward Euler on all of it)
+    // and a vertex held by its pull back rests where pull and drag balance; with the drag
+    // first, the pull was not damped and a leaf rested off by k|u|h (3 % at the default step).
+    const Real damping = in.damping[k], falling = static_cast<Real>(in.flying[k]), pull_back = in.global[k] * inv_h;
+    const Real fx = (vx * damping + falling * gravity_step[0]) - pull_back * ux;
+    const Real fy = (vy * damping + falling * gravity_step[1]) - pull_back * uy;
+    const Real fz = (vz * damping + falling * gravity_step[2]) - pull_back * uz;
+    const Real rx = air[0][c] - fx, ry = air[1][c] - fy, rz = air[2][c] - fz;
     const Real kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
     const Real share = kuh / (1 + kuh);
-    // A flying leaf falls (its global rate is 0); an attached vertex is pulled back.
-    const Real damping = in.damping[k], falling = static_cast<Real>(in.flying[k]), pull_back = in.global[k] * inv_h;
-    const Real nx = ((vx * damping + rx * share) + falling * gravity_step[0]) - pull_back * ux;
-    const Real ny = ((vy * damping + ry * share) + falling * gravity_step[1]) - pull_back * uy;
-    const Real nz = ((vz * damping + rz * share) + falling * gravity_step[2]) - pull_back * uz;
+    const Real nx = fx + rx * share, ny = fy + ry * share, nz = fz + rz * share;
     const Real ax = ux + step * nx, ay = uy + step * ny, az = uz + step * nz;
     velocity_x[k] = nx;
     velocity_y[k] = ny;

@@ -173,12 +173,14 @@ TEST(Solver, AttachedLeafBalancesTheTorqueAboutItsPetiole) {
   for (uint32_t s = model.cluster_offsets[1]; s < model.cluster_offsets[2]; ++s) {
     const uint32_t v = model.cluster_members[s];
     ASSERT_LT(state.velocities.col(v).norm(), 1e-9) << "not settled";
-    // The solver's drag over a step from rest (docs/solver.md, "Wind and forces").
+    // The solver's step from rest (docs/solver.md, "Wind and forces"): the pull back, then the
+    // drag integrated over the step from the velocity it left.
+    const Eigen::Vector3d pull = global[v] * (state.positions.col(v) - model.rest_positions.col(v));
+    const Eigen::Vector3d relative = air + pull / h;
     const double drag = 0.5 * wind.air_density * wind.leaf_drag_coefficient * model.vertex_drag_area[v] /
                         model.vertex_mass[v];
-    const double kuh = drag * air.norm() * h;
-    const Eigen::Vector3d push = h * air * (kuh / (1 + kuh));
-    const Eigen::Vector3d pull = global[v] * (state.positions.col(v) - model.rest_positions.col(v));
+    const double kuh = drag * relative.norm() * h;
+    const Eigen::Vector3d push = h * relative * (kuh / (1 + kuh));
     // The arm from a's goal: the held branch's goal for a is a's rest position.
     const Eigen::Vector3d arm = state.positions.col(v) - model.rest_positions.col(a);
     torque += model.vertex_mass[v] * arm.cross(push - pull);
