@@ -1,6 +1,5 @@
 #include "lsystem/lsystem.h"
 
-
 #include "common/errors.h"
 #include "common/read_text_file.h"
 

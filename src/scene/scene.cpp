@@ -1,6 +1,5 @@
 #include "scene/scene.h"
 
-
 #include "common/errors.h"
 #include "common/read_text_file.h"
 

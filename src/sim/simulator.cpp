@@ -437,8 +437,6 @@ void Solver<Real>::detach_leaf(SimState& state, size_t leaf) {
   const uint32_t c = model.leaf_cluster[leaf];
   const uint32_t a = model.leaf_attachment_vertex[leaf];
   const bool goes_with_leaf = model.vertex_leaf[a] == static_cast<int32_t>(leaf);
-  cluster_pin_slot[c] = kNone;  // a flying leaf turns about its centre
-  rebuild_cluster_rest(c);
   for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
     const uint32_t slot = model.vertex_memberships[s];
     const uint32_t owner = member_cluster[slot];
@@ -446,8 +444,10 @@ void Solver<Real>::detach_leaf(SimState& state, size_t leaf) {
     member_active[slot] = 0;
     member_in_fit[slot] = 0;
     member_correction.row(slot).setZero();
-    rebuild_cluster_rest(owner);
+    if (owner != c) rebuild_cluster_rest(owner);
   }
+  cluster_pin_slot[c] = kNone;  // a flying leaf turns about its centre: new rest data, once
+  rebuild_cluster_rest(c);
   uint32_t active = 0, first = kNone;
   for (uint32_t s = model.vertex_cluster_offsets[a]; s < model.vertex_cluster_offsets[a + 1]; ++s) {
     const uint32_t slot = model.vertex_memberships[s];
