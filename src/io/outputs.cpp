@@ -117,25 +117,38 @@ fs::path resolve(const fs::path& path, const fs::path& out_dir) {
   return (path.is_relative() && !out_dir.empty() ? out_dir / path : path).lexically_normal();
 }
 
-// Every target is written by one output only, and every folder takes files. A sequence has a
-// target per frame, so this runs on strings: path comparisons per component cost ~20 us a
-// target, a minute for a million-frame sequence.
+// Every target is written by one output only, is absent or a regular file (after its symbolic
+// links), and every folder takes files. The first pass only looks (lstat), so a refused output
+// leaves nothing created; the second creates folders and probes them. A sequence has a target
+// per frame, so this runs on strings: path comparisons per component cost ~20 us a target, a
+// minute for a million-frame sequence.
 void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs) {
   const fs::path cwd = fs::current_path();
-  std::unordered_map<std::string, size_t> writer;  // absolute target => output index
-  std::unordered_set<std::string> checked_folders;
+  std::unordered_map<std::string, size_t> writer;  // absolute file written => output index
+  std::unordered_set<std::string> folders;         // absolute folders seen
+  std::vector<fs::path> probes;                    // the first file of each folder
   for (size_t i = 0; i < workers.size(); ++i) {
     workers[i]->sink->for_each_target([&](const fs::path& target) {
-      const std::string absolute = target.is_absolute() ? target.string() : (cwd / target).string();
+      fs::path file;
+      try {
+        file = resolve_output_target(target);
+      } catch (const InputError& e) {
+        throw InputError(outputs[i].pointer + "/path: " + e.what());
+      }
+      const std::string absolute = file.is_absolute() ? file.string() : (cwd / file).string();
       const auto [it, inserted] = writer.emplace(absolute, i);
       if (!inserted)
-        throw InputError(outputs[i].pointer + "/path: writes " + target.string() + ", which " +
+        throw InputError(outputs[i].pointer + "/path: writes " + file.string() + ", which " +
                          outputs[it->second].pointer + " writes too");
-      if (checked_folders.insert(absolute.substr(0, absolute.rfind('/'))).second) check_writable_target(target);
-      else if (fs::is_directory(target))
-        throw OutputError(target.string() + ": a directory is in the way of the output file");
+      const std::string kind = non_regular_kind(file);
+      if (!kind.empty())
+        throw InputError(outputs[i].pointer + "/path: " + target.string() +
+                         (file == target ? " is " : " links to " + file.string() + ", ") + kind +
+                         ", left untouched; an output path must name a regular file or a new one");
+      if (folders.insert(absolute.substr(0, absolute.rfind('/'))).second) probes.push_back(file);
     });
   }
+  for (const fs::path& file : probes) check_writable_target(file);
 }
 
 }  // namespace

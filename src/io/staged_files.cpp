@@ -1,5 +1,6 @@
 #include "io/staged_files.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -26,6 +27,32 @@ fs::path temporary_path(const fs::path& target) {
   return target.parent_path() / name;
 }
 
+fs::path resolve_output_target(const fs::path& target) {
+  fs::path path = target;
+  for (int links = 0;; ++links) {
+    std::error_code error;
+    if (!fs::is_symlink(fs::symlink_status(path, error))) return path;
+    if (links == 40)  // Linux's own limit on a chain (ELOOP)
+      throw InputError(target.string() + ": a loop of symbolic links, or a chain of more than 40");
+    const fs::path next = fs::read_symlink(path, error);
+    if (error) throw InputError(target.string() + ": cannot read the symbolic link " + path.string() + ": " + error.message());
+    path = (next.is_absolute() ? next : path.parent_path() / next).lexically_normal();
+  }
+}
+
+std::string non_regular_kind(const fs::path& path) {
+  struct stat info;
+  if (::lstat(path.c_str(), &info) != 0) return "";  // absent (or unreachable: the probe reports it)
+  if (S_ISREG(info.st_mode)) return "";
+  if (S_ISDIR(info.st_mode)) return "a directory";
+  if (S_ISCHR(info.st_mode)) return "a character device";
+  if (S_ISBLK(info.st_mode)) return "a block device";
+  if (S_ISFIFO(info.st_mode)) return "a FIFO";
+  if (S_ISSOCK(info.st_mode)) return "a socket";
+  if (S_ISLNK(info.st_mode)) return "a symbolic link";
+  return "a file that is not a regular file";
+}
+
 void check_writable_target(const fs::path& target) {
   const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
   std::error_code error;
@@ -33,8 +60,6 @@ void check_writable_target(const fs::path& target) {
   if (error || !fs::is_directory(folder))
     throw OutputError(target.string() + ": cannot create the folder " + folder.string() +
                       (error ? ": " + error.message() : ": a file is in the way"));
-  if (fs::is_directory(target))
-    throw OutputError(target.string() + ": a directory is in the way of the output file");
   const fs::path probe = temporary_path(target);
   std::FILE* file = std::fopen(probe.c_str(), "wb");
   if (!file) throw OutputError(io_failure(target, "cannot create a file in " + folder.string()));
@@ -43,12 +68,18 @@ void check_writable_target(const fs::path& target) {
 }
 
 fs::path StagedFiles::stage(const fs::path& target) {
-  targets_.push_back(target);
+  targets_.push_back(resolve_output_target(target));
   temporaries_.push_back(temporary_path(target));
   return temporaries_.back();
 }
 
 void StagedFiles::commit() {
+  for (const fs::path& target : targets_) {
+    const std::string kind = non_regular_kind(target);
+    if (!kind.empty())
+      throw OutputError(target.string() + ": " + kind + " appeared at the output path during the bake; it was " +
+                        "left as it is and the finished file is not written");
+  }
   for (size_t i = 0; i < targets_.size(); ++i) {
     std::error_code error;
     fs::rename(temporaries_[i], targets_[i], error);

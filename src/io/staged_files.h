@@ -11,16 +11,29 @@ namespace treeanim {
 // target => "<dir>/.<name>.tmp-<pid>" (hidden, same folder so rename() is atomic).
 std::filesystem::path temporary_path(const std::filesystem::path& target);
 
-// Checks, before anything is simulated, that `target` can be written: its folder exists or is
-// created, no directory stands at the target, and a file can be created there (a probe
-// temporary is created and removed). Throws OutputError naming the path.
+// The file that writing `target` replaces: `target`, or where its chain of symbolic links ends.
+// A link is followed as cp and editors do, so the link stays and the file it names is replaced
+// (a dangling link: that file is created). Throws InputError on a loop or a chain over 40 links.
+std::filesystem::path resolve_output_target(const std::filesystem::path& target);
+
+// What stands at `path` when it is neither absent nor a regular file: "a directory", "a character
+// device", "a block device", "a FIFO", "a socket"; "" otherwise. Looks with lstat(), so it never
+// opens the path (opening a FIFO blocks) and never follows a link.
+std::string non_regular_kind(const std::filesystem::path& path);
+
+// Checks, before anything is simulated, that a file can be created in `target`'s folder: the
+// folder exists or is created, and a probe temporary is created and removed. Throws OutputError
+// naming the path.
 void check_writable_target(const std::filesystem::path& target);
 
 class StagedFiles {
  public:
-  // Registers `target`; returns the temporary to write instead.
+  // Registers `target` (resolve_output_target: a link's file is what gets replaced); returns the
+  // temporary to write instead, beside that file.
   std::filesystem::path stage(const std::filesystem::path& target);
-  // Renames every temporary to its target, in staging order. Throws OutputError naming the path.
+  // Renames every temporary to its target, in staging order; a target that is no longer absent or
+  // a regular file (something appeared there during the bake) is left as it is and fails the
+  // commit. Throws OutputError naming the path.
   void commit();
   // Removes every temporary still present. Never throws.
   void discard() noexcept;

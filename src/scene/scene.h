@@ -35,11 +35,8 @@ struct Scene {
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a
-// string). Missing intermediate objects are created. Throws InputError on a malformed override.
+// string; JSON nested too deep, with a repeated key or an out-of-range number is refused). Missing intermediate objects are created. Throws InputError on a malformed override.
 void apply_override(Json& document, const std::string& assignment);
-
-// Parses JSON text; syntax errors become InputError "name:line:column: ...".
-Json parse_scene_json(const std::string& text, const std::string& name);
 
 // Loads, overrides, validates. Errors: InputError "file: /pointer: message" (exit 2).
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);

@@ -3,9 +3,12 @@
 // solver: a branch quad (vertices 0-3, two triangles) and one leaf triangle hanging from
 // vertex 3 (vertices 3-5), one segment, two clusters.
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -104,6 +107,21 @@ class TempFolder : public ::testing::Test {
   }
   std::filesystem::path dir_;
 };
+
+// Leaves a Unix socket file at `path` => 0, or -1 with errno set. Bound at a short name and moved,
+// since a socket's address holds at most 107 bytes.
+inline int bind_unix_socket(const std::filesystem::path& path) {
+  const std::string bound_at = "/tmp/treeanim-socket-" + std::to_string(::getpid());
+  ::unlink(bound_at.c_str());
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  if (fd < 0) return -1;
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof address.sun_path, "%s", bound_at.c_str());
+  const int bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address);
+  ::close(fd);
+  return bound == 0 ? ::rename(bound_at.c_str(), path.c_str()) : bound;
+}
 
 inline std::string read_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -1,6 +1,13 @@
 // OutputSet: targets checked before simulating, nothing left behind on abort or failure,
 // the GLB size limit refused early with the number of frames that would fit.
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 
 #include "common/errors.h"
 #include "io/glb_size.h"
@@ -64,10 +71,13 @@ TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {
   EXPECT_EQ(paths[3], dir_ / "gltf/tree.0000.glb");
 }
 
+// The message of the error that refuses `outputs`, "input: " before a bad-input one.
 std::string output_error(const std::vector<OutputOptions>& outputs, const std::filesystem::path& dir,
                          const TreeModel& m, const BakeInfo& info) {
   try {
     OutputSet set(outputs, dir, m, info);
+  } catch (const InputError& e) {
+    return std::string("input: ") + e.what();
   } catch (const OutputError& e) {
     return e.what();
   }
@@ -83,13 +93,106 @@ TEST_F(OutputSetTest, BadPathsAreFoundBeforeSimulating) {
                               (dir_ / "file/obj").string(), 0), 0u) << in_file;
   std::filesystem::create_directories(dir_ / "in_the_way.h5");
   EXPECT_EQ(output_error({output("hdf5", "in_the_way.h5")}, dir_, m, info),
-            (dir_ / "in_the_way.h5").string() + ": a directory is in the way of the output file");
+            "input: /outputs/0/path: " + (dir_ / "in_the_way.h5").string() + " is a directory, left untouched; an "
+            "output path must name a regular file or a new one");
   std::filesystem::create_directories(dir_ / "seq/tree.0003.obj");
   EXPECT_EQ(output_error({output("obj", "seq/tree")}, dir_, m, info),
-            (dir_ / "seq/tree.0003.obj").string() + ": a directory is in the way of the output file");
+            "input: /outputs/0/path: " + (dir_ / "seq/tree.0003.obj").string() + " is a directory, left untouched; "
+            "an output path must name a regular file or a new one");
   // Not writable even for root: /proc takes no new files.
   const std::string unwritable = output_error({output("hdf5", "/proc/bake.h5")}, dir_, m, info);
   EXPECT_EQ(unwritable.rfind("/proc/bake.h5: cannot create a file in /proc: ", 0), 0u) << unwritable;
+}
+
+// What stands at a path, as lstat() sees it: type and device number, to tell "left as it was".
+std::pair<mode_t, dev_t> node_at(const std::filesystem::path& path) {
+  struct stat info {};
+  if (::lstat(path.c_str(), &info) != 0) return {0, 0};
+  return {info.st_mode, info.st_rdev};
+}
+
+// Every target of every format, with a device node (root only), a FIFO, a socket or a directory
+// standing at it: refused before anything is written, and the node left as it was. The check
+// looks with lstat(), so the FIFO is never opened (that would block).
+TEST_F(OutputSetTest, TargetsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info(3, 0);
+  const std::vector<std::pair<std::string, std::string>> targets = {
+      {"hdf5", "bake.h5"},           {"glb", "anim.glb"},           {"pc2", "tree.pc2"},
+      {"pc2", "tree.rest.obj"},      {"obj", "obj/tree.0001.obj"},  {"obj", "obj/tree.rest.obj"},
+      {"gltf", "gltf/tree.0002.glb"}};
+  const std::vector<std::pair<std::string, std::string>> paths = {
+      {"hdf5", "bake.h5"}, {"glb", "anim.glb"}, {"pc2", "tree.pc2"}, {"obj", "obj/tree"}, {"gltf", "gltf/tree"}};
+  for (const auto& [format, file] : targets) {
+    for (const std::string kind : {"character device", "FIFO", "socket", "directory"}) {
+      SCOPED_TRACE(format + " " + file + " " + kind);
+      std::filesystem::remove_all(dir_);
+      const std::filesystem::path at = dir_ / file;
+      std::filesystem::create_directories(at.parent_path());
+      int made = 0;
+      if (kind == "character device") {
+        if (::geteuid() != 0) continue;  // mknod needs root; CI runs as root
+        made = ::mknod(at.c_str(), S_IFCHR | 0600, makedev(1, 3));  // what /dev/null is
+      } else if (kind == "FIFO") {
+        made = ::mkfifo(at.c_str(), 0600);
+      } else if (kind == "socket") {
+        made = test::bind_unix_socket(at);
+      } else {
+        std::filesystem::create_directory(at);
+      }
+      ASSERT_EQ(made, 0) << std::strerror(errno);
+      const auto before = node_at(at);
+      const std::vector<std::string> entries_before = entries();
+      std::string path;
+      for (const auto& [f, p] : paths)
+        if (f == format) path = p;
+      EXPECT_EQ(output_error({output(format, path)}, dir_, m, info),
+                "input: /outputs/0/path: " + at.string() + " is a " + kind +
+                    ", left untouched; an output path must name a regular file or a new one");
+      EXPECT_EQ(node_at(at), before);
+      EXPECT_EQ(entries(), entries_before);  // no folder, no probe, no temporary
+    }
+  }
+}
+
+// A symbolic link at the target is followed, as cp and editors do: the file it names gets the
+// bake and the link stays. A dangling link creates its file; a loop and a link to a FIFO are refused.
+TEST_F(OutputSetTest, SymbolicLinksAreFollowedAndKept) {
+  namespace fs = std::filesystem;
+  const TreeModel m = small_model();
+  fs::create_directories(dir_ / "store");
+  { std::ofstream(dir_ / "store/old.h5") << "old"; }
+  fs::create_symlink("store/old.h5", dir_ / "bake.h5");
+  fs::create_symlink("store/new.pc2", dir_ / "tree.pc2");  // dangling
+  test::bake({output("hdf5", "bake.h5"), output("pc2", "tree.pc2")}, dir_, m, small_info(2, 0));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "bake.h5")));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "tree.pc2")));
+  EXPECT_EQ(test::read_file(dir_ / "store/old.h5").substr(1, 3), "HDF");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_ / "store/new.pc2")));
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_ / "tree.rest.obj")));  // named after the link
+
+  fs::create_symlink("loop-b.h5", dir_ / "loop-a.h5");
+  fs::create_symlink("loop-a.h5", dir_ / "loop-b.h5");
+  EXPECT_EQ(output_error({output("hdf5", "loop-a.h5")}, dir_, m, small_info()),
+            "input: /outputs/0/path: " + (dir_ / "loop-a.h5").string() +
+                ": a loop of symbolic links, or a chain of more than 40");
+  ASSERT_EQ(::mkfifo((dir_ / "store/pipe").c_str(), 0600), 0);
+  fs::create_symlink("store/pipe", dir_ / "piped.glb");
+  EXPECT_EQ(output_error({output("glb", "piped.glb")}, dir_, m, small_info()),
+            "input: /outputs/0/path: " + (dir_ / "piped.glb").string() + " links to " +
+                (dir_ / "store/pipe").string() + ", a FIFO, left untouched; an output path must name a regular "
+                "file or a new one");
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(dir_ / "store/pipe")));
+}
+
+// Two outputs that reach one file, one of them through a link, are refused like two equal paths.
+TEST_F(OutputSetTest, TwoOutputsCannotWriteOneFileThroughALink) {
+  const TreeModel m = small_model();
+  std::filesystem::create_symlink("a.h5", dir_ / "b.h5");
+  std::vector<OutputOptions> outputs{output("hdf5", "a.h5"), output("hdf5", "b.h5")};
+  outputs[1].pointer = "/outputs/1";
+  EXPECT_EQ(output_error(outputs, dir_, m, small_info()),
+            "input: /outputs/1/path: writes " + (dir_ / "a.h5").string() + ", which /outputs/0 writes too");
 }
 
 TEST_F(OutputSetTest, TwoOutputsCannotWriteOneFile) {
@@ -117,7 +220,8 @@ TEST_F(OutputSetTest, FailedRenameRemovesEveryTemporary) {
     set.finish();
     FAIL() << "finished";
   } catch (const OutputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind((dir_ / "b.0001.obj").string() + ": cannot rename", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind((dir_ / "b.0001.obj").string() + ": a directory appeared at the output "
+                                          "path during the bake", 0), 0u) << e.what();
   }
   // a.h5 and b.rest.obj, b.0000.obj were renamed before the failure: whole files. No temporary stays.
   for (const std::string& name : entries()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;

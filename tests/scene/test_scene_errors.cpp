@@ -168,6 +168,36 @@ TEST(SceneOverrides, EmptyNameIsRefused) {
   EXPECT_THROW(apply_override(document, "=1"), InputError);
 }
 
+// A --set value or path nested past the limit is refused, at any depth, before it reaches the
+// document (a deep document crashed every recursive walk over it).
+TEST(SceneOverrides, DeepValuesAndPathsAreRefused) {
+  Json document = Json::object();
+  const std::string deep = std::string(50'000, '[') + std::string(50'000, ']');
+  try {
+    apply_override(document, "tree=" + deep);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--set 'tree=" + std::string(52, '[') + "...':1:256: JSON nested deeper than "
+              "256 levels of arrays and objects (counted from the scene's root; /tree takes 1 of them); no scene "
+              "needs more");
+  }
+  std::string path = "tree";
+  for (int i = 0; i < 50'000; ++i) path += ".a";
+  EXPECT_THROW(apply_override(document, path + "=1"), InputError);
+  EXPECT_THROW(apply_override(document, "tree={\"a\": 1, \"a\": 2}"), InputError);
+  EXPECT_EQ(document, Json::object());
+  apply_override(document, "tree=" + std::string(255, '[') + std::string(255, ']'));  // at the limit
+}
+
+TEST(SceneText, RepeatedKeysAreRefused) {
+  try {
+    load_scene_text("{\"seed\": 3,\n\"seed\": 7}", "s.json", "/scenes", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "s.json:2:1: /seed: duplicate key (first at line 1, again at line 2); keep one of them");
+  }
+}
+
 TEST(SceneResolved, DefaultsAreFilledIn) {
   const Scene scene = load_scene_text(kValid, "s.json", "/scenes", {});
   EXPECT_EQ(scene.resolved["time"]["fps"], 24);
