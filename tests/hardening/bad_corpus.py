@@ -6,7 +6,8 @@ usage: bad_corpus.py TREEANIM CORPUS_DIR
 Each case runs in CORPUS_DIR (paths in its args are relative to it; a lone surrogate such as
 \udcda in cases.json stands for the byte 0xDA, as os.fsencode maps it); "{tmp}" in an argument is
 replaced by a fresh empty folder, which must still be empty afterwards (a refused bake writes
-nothing).
+nothing), and "{corpus}" (in arguments and messages) by the corpus folder, which no case may
+change (a refused bake replaces nothing).
 """
 import json
 import os
@@ -15,10 +16,24 @@ import sys
 import tempfile
 
 
+def snapshot(folder):
+    """folder => {relative path: (type and mode bits, size, modification time)} of everything below it."""
+    found = {}
+    for root, dirs, names in os.walk(folder):
+        for name in dirs + names:
+            path = os.path.join(root, name)
+            info = os.lstat(path)
+            found[os.path.relpath(path, folder)] = (info.st_mode, info.st_size, info.st_mtime_ns)
+    return found
+
+
 def run_case(binary, corpus, case):
     """case => list of problems (empty when it behaves as documented)."""
+    corpus = os.path.abspath(corpus)
+    before = snapshot(corpus)
     with tempfile.TemporaryDirectory(prefix="treeanim-bad-") as tmp:
-        args = [a.replace("{tmp}", tmp) for a in case["args"]]
+        args = [a.replace("{tmp}", tmp).replace("{corpus}", corpus) for a in case["args"]]
+        message = case["message"].replace("{corpus}", corpus)
         try:
             done = subprocess.run([binary] + args, cwd=corpus, capture_output=True, text=True,
                                   errors="replace", timeout=120)
@@ -27,13 +42,15 @@ def run_case(binary, corpus, case):
         problems = []
         if done.returncode != case["exit"]:
             problems.append("exit %d, expected %d" % (done.returncode, case["exit"]))
-        if case["message"] not in done.stderr:
-            problems.append("stderr lacks %r" % case["message"])
+        if message not in done.stderr:
+            problems.append("stderr lacks %r" % message)
         if "internal error" in done.stderr:
             problems.append("an internal error (an exception nobody mapped)")
         left = os.listdir(tmp)
         if left:
             problems.append("files left in the output folder: %s" % left)
+        if snapshot(corpus) != before:
+            problems.append("the corpus folder changed")
         if problems:
             problems.append("stderr was: %s" % done.stderr.strip()[-2000:])
         return problems

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Failure injection for treeanim (issue 8): hostile conditions around a real bake must give the
+"""Failure injection for treeanim: hostile conditions around a real bake must give the
 documented exit code and message and leave no file under a final name (and no temporaries).
 
 usage: failure_injection.py TREEANIM SCENARIO     (exit 0 pass, 1 fail, 77 skipped)
@@ -11,6 +11,7 @@ import os
 import resource
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -103,9 +104,141 @@ def output_in_proc(bake):
 
 
 def output_directory_in_the_way(bake):
-    """A directory stands where the hdf5 file should go."""
+    """A directory stands where the hdf5 file should go: bad input, and it stays an empty directory."""
     os.makedirs(os.path.join(bake.out, "bake.h5"))
-    expect(bake.run(24), 4, "bake.h5: a directory is in the way of the output file", bake.out)
+    done = bake.run(24)
+    expect(done, 2, "bake.h5 is a directory, left untouched", os.path.join(bake.out, "bake.h5"))
+    if sorted(os.listdir(bake.out)) != ["bake.h5"]:
+        raise Failed("the output folder holds more than the directory: %s" % os.listdir(bake.out))
+
+
+def node_state(path):
+    """What stands at path, without opening anything but a regular file: type, device, size, bytes."""
+    info = os.lstat(path)
+    content = None
+    if stat.S_ISREG(info.st_mode):
+        with open(path, "rb") as f:
+            content = f.read()
+    return (info.st_mode, info.st_rdev, info.st_size, content)
+
+
+def tree_state(folder):
+    """folder => {relative path: node_state} of everything below it."""
+    found = {}
+    for root, dirs, names in os.walk(folder):
+        for name in dirs + names:
+            path = os.path.join(root, name)
+            found[os.path.relpath(path, folder)] = node_state(path)
+    return found
+
+
+# Every file the bake scene's outputs write (one frame of each sequence), plus a glTF sequence.
+WITH_GLTF = ["--set", "outputs.4={\"format\": \"gltf\", \"path\": \"gltf/tree\"}"]
+TARGETS = ["bake.h5", "seq/tree.0005.obj", "seq/tree.rest.obj", "tree.glb", "tree.pc2", "tree.rest.obj",
+           "gltf/tree.0003.glb"]
+
+
+def output_not_a_regular_file(bake):
+    """A character device (root only: mknod), a FIFO or a directory at any output's target: exit 2
+    before simulating, naming the output and what stands there; the node is left as it was and
+    nothing else is written. The FIFO must not be opened (that would block the bake)."""
+    kinds = [("FIFO", lambda p: os.mkfifo(p)), ("directory", os.mkdir)]
+    if os.geteuid() == 0:
+        kinds.insert(0, ("character device", lambda p: os.mknod(p, 0o600 | stat.S_IFCHR, os.makedev(1, 3))))
+    else:
+        print("not root: no device node (mknod needs root); FIFOs and directories only")
+    for target in TARGETS:
+        for kind, make in kinds:
+            shutil.rmtree(bake.out, ignore_errors=True)
+            node = os.path.join(bake.out, target)
+            os.makedirs(os.path.dirname(node))
+            make(node)
+            before = tree_state(bake.out)
+            done = bake.run(12, WITH_GLTF, timeout=30)
+            stderr = done.stderr
+            problems = []
+            if done.returncode != 2:
+                problems.append("exit %d, expected 2" % done.returncode)
+            message = "%s is a %s, left untouched" % (node, kind)
+            if message not in stderr:
+                problems.append("stderr lacks %r" % message)
+            if tree_state(bake.out) != before:
+                problems.append("the output folder changed")
+            if problems:
+                raise Failed("%s at %s: %s\nstderr: %s" % (kind, target, "; ".join(problems), stderr.strip()[-1000:]))
+    return 0
+
+
+def output_symbolic_links_followed(bake):
+    """A symbolic link at a target is followed, as cp does: the file it names gets the bake (a
+    dangling link creates it) and the link stays a link; no temporary is left on either side."""
+    store = os.path.join(bake.tmp, "store")
+    os.makedirs(store)
+    os.makedirs(bake.out)
+    with open(os.path.join(store, "old.h5"), "w") as f:
+        f.write("an old bake")
+    os.symlink(os.path.join(store, "old.h5"), os.path.join(bake.out, "bake.h5"))
+    os.symlink("../store/new.glb", os.path.join(bake.out, "tree.glb"))  # dangling, relative
+    done = bake.run(12)
+    if done.returncode != 0:
+        raise Failed("exit %d: %s" % (done.returncode, done.stderr))
+    for link in ("bake.h5", "tree.glb"):
+        if not os.path.islink(os.path.join(bake.out, link)):
+            raise Failed(link + " is no longer a symbolic link")
+    with open(os.path.join(store, "old.h5"), "rb") as f:
+        if f.read(8) != b"\x89HDF\r\n\x1a\n":
+            raise Failed("the linked file does not hold the HDF5 bake")
+    with open(os.path.join(store, "new.glb"), "rb") as f:
+        if f.read(4) != b"glTF":
+            raise Failed("the dangling link's file was not created with the GLB")
+    left = [f for f in files_under(bake.tmp) if ".tmp-" in f]
+    if left:
+        raise Failed("temporaries left: %s" % left)
+
+
+def bad_scene_keeps_previous_bake(edit, message):
+    """edit(bake) makes the scene bad input => a scenario: over a finished bake, the bad scene
+    exits 2 with `message` and every file of the previous bake stays byte for byte."""
+    def scenario(bake):
+        first = bake.run(12)
+        if first.returncode != 0:
+            raise Failed("the first bake failed: " + first.stderr)
+        before = tree_state(bake.out)
+        extra = edit(bake)
+        done = bake.run(12, extra)
+        problems = []
+        if done.returncode != 2:
+            problems.append("exit %d, expected 2" % done.returncode)
+        if message not in done.stderr:
+            problems.append("stderr lacks %r" % message)
+        if tree_state(bake.out) != before:
+            problems.append("the previous bake changed")
+        if problems:
+            raise Failed("; ".join(problems) + "\nstderr: " + done.stderr.strip()[-1000:])
+    return scenario
+
+
+def nest_scene_deeply(bake):
+    """50,000 levels in the scene file (a stack overflow before the depth limit) => no --set."""
+    with open(bake.scene) as f:
+        text = f.read()
+    with open(bake.scene, "w") as f:
+        f.write(text.replace('"wind":', '"tree": %s%s,\n  "wind":' % ("[" * 50000, "]" * 50000), 1))
+    return []
+
+
+def nest_set_deeply(bake):
+    """50,000 levels in a --set value."""
+    return ["--set", "tree=" + "[" * 50000 + "]" * 50000]
+
+
+def repeat_a_key(bake):
+    """The scene's "time" given twice, as a hand edit or a merge leaves it."""
+    with open(bake.scene) as f:
+        text = f.read()
+    with open(bake.scene, "w") as f:
+        f.write(text.replace('"outputs":', '"time": {"fps": 30},\n  "outputs":', 1))
+    return []
 
 
 def output_read_only_folder(bake):
@@ -233,6 +366,14 @@ SCENARIOS = {
     "output-in-proc": output_in_proc,
     "output-directory-in-the-way": output_directory_in_the_way,
     "output-read-only-folder": output_read_only_folder,
+    "output-not-a-regular-file": output_not_a_regular_file,
+    "output-symbolic-links-followed": output_symbolic_links_followed,
+    "deep-scene-keeps-previous-bake": bad_scene_keeps_previous_bake(
+        nest_scene_deeply, "bake.json:4:266: JSON nested deeper than 256 levels of arrays and objects"),
+    "deep-set-keeps-previous-bake": bad_scene_keeps_previous_bake(
+        nest_set_deeply, ":1:256: JSON nested deeper than 256 levels of arrays and objects"),
+    "repeated-key-keeps-previous-bake": bad_scene_keeps_previous_bake(
+        repeat_a_key, "bake.json:6:3: /time: duplicate key (first at line 5, again at line 6)"),
     "disk-full": disk_full,
     "disk-full-efbig": disk_full_efbig,
     "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
