@@ -1,4 +1,4 @@
-# Stress suite of issue 7 (tests/stress/README.md): extreme wind and steps, solver limits,
+# Stress suite (tests/stress/README.md): extreme wind and steps, solver limits,
 # degenerate geometry, 1,000,000 steps, seeded random scenes, thread-count determinism.
 # Included by CMakeLists.txt inside TREEANIM_TESTS; label "stress". Longer runs: scripts/stress.
 # Cases marked "defect" in tests/stress/cases.json reproduce an open solver defect: they are

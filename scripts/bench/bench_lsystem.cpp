@@ -1,4 +1,4 @@
-// Throughput of the L-system stage (issue 3): derivation of a non-parametric and a parametric
+// Throughput of the L-system stage: derivation of a non-parametric and a parametric
 // grammar, and turtle interpretation, in modules per second (modules of every string produced,
 // or read). A plain timing program: best of `repeats` runs, printed as one table.
 //

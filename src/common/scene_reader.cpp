@@ -268,6 +268,7 @@ void SceneReader::register_key(const std::string& object_pointer, const std::str
   if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
 }
 
+// Recursive: the document is at most kMaxJsonDepth deep (common/json_text.h checks the text).
 void SceneReader::check_object(const Json& node, const std::string& pointer) const {
   auto known = valid_keys_.find(pointer);
   if (known == valid_keys_.end()) return;  // free-form (read raw by its stage)

@@ -1,7 +1,7 @@
 // One animated GLB: the rest mesh, one morph target per written frame (displacements from the
 // rest pose) and an animation on the node's `weights`, one-hot per frame with LINEAR
 // interpolation, so a player blends neighbouring frames at in-between times. assimp 5.2 cannot
-// export morph-weight animation (assimp issue 5352), so the container is written here with
+// export morph-weight animation (assimp GitHub issue #5352), so the container is written here with
 // nlohmann_json, streamed: the JSON chunk's room is reserved up front (its numbers at their
 // longest) and filled in by finish(), the frames go straight to the BIN chunk.
 //

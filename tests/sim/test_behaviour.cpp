@@ -299,7 +299,7 @@ TEST(Behaviour, SubstepCountDoesNotChangeThePhysicalMotion) {
 }
 
 TEST(Behaviour, ConvergesAtFirstOrderInTheStep) {
-  // Issue 7: with physical stiffness the error against a converged small-step bake (512
+  // With physical stiffness the error against a converged small-step bake (512
   // substeps) falls as h, order 0.8-1.2 (scripts/bench-accuracy measures the same on larger
   // trees), here on a young tree with leaves in a turbulent 5 m/s wind that starts at once.
   const TreeModel model = grown_tree(4, 2, 4);

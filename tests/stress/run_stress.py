@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Stress runner of issue 7 (tests/stress/README.md).
+"""Stress runner (tests/stress/README.md).
 
   run_stress.py --treeanim BIN case NAME...        cases of tests/stress/cases.json
   run_stress.py --treeanim BIN ctest-cases          every case marked "ctest"

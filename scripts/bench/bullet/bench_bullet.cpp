@@ -1,4 +1,4 @@
-// Shape matching against Bullet's soft-body clusters (issue 7, optional; not a test): the same
+// Shape matching against Bullet's soft-body clusters (optional; not a test): the same
 // vertices, masses and clusters, one thread each.
 //   bench_bullet_float|bench_bullet_double SCENE [--frames N]
 // Ours: Simulator::advance_frame, in the precision Bullet was built with (hsm.precision is
