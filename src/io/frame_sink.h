@@ -72,6 +72,8 @@ std::unique_ptr<FrameSink> make_gltf_sink(const OutputOptions& options, const st
                                           const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                         const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
 

@@ -6,7 +6,8 @@
 // longest) and filled in by finish(), the frames go straight to the BIN chunk.
 //
 // BIN layout (every part a multiple of 4 bytes): indices u32 [T*3], rest positions f32 [N*3],
-// UVs f32 [N*2], targets f32 [F][N*3], times f32 [F], weights f32 [F*F].
+// (with normals: rest normals f32 [N*3]), UVs f32 [N*2], targets f32 [F][N*3] (with normals
+// [F][2][N*3]: a frame's position then normal displacements), times f32 [F], weights f32 [F*F].
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include "io/obj_format.h"
 #include "io/output_file.h"
 #include "io/staged_files.h"
+#include "io/vertex_normals.h"
 
 namespace treeanim {
 
@@ -51,6 +53,7 @@ struct Bounds {
 // and for real (in finish()).
 struct GlbContent {
   size_t vertices = 0, triangles = 0, frames = 0;
+  bool normals = false;                   // NORMAL on the mesh and on every target
   std::string generator;
   std::optional<Bounds> rest;             // nullopt: render the longest placeholder numbers
   std::vector<Bounds> targets;            // (frames) displacement bounds
@@ -66,22 +69,28 @@ nlohmann::json bounds_json(const std::array<float, 3>& values, bool placeholder)
   return {double(values[0]), double(values[1]), double(values[2])};
 }
 
-uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames) {
-  const uint64_t n = vertices, f = frames;
-  return 12 * uint64_t(triangles) + 12 * n + 8 * n + 12 * n * f + 4 * f + 4 * f * f;
+// Bytes of one vertex attribute per vertex set that a frame's target holds: 1, or 2 with normals.
+uint64_t target_sets(bool normals) { return normals ? 2 : 1; }
+
+uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames, bool normals) {
+  const uint64_t n = vertices, f = frames, sets = target_sets(normals);
+  return 12 * uint64_t(triangles) + 12 * n * sets + 8 * n + 12 * n * sets * f + 4 * f + 4 * f * f;
 }
 
 std::string render_json(const GlbContent& c) {
   using nlohmann::json;
-  const uint64_t n = c.vertices, f = c.frames, t = c.triangles;
-  const uint64_t indices_bytes = 12 * t, position_bytes = 12 * n, uv_bytes = 8 * n, targets_bytes = 12 * n * f;
-  const uint64_t targets_offset = indices_bytes + position_bytes + uv_bytes;
+  const uint64_t n = c.vertices, f = c.frames, t = c.triangles, sets = target_sets(c.normals);
+  const uint64_t indices_bytes = 12 * t, rest_bytes = 12 * n * sets, uv_bytes = 8 * n;
+  const uint64_t frame_bytes = 12 * n * sets, targets_bytes = frame_bytes * f;
+  const uint64_t targets_offset = indices_bytes + rest_bytes + uv_bytes;
   const uint64_t times_offset = targets_offset + targets_bytes;
 
+  // Views 0-2: indices, rest positions (and normals, one view: stride 12), UVs.
   json views = json::array({
       {{"buffer", 0}, {"byteOffset", 0}, {"byteLength", indices_bytes}, {"target", kElementArrayBuffer}},
-      {{"buffer", 0}, {"byteOffset", indices_bytes}, {"byteLength", position_bytes}, {"target", kArrayBuffer}},
-      {{"buffer", 0}, {"byteOffset", indices_bytes + position_bytes}, {"byteLength", uv_bytes},
+      {{"buffer", 0}, {"byteOffset", indices_bytes}, {"byteLength", rest_bytes}, {"byteStride", 12},
+       {"target", kArrayBuffer}},
+      {{"buffer", 0}, {"byteOffset", indices_bytes + rest_bytes}, {"byteLength", uv_bytes},
        {"target", kArrayBuffer}},
   });
   json accessors = json::array({
@@ -92,6 +101,11 @@ std::string render_json(const GlbContent& c) {
       {{"bufferView", 2}, {"componentType", kFloat}, {"count", n}, {"type", "VEC2"}},
   });
   json primitive = {{"attributes", {{"POSITION", 1}, {"TEXCOORD_0", 2}}}, {"indices", 0}, {"mode", 4}};
+  if (c.normals) {
+    primitive["attributes"]["NORMAL"] = accessors.size();
+    accessors.push_back({{"bufferView", 1}, {"byteOffset", 12 * n}, {"componentType", kFloat}, {"count", n},
+                         {"type", "VEC3"}});
+  }
   json mesh = {{"name", "tree"}};
   json document = {
       {"asset", {{"version", "2.0"}, {"generator", c.generator},
@@ -110,9 +124,14 @@ std::string render_json(const GlbContent& c) {
     for (uint64_t k = 0; k < f; ++k) {
       const Bounds bounds = c.placeholder ? Bounds{} : c.targets[k];
       targets.push_back({{"POSITION", accessors.size()}});
-      accessors.push_back({{"bufferView", 3}, {"byteOffset", 12 * n * k}, {"componentType", kFloat},
+      accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k}, {"componentType", kFloat},
                            {"count", n}, {"type", "VEC3"}, {"min", bounds_json(bounds.min, c.placeholder)},
                            {"max", bounds_json(bounds.max, c.placeholder)}});
+      if (c.normals) {  // glTF asks bounds of POSITION only
+        targets.back()["NORMAL"] = accessors.size();
+        accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k + 12 * n}, {"componentType", kFloat},
+                             {"count", n}, {"type", "VEC3"}});
+      }
     }
     const size_t times_accessor = accessors.size();
     const double longest = -1.7976931348623157e308;
@@ -132,7 +151,7 @@ std::string render_json(const GlbContent& c) {
   }
   mesh["primitives"] = json::array({primitive});
   document["meshes"] = json::array({mesh});
-  document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f)}}});
+  document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f, c.normals)}}});
   document["bufferViews"] = views;
   document["accessors"] = accessors;
   std::string text = document.dump();
@@ -151,9 +170,10 @@ std::vector<std::string> target_names(const FrameSelection& selection) {
 }
 
 // The JSON with every number at its longest, for `frames` frames named as in `names`.
-GlbContent placeholder_content(const TreeModel& model, const std::string& generator, size_t frames,
+GlbContent placeholder_content(const TreeModel& model, const std::string& generator, bool normals, size_t frames,
                                std::vector<std::string> names) {
   GlbContent content;
+  content.normals = normals;
   content.vertices = model.vertex_count();
   content.triangles = model.triangle_count();
   content.frames = frames;
@@ -168,26 +188,28 @@ GlbContent placeholder_content(const TreeModel& model, const std::string& genera
 // each further frame adds, plus room for the few totals whose digits grow with the frame count.
 class GlbSizeBound {
  public:
-  GlbSizeBound(const TreeModel& model, const std::string& generator)
-      : vertices_(model.vertex_count()), triangles_(model.triangle_count()) {
+  GlbSizeBound(const TreeModel& model, const std::string& generator, bool normals)
+      : vertices_(model.vertex_count()), triangles_(model.triangle_count()), normals_(normals) {
     using nlohmann::json;
     constexpr uint64_t kMax = std::numeric_limits<uint64_t>::max();
     constexpr double kLongest = -1.7976931348623157e308;
     const json longest3 = {kLongest, kLongest, kLongest};
     const json accessor = {{"bufferView", 3}, {"byteOffset", kMax}, {"componentType", kFloat}, {"count", kMax},
                            {"type", "VEC3"}, {"min", longest3}, {"max", longest3}};
-    const json target = {{"POSITION", kMax}};
+    json target = {{"POSITION", kMax}};
+    if (normals) target["NORMAL"] = kMax;
     const json name = "frame_-9223372036854775808";
-    per_frame_json_ = accessor.dump().size() + target.dump().size() + name.dump().size() + json(0.0).dump().size() + 4;
-    no_frame_json_ = render_json(placeholder_content(model, generator, 0, {})).size();
-    one_frame_json_ = render_json(placeholder_content(model, generator, 1, {name.get<std::string>()})).size();
+    per_frame_json_ = target_sets(normals) * (accessor.dump().size() + 1) + target.dump().size() + name.dump().size() +
+                      json(0.0).dump().size() + 3;
+    no_frame_json_ = render_json(placeholder_content(model, generator, normals, 0, {})).size();
+    one_frame_json_ = render_json(placeholder_content(model, generator, normals, 1, {name.get<std::string>()})).size();
   }
 
   uint64_t bytes(uint64_t frames) const {
     // Totals that grow with the frame count: view and buffer lengths and offsets, counts.
     constexpr uint64_t kGrowingDigits = 16 * 20;
     const uint64_t json = frames == 0 ? no_frame_json_ : one_frame_json_ + (frames - 1) * per_frame_json_ + kGrowingDigits;
-    return glb_bytes(json + 3, bin_bytes(vertices_, triangles_, frames));
+    return glb_bytes(json + 3, bin_bytes(vertices_, triangles_, frames, normals_));
   }
 
   // The largest frame count (written frames) whose GLB fits in `limit` bytes.
@@ -205,6 +227,7 @@ class GlbSizeBound {
 
  private:
   size_t vertices_, triangles_;
+  bool normals_;
   uint64_t per_frame_json_ = 0, no_frame_json_ = 0, one_frame_json_ = 0;
 };
 
@@ -213,7 +236,8 @@ class GlbSink final : public FrameSink {
   GlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : path_(std::move(path)), model_(model),
         selection_{info.frame_start, info.frame_count, options.frame_step},
-        content_(placeholder_content(model, info.generator, size_t(selection_.written()), target_names(selection_))) {}
+        content_(placeholder_content(model, info.generator, options.normals, size_t(selection_.written()),
+                                     target_names(selection_))) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
@@ -225,6 +249,10 @@ class GlbSink final : public FrameSink {
     file_->write(std::string(12 + 8 + reserved_json_ + 8, '\0'));  // header and JSON, filled by finish()
     for (uint32_t index : model_.triangles) file_->write_u32_le(index);
     file_->write_f32_le(rest_.data(), rest_.size());
+    if (content_.normals) {
+      rest_normals_ = rest_normals(model_);
+      file_->write_f32_le(rest_normals_.data(), rest_normals_.size());
+    }
     std::vector<float> uvs(2 * model_.vertex_count());
     for (size_t v = 0; v < model_.vertex_count(); ++v) {
       uvs[2 * v] = model_.uvs(0, long(v));
@@ -244,6 +272,10 @@ class GlbSink final : public FrameSink {
       bounds.add(&displacement_[i]);
     }
     file_->write_f32_le(displacement_.data(), displacement_.size());
+    if (content_.normals) {
+      for (size_t i = 0; i < rest_normals_.size(); ++i) displacement_[i] = frame.normals[i] - rest_normals_[i];
+      file_->write_f32_le(displacement_.data(), displacement_.size());
+    }
     content_.targets.push_back(bounds);
     times_.push_back(float(frame.time));
   }
@@ -270,11 +302,12 @@ class GlbSink final : public FrameSink {
     file_->seek(0);
     file_->write_u32_le(kGlbMagic);
     file_->write_u32_le(2);
-    file_->write_u32_le(uint32_t(GlbSizeBound::glb_bytes(reserved_json_, bin_bytes(content_.vertices, content_.triangles, f))));
+    const uint64_t bin = bin_bytes(content_.vertices, content_.triangles, f, content_.normals);
+    file_->write_u32_le(uint32_t(GlbSizeBound::glb_bytes(reserved_json_, bin)));
     file_->write_u32_le(uint32_t(reserved_json_));
     file_->write_u32_le(kChunkJson);
     file_->write(json);
-    file_->write_u32_le(uint32_t(bin_bytes(content_.vertices, content_.triangles, f)));
+    file_->write_u32_le(uint32_t(bin));
     file_->write_u32_le(kChunkBin);
     file_->close();
     file_.reset();
@@ -292,6 +325,7 @@ class GlbSink final : public FrameSink {
   GlbContent content_;
   size_t reserved_json_ = 0;           // bytes of the JSON chunk
   std::vector<float> rest_;            // (N*3) m, float rest pose the displacements are taken from
+  std::vector<float> rest_normals_;    // (N*3) unit, with normals: what the normal targets displace
   std::vector<float> displacement_;    // (N*3) m, scratch for one target
   std::vector<float> times_;           // (frames written) s
   std::optional<OutputFile> file_;
@@ -299,15 +333,15 @@ class GlbSink final : public FrameSink {
 
 }  // namespace
 
-uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step) {
+uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step, bool normals) {
   const FrameSelection selection{info.frame_start, info.frame_count, frame_step};
-  return GlbSizeBound(model, info.generator).bytes(uint64_t(selection.written()));
+  return GlbSizeBound(model, info.generator, normals).bytes(uint64_t(selection.written()));
 }
 
 std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
   const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
-  const GlbSizeBound bound(model, info.generator);
+  const GlbSizeBound bound(model, info.generator, options.normals);
   const uint64_t bytes = bound.bytes(uint64_t(selection.written()));
   if (bytes > kGlbMaxBytes) {
     const uint64_t fits = bound.frames_within(kGlbMaxBytes);  // written frames

@@ -10,7 +10,8 @@ namespace treeanim {
 // A GLB states its total length as uint32: 4 GiB - 1 bytes at most.
 constexpr uint64_t kGlbMaxBytes = 0xFFFFFFFFull;
 
-// Bytes of the animated GLB of `info.frame_count` frames written every `frame_step`-th.
-uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step);
+// Bytes of the animated GLB of `info.frame_count` frames written every `frame_step`-th, with
+// morph-target normals or without.
+uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step, bool normals = false);
 
 }  // namespace treeanim

@@ -1,5 +1,5 @@
 // glTF sequence through assimp's "glb2" exporter: one self-contained .glb per written frame
-// ("<name>.%04d.glb"), mesh with positions, UVs and the shared triangle list.
+// ("<name>.%04d.glb"), mesh with positions, UVs (and normals when asked) and the shared triangle list.
 #include <assimp/Exporter.hpp>
 #include <assimp/material.h>
 #include <assimp/scene.h>
@@ -16,7 +16,7 @@ namespace {
 
 // The rest mesh as an aiScene (one node, one mesh, one default material: assimp's glTF 2
 // exporter dereferences the mesh's material, so a scene without one cannot be exported).
-std::unique_ptr<aiScene> make_scene(const TreeModel& model) {
+std::unique_ptr<aiScene> make_scene(const TreeModel& model, bool with_normals) {
   auto scene = std::make_unique<aiScene>();
   scene->mRootNode = new aiNode("tree");
   scene->mRootNode->mNumMeshes = 1;
@@ -36,6 +36,7 @@ std::unique_ptr<aiScene> make_scene(const TreeModel& model) {
   mesh->mVertices = new aiVector3D[n];
   mesh->mTextureCoords[0] = new aiVector3D[n];
   mesh->mNumUVComponents[0] = 2;
+  if (with_normals) mesh->mNormals = new aiVector3D[n];
   for (unsigned v = 0; v < n; ++v) {
     mesh->mVertices[v] = aiVector3D(float(model.rest_positions(0, v)), float(model.rest_positions(1, v)),
                                     float(model.rest_positions(2, v)));
@@ -58,7 +59,7 @@ std::unique_ptr<aiScene> make_scene(const TreeModel& model) {
 class GltfSink final : public FrameSink {
  public:
   GltfSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
-      : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model),
+      : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model), normals_(options.normals),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
@@ -70,12 +71,15 @@ class GltfSink final : public FrameSink {
     return {pattern_.frame(selection_.start)};
   }
 
-  void begin() override { scene_ = make_scene(model_); }
+  void begin() override { scene_ = make_scene(model_, normals_); }
 
   void write(const FrameData& frame) override {
     aiMesh* mesh = scene_->mMeshes[0];
     for (unsigned v = 0; v < mesh->mNumVertices; ++v)
       mesh->mVertices[v] = aiVector3D(frame.positions[3 * v], frame.positions[3 * v + 1], frame.positions[3 * v + 2]);
+    if (normals_)
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v)
+        mesh->mNormals[v] = aiVector3D(frame.normals[3 * v], frame.normals[3 * v + 1], frame.normals[3 * v + 2]);
     const fs::path target = pattern_.frame(frame.frame);
     const fs::path temporary = staged_.stage(target);
     if (exporter_.Export(scene_.get(), "glb2", temporary.string()) != aiReturn_SUCCESS)
@@ -87,6 +91,7 @@ class GltfSink final : public FrameSink {
  private:
   SequencePattern pattern_;
   const TreeModel& model_;
+  bool normals_;  // NORMAL in every frame
   FrameSelection selection_;
   std::unique_ptr<aiScene> scene_;  // rest mesh, positions replaced per frame
   Assimp::Exporter exporter_;

@@ -1,15 +1,18 @@
-// HDF5 bake (DESIGN.md "HDF5 bake layout", format_version 1): the model once, then
-// /frames/* extended by one frame per write(), one frame per chunk, so a bake streams to disk
-// and a reader can pull any frame with one chunk read.
+// HDF5 bake (docs/outputs.md "HDF5 bake"): the model once, then /frames/* extended by one frame
+// per write(), one frame per chunk, so a bake streams to disk and a reader can pull any frame with
+// one chunk read. format_version 1 stores /frames/positions; 2 (option "quantize") stores
+// /frames/displacement_quantized instead, integers q with positions = rest + step * q.
 #include <hdf5.h>
 
 #include <array>
+#include <cmath>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/obj_format.h"
 #include "io/staged_files.h"
 
 namespace treeanim {
@@ -82,13 +85,16 @@ class Handle {
 class Hdf5Sink final : public FrameSink {
  public:
   Hdf5Sink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
-      : options_(options), path_(std::move(path)), model_(model), info_(info) {}
+      : options_(options), path_(std::move(path)), model_(model), info_(info),
+        // int16 when the solver's bound on displacements fits in it at this step, else int32.
+        quantized_int16_(options.quantize > 0 && std::round(info.displacement_bound / options.quantize) <= 32767) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {
     const auto lock = hdf5_lock();
+    rest_ = rest_positions_f32(model_);
     const fs::path temporary = staged_.stage(path_);
     file_ = Handle(check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
                          "create the file"), H5Fclose);
@@ -104,7 +110,13 @@ class Hdf5Sink final : public FrameSink {
     const auto lock = hdf5_lock();
     const hsize_t n = model_.vertex_count();
     append(time_.get(), {}, H5T_NATIVE_DOUBLE, &frame.time);
-    append(positions_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
+    if (options_.quantize > 0) {
+      quantize(frame);
+      append(positions_.get(), {n, 3}, H5T_NATIVE_INT32, quantized_.data());
+    } else {
+      append(positions_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
+    }
+    if (options_.normals) append(normals_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.normals.data());
     if (options_.velocities) append(velocities_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.velocities.data());
     if (leaf_attached_.get() >= 0)
       append(leaf_attached_.get(), {model_.leaf_count()}, H5T_NATIVE_UINT8, frame.leaf_attached.data());
@@ -150,9 +162,12 @@ class Hdf5Sink final : public FrameSink {
     return type;
   }
 
-  void write_attribute(const char* name, hid_t file_type, hid_t memory_type, const void* value) const {
+  // An attribute of the file's root, or of `object` when given.
+  void write_attribute(const char* name, hid_t file_type, hid_t memory_type, const void* value,
+                       hid_t object = -1) const {
     Handle space(check(H5Screate(H5S_SCALAR), "make a scalar space"), H5Sclose);
-    Handle attribute(check(H5Acreate2(file_.get(), name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+    Handle attribute(check(H5Acreate2(object < 0 ? file_.get() : object, name, file_type, space.get(), H5P_DEFAULT,
+                                      H5P_DEFAULT),
                            std::string("create attribute ") + name), H5Aclose);
     check_status(H5Awrite(attribute.get(), memory_type, value), std::string("write attribute ") + name);
   }
@@ -163,7 +178,7 @@ class Hdf5Sink final : public FrameSink {
   }
 
   void write_root_attributes() const {
-    const int32_t version = 1, substeps = info_.substeps;
+    const int32_t version = options_.quantize > 0 ? 2 : 1, substeps = info_.substeps;
     const int64_t frame_start = info_.frame_start;
     const uint64_t seed = info_.seed;
     write_string_attribute("format", "treeanim");
@@ -208,8 +223,7 @@ class Hdf5Sink final : public FrameSink {
   void write_mesh() const {
     const Handle group = create_group("/mesh");
     const hsize_t n = model_.vertex_count();
-    std::vector<float> rest(model_.rest_positions.data(), model_.rest_positions.data() + 3 * n);
-    write_array(group.get(), "rest_positions", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {n, 3}, rest.data());
+    write_array(group.get(), "rest_positions", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {n, 3}, rest_.data());
     write_array(group.get(), "triangles", H5T_STD_U32LE, H5T_NATIVE_UINT32, {model_.triangle_count(), 3},
                 model_.triangles.data());
   }
@@ -248,10 +262,10 @@ class Hdf5Sink final : public FrameSink {
     write_array(g, "segment_cluster", H5T_STD_U32LE, H5T_NATIVE_UINT32, {s}, model_.segment_cluster.data());
   }
 
-  // An extendible dataset [0, frame_shape...] with one frame per chunk; shuffle + deflate when
-  // compression > 0.
+  // An extendible dataset [0, frame_shape...] with one frame per chunk; shuffle + deflate at
+  // `level` when it is > 0.
   Handle create_frame_dataset(hid_t group, const char* name, hid_t file_type, std::vector<hsize_t> frame_shape,
-                              hsize_t frames_per_chunk, bool compress) const {
+                              hsize_t frames_per_chunk, int level) const {
     std::vector<hsize_t> dims{0}, max_dims{H5S_UNLIMITED}, chunk{frames_per_chunk};
     for (hsize_t d : frame_shape) {
       dims.push_back(d);
@@ -262,9 +276,9 @@ class Hdf5Sink final : public FrameSink {
                  H5Sclose);
     Handle properties(check(H5Pcreate(H5P_DATASET_CREATE), "make dataset properties"), H5Pclose);
     check_status(H5Pset_chunk(properties.get(), int(chunk.size()), chunk.data()), std::string("chunk ") + name);
-    if (compress) {
+    if (level > 0) {
       check_status(H5Pset_shuffle(properties.get()), "enable shuffle");
-      check_status(H5Pset_deflate(properties.get(), unsigned(options_.compression)), "enable deflate");
+      check_status(H5Pset_deflate(properties.get(), unsigned(level)), "enable deflate");
     }
     return Handle(check(H5Dcreate2(group, name, file_type, space.get(), H5P_DEFAULT, properties.get(),
                                    H5P_DEFAULT), std::string("create /frames/") + name), H5Dclose);
@@ -274,14 +288,22 @@ class Hdf5Sink final : public FrameSink {
     const Handle group = create_group("/frames");
     const hid_t g = group.get();
     const hsize_t n = model_.vertex_count();
-    const bool compress = options_.compression > 0;
+    const int level = options_.compression;
     // Times are tiny: 1024 per chunk keeps the chunk index small for long bakes.
-    time_ = create_frame_dataset(g, "time", H5T_IEEE_F64LE, {}, 1024, false);
-    positions_ = create_frame_dataset(g, "positions", H5T_IEEE_F32LE, {n, 3}, 1, compress);
+    time_ = create_frame_dataset(g, "time", H5T_IEEE_F64LE, {}, 1024, 0);
+    if (options_.quantize > 0) {
+      // Integers are only worth storing shuffled and deflated (level 4 unless one is given).
+      positions_ = create_frame_dataset(g, "displacement_quantized", quantized_int16_ ? H5T_STD_I16LE : H5T_STD_I32LE,
+                                        {n, 3}, 1, level > 0 ? level : 4);
+      write_attribute("step", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &options_.quantize, positions_.get());
+    } else {
+      positions_ = create_frame_dataset(g, "positions", H5T_IEEE_F32LE, {n, 3}, 1, level);
+    }
     if (options_.velocities)
-      velocities_ = create_frame_dataset(g, "velocities", H5T_IEEE_F32LE, {n, 3}, 1, compress);
+      velocities_ = create_frame_dataset(g, "velocities", H5T_IEEE_F32LE, {n, 3}, 1, level);
+    if (options_.normals) normals_ = create_frame_dataset(g, "normals", H5T_IEEE_F32LE, {n, 3}, 1, level);
     if (model_.leaf_count() > 0)
-      leaf_attached_ = create_frame_dataset(g, "leaf_attached", H5T_STD_U8LE, {model_.leaf_count()}, 1, compress);
+      leaf_attached_ = create_frame_dataset(g, "leaf_attached", H5T_STD_U8LE, {model_.leaf_count()}, 1, level);
   }
 
   // Grows `dataset` [k, frame_shape...] by one frame and writes `data` (one frame) there.
@@ -300,10 +322,27 @@ class Hdf5Sink final : public FrameSink {
                  "write frame " + std::to_string(start[0]));
   }
 
+  // frame => quantized_: (position - rest) / step rounded to the nearest integer. A value beyond
+  // the stored type fails the bake rather than being clipped (a file never lies).
+  void quantize(const FrameData& frame) {
+    const double limit = quantized_int16_ ? 32767.0 : 2147483647.0;
+    quantized_.resize(rest_.size());
+    for (size_t i = 0; i < rest_.size(); ++i) {
+      const double q = std::nearbyint((double(frame.positions[i]) - double(rest_[i])) / options_.quantize);
+      if (!(std::fabs(q) <= limit))
+        throw OutputError(path_.string() + ": frame " + std::to_string(frame.frame) + " moves vertex " +
+                          std::to_string(i / 3) + " " + std::to_string(double(frame.positions[i]) - rest_[i]) +
+                          " m from rest, beyond what quantize = " + std::to_string(options_.quantize) + " m holds in " +
+                          (quantized_int16_ ? "int16" : "int32") + "; raise quantize or leave it out");
+      quantized_[i] = static_cast<int32_t>(q);
+    }
+  }
+
   bool close_datasets() {
     bool ok = time_.reset();
     ok = positions_.reset() && ok;
     ok = velocities_.reset() && ok;
+    ok = normals_.reset() && ok;
     return leaf_attached_.reset() && ok;
   }
 
@@ -311,7 +350,11 @@ class Hdf5Sink final : public FrameSink {
   fs::path path_;
   const TreeModel& model_;
   BakeInfo info_;
-  Handle file_, time_, positions_, velocities_, leaf_attached_;
+  bool quantized_int16_;           // the quantized displacements are stored as int16 (else int32)
+  std::vector<float> rest_;        // (V*3) m, float32 rest pose as stored in /mesh
+  std::vector<int32_t> quantized_; // (V*3) scratch: one frame's quantized displacements
+  // positions_ is /frames/positions, or /frames/displacement_quantized when quantized.
+  Handle file_, time_, positions_, velocities_, normals_, leaf_attached_;
   hsize_t frames_written_ = 0;
 };
 

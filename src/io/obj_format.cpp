@@ -28,7 +28,7 @@ std::vector<float> rest_positions_f32(const TreeModel& model) {
   return std::vector<float>(rest, rest + 3 * model.vertex_count());
 }
 
-std::string obj_shared_lines(const TreeModel& model) {
+std::string obj_shared_lines(const TreeModel& model, bool with_normals) {
   std::string out;
   out.reserve(24 * model.vertex_count() + 40 * model.triangle_count());
   for (size_t v = 0; v < model.vertex_count(); ++v) {
@@ -46,6 +46,10 @@ std::string obj_shared_lines(const TreeModel& model) {
       append_index(out, index);
       out += '/';
       append_index(out, index);
+      if (with_normals) {
+        out += '/';
+        append_index(out, index);
+      }
     }
     out += '\n';
   }
@@ -53,19 +57,22 @@ std::string obj_shared_lines(const TreeModel& model) {
 }
 
 void write_obj_file(const std::filesystem::path& temporary, const std::filesystem::path& target,
-                    std::string_view comment, const std::vector<float>& positions, const std::string& shared) {
+                    std::string_view comment, const std::vector<float>& positions, const std::string& shared,
+                    const std::vector<float>& normals) {
   std::string text;
-  text.reserve(comment.size() + 3 + 12 * positions.size());
+  text.reserve(comment.size() + 3 + 12 * (positions.size() + normals.size()));
   text += "# ";
   text += comment;
   text += '\n';
-  for (size_t i = 0; i < positions.size(); i += 3) {
-    text += 'v';
-    for (size_t a = 0; a < 3; ++a) {
-      text += ' ';
-      append_number(text, positions[i + a]);
+  for (const auto& [keyword, values] : {std::pair{"v", &positions}, std::pair{"vn", &normals}}) {
+    for (size_t i = 0; i < values->size(); i += 3) {
+      text += keyword;
+      for (size_t a = 0; a < 3; ++a) {
+        text += ' ';
+        append_number(text, (*values)[i + a]);
+      }
+      text += '\n';
     }
-    text += '\n';
   }
   OutputFile file(temporary, target);
   file.write(text);

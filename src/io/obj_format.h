@@ -10,13 +10,16 @@
 
 namespace treeanim {
 
-// The part every OBJ of a bake shares: "vt" lines (one per vertex) and "f v/vt" lines.
-std::string obj_shared_lines(const TreeModel& model);
+// The part every OBJ of a bake shares: "vt" lines (one per vertex) and "f v/vt" lines, or
+// "f v/vt/vn" lines when every file has a "vn" line per vertex.
+std::string obj_shared_lines(const TreeModel& model, bool with_normals = false);
 // TreeModel rest positions (double) => (V*3) float, as the sinks write them.
 std::vector<float> rest_positions_f32(const TreeModel& model);
 // Writes one OBJ: a comment line, "v" lines of `positions` (V*3 floats, shortest round-trip
-// text), then `shared`. Throws OutputError naming `target`.
+// text), "vn" lines of `normals` (V*3, or empty for none), then `shared`. Throws OutputError
+// naming `target`.
 void write_obj_file(const std::filesystem::path& temporary, const std::filesystem::path& target,
-                    std::string_view comment, const std::vector<float>& positions, const std::string& shared);
+                    std::string_view comment, const std::vector<float>& positions, const std::string& shared,
+                    const std::vector<float>& normals = {});
 
 }  // namespace treeanim

@@ -5,6 +5,7 @@
 #include "io/frame_sink.h"
 #include "io/obj_format.h"
 #include "io/staged_files.h"
+#include "io/vertex_normals.h"
 
 namespace treeanim {
 
@@ -12,11 +13,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+const std::vector<float> kNoNormals;
+
 class ObjSink final : public FrameSink {
  public:
   ObjSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
       : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
-        selection_{info.frame_start, info.frame_count, options.frame_step} {}
+        selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
     visit(pattern_.rest());
@@ -29,17 +32,17 @@ class ObjSink final : public FrameSink {
   }
 
   void begin() override {
-    shared_ = obj_shared_lines(model_);
+    shared_ = obj_shared_lines(model_, normals_);
     const fs::path rest = pattern_.rest();
     write_obj_file(staged_.stage(rest), rest, info_.generator + ", rest pose, metres, Y up",
-                   rest_positions_f32(model_), shared_);
+                   rest_positions_f32(model_), shared_, normals_ ? rest_normals(model_) : kNoNormals);
   }
 
   void write(const FrameData& frame) override {
     const fs::path target = pattern_.frame(frame.frame);
     write_obj_file(staged_.stage(target), target,
                    info_.generator + ", frame " + std::to_string(frame.frame) + ", metres, Y up",
-                   frame.positions, shared_);
+                   frame.positions, shared_, normals_ ? frame.normals : kNoNormals);
   }
 
 
@@ -48,6 +51,7 @@ class ObjSink final : public FrameSink {
   const TreeModel& model_;
   BakeInfo info_;
   FrameSelection selection_;
+  bool normals_;        // "vn" lines in every file
   std::string shared_;  // "vt" and "f" lines, identical in every file
 };
 

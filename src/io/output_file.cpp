@@ -1,5 +1,6 @@
 #include "io/output_file.h"
 
+#include <algorithm>
 #include <bit>
 
 #include "common/errors.h"
@@ -32,6 +33,26 @@ void OutputFile::write_f32_le(const float* values, size_t count) {
     write(values, count * sizeof(float));
   } else {
     for (size_t i = 0; i < count; ++i) write_u32_le(std::bit_cast<uint32_t>(values[i]));
+  }
+}
+
+void OutputFile::write_u32_be(uint32_t value) {
+  unsigned char bytes[4];
+  for (int i = 0; i < 4; ++i) bytes[i] = static_cast<unsigned char>(value >> (8 * (3 - i)));
+  write(bytes, 4);
+}
+
+void OutputFile::write_f32_be(const float* values, size_t count) {
+  // Byte-swapped a block at a time: one write per value would cost a call per 4 bytes.
+  constexpr size_t kBlock = 4096;
+  uint32_t swapped[kBlock];
+  for (size_t begin = 0; begin < count; begin += kBlock) {
+    const size_t n = std::min(kBlock, count - begin);
+    for (size_t i = 0; i < n; ++i) {
+      const auto bits = std::bit_cast<uint32_t>(values[begin + i]);
+      swapped[i] = std::endian::native == std::endian::big ? bits : __builtin_bswap32(bits);
+    }
+    write(swapped, n * sizeof(uint32_t));
   }
 }
 

@@ -19,9 +19,11 @@ class OutputFile {
 
   void write(const void* data, size_t bytes);
   void write(std::string_view text) { write(text.data(), text.size()); }
-  // Little-endian integers and floats, whatever the host order.
+  // Little- and big-endian integers and floats, whatever the host order.
   void write_u32_le(uint32_t value);
   void write_f32_le(const float* values, size_t count);
+  void write_u32_be(uint32_t value);
+  void write_f32_be(const float* values, size_t count);
   void seek(uint64_t offset);
   // Flushes and closes; throws when the data did not reach the file.
   void close();

@@ -8,8 +8,13 @@ namespace treeanim {
 OutputOptions read_output_options(SceneObject element) {
   OutputOptions options;
   options.pointer = element.pointer();
-  if (!element.has("format")) element.fail("format", "required (one of hdf5, obj, gltf, glb, pc2)");
-  options.format = element.choice("format", "", {std::begin(kOutputFormats), std::end(kOutputFormats)});
+  const std::vector<std::string> formats(std::begin(kOutputFormats), std::end(kOutputFormats));
+  if (!element.has("format")) {
+    std::string listed;
+    for (const std::string& format : formats) listed += (listed.empty() ? "" : ", ") + format;
+    element.fail("format", "required (one of " + listed + ")");
+  }
+  options.format = element.choice("format", "", formats);
   const auto path = element.optional_string("path");
   if (!path || path->empty()) element.fail_expected("path", "a non-empty path string");
   options.path = *path;
@@ -17,7 +22,11 @@ OutputOptions read_output_options(SceneObject element) {
   if (options.format == "hdf5") {
     options.compression = static_cast<int>(element.integer("compression", 0, 0, 9));
     options.velocities = element.boolean("velocities", false);
+    // 1 nm is far below float32's resolution of a tree's coordinates; 1 m is no shape at all.
+    options.quantize = element.optional_number("quantize", Range{1e-9, 1.0, false, false}).value_or(0.0);
   }
+  if (options.format == "hdf5" || options.format == "obj" || options.format == "gltf" || options.format == "glb")
+    options.normals = element.boolean("normals", false);
   return options;
 }
 

@@ -8,16 +8,18 @@
 namespace treeanim {
 
 struct OutputOptions {
-  std::string format;              // "hdf5" | "obj" | "gltf" | "glb" | "pc2"
+  std::string format;              // "hdf5" | "obj" | "gltf" | "glb" | "pc2" | "mdd"
   std::filesystem::path path;      // as written in the scene; resolved by OutputSet
   int frame_step = 1;              // write every k-th frame
   int compression = 0;             // hdf5: 0 none, 1..9 shuffle + deflate level
   bool velocities = false;         // hdf5: also write /frames/velocities
+  bool normals = false;            // hdf5, obj, gltf, glb: per-frame vertex normals
+  double quantize = 0;             // hdf5: m, > 0 stores displacements as integers of this step
   std::string pointer;             // "/outputs/N", for messages about this element
 };
 
 // The formats /outputs/N/format accepts.
-inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2"};
+inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd"};
 
 // One element of /outputs => options. Keys that do not apply to the format are left
 // undeclared, so the scene reader reports them as unknown.

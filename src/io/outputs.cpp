@@ -16,6 +16,7 @@
 #include "common/errors.h"
 #include "io/frame_sink.h"
 #include "io/staged_files.h"
+#include "io/vertex_normals.h"
 
 namespace treeanim {
 
@@ -40,6 +41,7 @@ std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::pat
   if (options.format == "gltf") return make_gltf_sink(options, path, model, info);
   if (options.format == "glb") return make_glb_sink(options, path, model, info);
   if (options.format == "pc2") return make_pc2_sink(options, path, model, info);
+  if (options.format == "mdd") return make_mdd_sink(options, path, model, info);
   throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
 }
 
@@ -105,6 +107,8 @@ struct OutputSet::Impl {
   const TreeModel& model;
   std::vector<std::unique_ptr<Worker>> workers;
   bool velocities = false;
+  bool normals = false;
+  std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
   bool has_hdf5 = false;
   bool done = false;  // finished or aborted
 
@@ -166,10 +170,12 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     const auto summary = worker->sink->summary_paths();
     worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();
     impl_->velocities = impl_->velocities || options.velocities;
+    impl_->normals = impl_->normals || options.normals;
     impl_->has_hdf5 = impl_->has_hdf5 || options.format == "hdf5";
     impl_->workers.push_back(std::move(worker));
   }
   check_targets(impl_->workers, outputs);
+  if (impl_->normals) impl_->rest_normals = rest_normals(model);
 }
 
 OutputSet::~OutputSet() {
@@ -196,6 +202,9 @@ void OutputSet::push(FrameData frame) {
                            " does not match the model (positions " + std::to_string(frame.positions.size()) +
                            ", velocities " + std::to_string(frame.velocities.size()) + ", leaf flags " +
                            std::to_string(frame.leaf_attached.size()) + ")");
+  // Once per frame for every output that carries them, on the caller's thread: the writers
+  // share the frame read-only.
+  if (impl_->normals) vertex_normals(impl_->model, frame.positions.data(), impl_->rest_normals, frame.normals);
   const auto shared = std::make_shared<const FrameData>(std::move(frame));
   for (auto& worker : impl_->workers) {
     if (!worker->selection.wants(shared->frame)) continue;

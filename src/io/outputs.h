@@ -4,6 +4,7 @@
 // beside its target and renames it when complete; abort() removes every temporary.
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +23,9 @@ struct BakeInfo {
   long long frame_count = 0;   // frames the bake will hand to push()
   int substeps = 1;
   uint64_t seed = 0;
+  // m: no written vertex is farther from its rest position (the solver's runaway guard);
+  // infinity when nothing bounds it (leaves that detach fly on).
+  double displacement_bound = std::numeric_limits<double>::infinity();
 };
 
 // One simulated frame, converted to float for output.
@@ -30,6 +34,7 @@ struct FrameData {
   double time = 0;                     // s
   std::vector<float> positions;        // (V*3) m
   std::vector<float> velocities;       // (V*3) m/s; empty unless some output asked for them
+  std::vector<float> normals;          // (V*3) unit; filled by OutputSet::push when an output wants them
   std::vector<uint8_t> leaf_attached;  // (L)
 };
 

@@ -4,6 +4,7 @@
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/vertex_normals.h"
 #include "io_test_support.h"
 
 namespace treeanim {
@@ -84,6 +85,53 @@ TEST_F(ObjPc2, Pc2CacheAndRestObj) {
     const FrameData expected = small_frame(m, 4 + 2 * long(k));
     for (size_t i = 0; i < 18; ++i) EXPECT_EQ(f32(32 + 4 * (18 * k + i)), expected.positions[i]);
   }
+}
+
+// MDD, big-endian: int32 frames, int32 points, float32 time of each frame, then the frames.
+TEST_F(ObjPc2, MddCacheAndRestObj) {
+  const TreeModel m = small_model();
+  test::bake({test::output("mdd", "cache/tree", 2)}, dir_, m, small_info(6, 4));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"cache", "cache/tree.mdd", "cache/tree.rest.obj"}));
+  const test::ObjMesh rest = test::parse_obj(dir_ / "cache/tree.rest.obj");
+  EXPECT_EQ(rest.positions, test::rest_f32(m));
+  expect_topology(rest, m);
+
+  const std::string bytes = test::read_file(dir_ / "cache/tree.mdd");
+  ASSERT_EQ(bytes.size(), 8u + 3 * 4 + 3 * 6 * 3 * 4);  // frames 4, 6, 8
+  auto u32 = [&](size_t offset) {
+    const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
+    return uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | uint32_t(b[3]);
+  };
+  auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
+  EXPECT_EQ(u32(0), 3u);  // frames
+  EXPECT_EQ(u32(4), 6u);  // points
+  for (size_t k = 0; k < 3; ++k) {
+    const FrameData expected = small_frame(m, 4 + 2 * long(k));
+    EXPECT_EQ(f32(8 + 4 * k), float(expected.time));
+    for (size_t i = 0; i < 18; ++i) EXPECT_EQ(f32(20 + 4 * (18 * k + i)), expected.positions[i]);
+  }
+}
+
+// "normals": a "vn" line per vertex in the rest OBJ and every frame, faces "v/vt/vn".
+TEST_F(ObjPc2, ObjSequenceWithNormals) {
+  const TreeModel m = small_model();
+  OutputOptions o = test::output("obj", "obj/tree");
+  o.normals = true;
+  test::bake({o}, dir_, m, small_info(2, 0));
+  std::vector<float> expected;
+  vertex_normals(m, small_frame(m, 1).positions.data(), rest_normals(m), expected);
+  const std::string text = test::read_file(dir_ / "obj/tree.0001.obj");
+  std::vector<float> read;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("vn ", 0) == 0) {
+      std::istringstream fields(line.substr(3));
+      for (float x; fields >> x;) read.push_back(x);
+    }
+  }
+  EXPECT_EQ(read, expected);
+  EXPECT_NE(text.find("\nf 2/2/2 3/3/3 1/1/1\n"), std::string::npos);
+  EXPECT_NE(test::read_file(dir_ / "obj/tree.rest.obj").find("\nvn "), std::string::npos);
 }
 
 TEST_F(ObjPc2, Pc2PathGetsItsExtension) {
