@@ -16,8 +16,16 @@ function(io_client_test name program)
   set_tests_properties(${name} PROPERTIES LABELS "io;clients" FIXTURES_REQUIRED io_bake TIMEOUT 300)
 endfunction()
 
+# The scene's own outputs, then the same scene again with the optional outputs (normals, a
+# quantized HDF5, MDD) into options/, beside a plain HDF5 bake with normals to compare with.
+set(io_options_dir ${io_bake_dir}/options)
+set(io_options_outputs "[{\"format\":\"hdf5\",\"path\":\"plain.h5\",\"normals\":true},\
+{\"format\":\"hdf5\",\"path\":\"quantized.h5\",\"quantize\":0.0001},\
+{\"format\":\"obj\",\"path\":\"obj/tree\",\"normals\":true,\"frame_step\":5},\
+{\"format\":\"gltf\",\"path\":\"gltf/tree\",\"normals\":true,\"frame_step\":6},\
+{\"format\":\"glb\",\"path\":\"normals.glb\",\"normals\":true},{\"format\":\"mdd\",\"path\":\"tree.mdd\"}]")
 add_test(NAME io_clients_bake
-         COMMAND sh -c "rm -rf '${io_bake_dir}' && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet"
+         COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}'"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(io_clients_bake PROPERTIES LABELS "io;clients" FIXTURES_SETUP io_bake TIMEOUT 120)
 
@@ -25,6 +33,12 @@ find_program(TREEANIM_SYSTEM_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
 io_client_test(io_clients_h5py "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_hdf5.py
                ${io_bake_dir}/small_tree.h5 --obj ${io_bake_dir}/obj/small_tree --pc2 ${io_bake_dir}/small_tree.pc2
                --velocities yes --compression 4)
+
+# Normals against normals recomputed from each frame's triangles (and equal in OBJ and GLB),
+# the quantized bake within half a step of the plain one, the MDD equal to the bake.
+io_client_test(io_clients_bake_options "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_bake_options.py
+               ${io_options_dir}/plain.h5 --quantized ${io_options_dir}/quantized.h5 --mdd ${io_options_dir}/tree.mdd
+               --obj ${io_options_dir}/obj/tree --glb ${io_options_dir}/normals.glb)
 
 # Golden bake: positions, velocities and every other number within 1e-5 (m, m/s, kg), strings
 # and attributes exact. scripts/update-golden regenerates tests/golden/*.h5 on purpose.
@@ -38,12 +52,14 @@ if(NOT EXISTS ${io_clients}/node/node_modules/gltf-validator)
 endif()
 io_client_test(io_clients_gltf_validator "${TREEANIM_NODE}" ${io_clients}/node/validate_gltf.js
                ${io_bake_dir}/small_tree.glb ${io_bake_dir}/gltf/small_tree.0000.glb
-               ${io_bake_dir}/gltf/small_tree.0006.glb)
+               ${io_bake_dir}/gltf/small_tree.0006.glb ${io_options_dir}/normals.glb
+               ${io_options_dir}/gltf/tree.0006.glb)
 
 find_program(TREEANIM_BLENDER blender)
 io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --python
                ${io_clients}/check_blender.py -- ${io_bake_dir}/small_tree.h5 ${io_bake_dir}/small_tree.glb
-               ${io_bake_dir}/small_tree.pc2 ${io_bake_dir}/small_tree.rest.obj)
+               ${io_bake_dir}/small_tree.pc2 ${io_bake_dir}/small_tree.rest.obj
+               ${io_options_dir}/tree.mdd ${io_options_dir}/tree.rest.obj)
 
 # A bad output path is refused before simulating, with exit code 4 and the path named.
 add_test(NAME io_cli_unwritable_output

@@ -2,10 +2,12 @@
 
 1. imports the animated GLB (import_shading='SMOOTH': Blender 3.4's default path hits a numpy
    error) and checks every shape key against the HDF5 frame it stands for, to 1e-5 m;
-2. imports the PC2's rest OBJ, adds a Mesh Cache modifier reading the PC2, and checks the
-   evaluated vertices at several frames against the HDF5 frames, to 1e-5 m.
+2. imports each point cache's rest OBJ (PC2, and MDD when given), adds a Mesh Cache modifier
+   reading the cache, and checks the evaluated vertices at several frames against the HDF5
+   frames, to 1e-5 m.
 
 Usage: blender -b --factory-startup --python check_blender.py -- BAKE.h5 ANIM.glb CACHE.pc2 REST.obj
+       [CACHE.mdd REST.obj]
 Exit 0 when everything holds, 1 otherwise. Runs with Blender's Python (h5py from python3-h5py)."""
 import sys
 
@@ -77,7 +79,7 @@ def check_animated_glb(path, bake):
     return worst
 
 
-def check_mesh_cache(pc2, rest_obj, bake):
+def check_mesh_cache(cache, rest_obj, bake):
     clear_scene()
     # Axes as in the file (no Y-up => Z-up turn), so the cache's coordinates apply unchanged.
     bpy.ops.wm.obj_import(filepath=rest_obj, forward_axis='Y', up_axis='Z')
@@ -89,10 +91,10 @@ def check_mesh_cache(pc2, rest_obj, bake):
         return 0.0, []  # Mesh Cache needs equal counts; reported above
     check(np.abs(coordinates(obj.data.vertices) - rest).max() <= TOLERANCE, f"{rest_obj}: rest pose differs")
     modifier = obj.modifiers.new("cache", 'MESH_CACHE')
-    modifier.cache_format = 'PC2'
-    modifier.filepath = pc2
-    # Mesh Cache in FRAME mode plays sample (scene frame - frame_start); the PC2 header's start
-    # frame is the bake's frame_start, so both count frames alike.
+    modifier.cache_format = 'MDD' if cache.endswith(".mdd") else 'PC2'
+    modifier.filepath = cache
+    # Mesh Cache in FRAME mode plays sample (scene frame - frame_start): sample 0 is the bake's
+    # frame_start (the PC2 header says so too).
     start = int(bake.attrs["frame_start"])
     modifier.frame_start = start
     time = bake["frames/time"][()]
@@ -106,24 +108,28 @@ def check_mesh_cache(pc2, rest_obj, bake):
         co = coordinates(evaluated.data.vertices)
         error = np.abs(co - bake["frames/positions"][k]).max()
         worst = max(worst, error)
-        check(error <= TOLERANCE, f"{pc2}: frame {frames[k]} through Mesh Cache differs from the bake by {error:.3g} m")
-    check(len(checked) > 0, f"{pc2}: no frame checked")
+        check(error <= TOLERANCE, f"{cache}: frame {frames[k]} through Mesh Cache differs from the bake by {error:.3g} m")
+    check(len(checked) > 0, f"{cache}: no frame checked")
     return worst, [frames[k] for k in checked]
 
 
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:]
-    if len(argv) != 4:
+    if len(argv) not in (4, 6):
         print(__doc__)
         return 2
-    bake_path, glb, pc2, rest_obj = argv
+    bake_path, glb = argv[:2]
+    caches = list(zip(argv[2::2], argv[3::2]))
+    summary = []
     with h5py.File(bake_path, "r") as bake:
         glb_error = check_animated_glb(glb, bake)
-        cache_error, frames = check_mesh_cache(pc2, rest_obj, bake)
+        for cache, rest_obj in caches:
+            cache_error, frames = check_mesh_cache(cache, rest_obj, bake)
+            summary.append(f"{cache.rsplit('.', 1)[-1].upper()} at frames {frames} within {cache_error:.3g} m")
     for failure in failures:
         print(f"check_blender: {failure}")
     print(f"check_blender: {'FAILED' if failures else 'ok'}: shape keys within {glb_error:.3g} m, "
-          f"Mesh Cache at frames {frames} within {cache_error:.3g} m")
+          f"Mesh Cache: {'; '.join(summary)}")
     return 1 if failures else 0
 
 
