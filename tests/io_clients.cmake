@@ -23,7 +23,8 @@ set(io_options_outputs "[{\"format\":\"hdf5\",\"path\":\"plain.h5\",\"normals\":
 {\"format\":\"hdf5\",\"path\":\"quantized.h5\",\"quantize\":0.0001},\
 {\"format\":\"obj\",\"path\":\"obj/tree\",\"normals\":true,\"frame_step\":5},\
 {\"format\":\"gltf\",\"path\":\"gltf/tree\",\"normals\":true,\"frame_step\":6},\
-{\"format\":\"glb\",\"path\":\"normals.glb\",\"normals\":true},{\"format\":\"mdd\",\"path\":\"tree.mdd\"}]")
+{\"format\":\"glb\",\"path\":\"normals.glb\",\"normals\":true},{\"format\":\"mdd\",\"path\":\"tree.mdd\"},\
+{\"format\":\"vat\",\"path\":\"vat/tree\"},{\"format\":\"vat\",\"path\":\"vat_half/tree\",\"precision\":\"half\",\"texture_width\":100}]")
 add_test(NAME io_clients_bake
          COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}'"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
@@ -53,13 +54,20 @@ endif()
 io_client_test(io_clients_gltf_validator "${TREEANIM_NODE}" ${io_clients}/node/validate_gltf.js
                ${io_bake_dir}/small_tree.glb ${io_bake_dir}/gltf/small_tree.0000.glb
                ${io_bake_dir}/gltf/small_tree.0006.glb ${io_options_dir}/normals.glb
-               ${io_options_dir}/gltf/tree.0006.glb)
+               ${io_options_dir}/gltf/tree.0006.glb ${io_options_dir}/vat/tree.glb)
 
 find_program(TREEANIM_BLENDER blender)
 io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --python
                ${io_clients}/check_blender.py -- ${io_bake_dir}/small_tree.h5 ${io_bake_dir}/small_tree.glb
                ${io_bake_dir}/small_tree.pc2 ${io_bake_dir}/small_tree.rest.obj
                ${io_options_dir}/tree.mdd ${io_options_dir}/tree.rest.obj)
+
+# Vertex animation textures read by Blender (bpy.data.images.load): rest + texel gives the bake's
+# frames to the texture's precision (float and half), the normals too, and the rest GLB's second
+# UV map addresses each vertex's texel.
+io_client_test(io_clients_blender_vat "${TREEANIM_BLENDER}" -b --factory-startup --python
+               ${io_clients}/check_vat.py -- ${io_options_dir}/plain.h5 ${io_options_dir}/vat/tree
+               ${io_options_dir}/vat_half/tree)
 
 # A bad output path is refused before simulating, with exit code 4 and the path named.
 add_test(NAME io_cli_unwritable_output

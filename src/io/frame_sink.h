@@ -74,6 +74,8 @@ std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const std
                                          const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                         const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
 

@@ -27,6 +27,11 @@ OutputOptions read_output_options(SceneObject element) {
   }
   if (options.format == "hdf5" || options.format == "obj" || options.format == "gltf" || options.format == "glb")
     options.normals = element.boolean("normals", false);
+  if (options.format == "vat") {
+    options.normals = true;  // the normals texture
+    options.texture_width = static_cast<size_t>(element.integer("texture_width", 0, 0, 8192));
+    options.vat_half = element.choice("precision", "float", {"float", "half"}) == "half";
+  }
   return options;
 }
 

@@ -42,6 +42,7 @@ std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::pat
   if (options.format == "glb") return make_glb_sink(options, path, model, info);
   if (options.format == "pc2") return make_pc2_sink(options, path, model, info);
   if (options.format == "mdd") return make_mdd_sink(options, path, model, info);
+  if (options.format == "vat") return make_vat_sink(options, path, model, info);
   throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
 }
 

@@ -120,9 +120,11 @@ TEST_F(OutputSetTest, TargetsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
   const std::vector<std::pair<std::string, std::string>> targets = {
       {"hdf5", "bake.h5"},           {"glb", "anim.glb"},           {"pc2", "tree.pc2"},
       {"pc2", "tree.rest.obj"},      {"obj", "obj/tree.0001.obj"},  {"obj", "obj/tree.rest.obj"},
-      {"gltf", "gltf/tree.0002.glb"}};
+      {"gltf", "gltf/tree.0002.glb"}, {"mdd", "tree.mdd"},            {"vat", "vat/tree.normals.exr"},
+      {"vat", "vat/tree.json"}};
   const std::vector<std::pair<std::string, std::string>> paths = {
-      {"hdf5", "bake.h5"}, {"glb", "anim.glb"}, {"pc2", "tree.pc2"}, {"obj", "obj/tree"}, {"gltf", "gltf/tree"}};
+      {"hdf5", "bake.h5"},   {"glb", "anim.glb"}, {"pc2", "tree.pc2"}, {"obj", "obj/tree"},
+      {"gltf", "gltf/tree"}, {"mdd", "tree.mdd"}, {"vat", "vat/tree"}};
   for (const auto& [format, file] : targets) {
     for (const std::string kind : {"character device", "FIFO", "socket", "directory"}) {
       SCOPED_TRACE(format + " " + file + " " + kind);
