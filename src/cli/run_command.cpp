@@ -115,6 +115,7 @@ int run_command(const RunRequest& request) {
                 tree.model.cluster_count(), (write_last - first) * scene.time.substeps,
                 seconds_since(wall_start), seconds_since(sim_start));
     for (const auto& path : outputs.final_paths()) std::printf("  wrote %s\n", path.string().c_str());
+    for (const auto& [path, line] : outputs.reports()) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
   }
   return 0;
 }

@@ -41,6 +41,8 @@ class FrameSink {
   virtual void finish() {}
   // Renames every temporary to its final name.
   void commit() { staged_.commit(); }
+  // A line for the run's summary after finish() ("" for none), e.g. a fit's error.
+  virtual std::string report() const { return ""; }
   // Closes and removes every temporary. Never throws.
   virtual void abort() noexcept { staged_.discard(); }
 
@@ -74,6 +76,8 @@ std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const std
                                          const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                                 const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,

@@ -32,6 +32,8 @@ OutputOptions read_output_options(SceneObject element) {
     options.texture_width = static_cast<size_t>(element.integer("texture_width", 0, 0, 8192));
     options.vat_half = element.choice("precision", "float", {"float", "half"}) == "half";
   }
+  if (options.format == "skinned_glb")
+    options.max_joints = static_cast<size_t>(element.optional_integer("max_joints", 1, 65535).value_or(0));
   return options;
 }
 

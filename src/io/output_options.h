@@ -8,7 +8,7 @@
 namespace treeanim {
 
 struct OutputOptions {
-  std::string format;              // "hdf5" | "obj" | "gltf" | "glb" | "pc2" | "mdd" | "vat"
+  std::string format;              // one of kOutputFormats
   std::filesystem::path path;      // as written in the scene; resolved by OutputSet
   int frame_step = 1;              // write every k-th frame
   int compression = 0;             // hdf5: 0 none, 1..9 shuffle + deflate level
@@ -16,12 +16,13 @@ struct OutputOptions {
   bool normals = false;            // hdf5, obj, gltf, glb: per-frame vertex normals
   double quantize = 0;             // hdf5: m, > 0 stores displacements as integers of this step
   size_t texture_width = 0;        // vat: texels per row; 0 = as many as vertices, at most 8192
+  size_t max_joints = 0;           // skinned_glb: joints at most; 0 = one per cluster
   bool vat_half = false;           // vat: half-float textures (else float)
   std::string pointer;             // "/outputs/N", for messages about this element
 };
 
 // The formats /outputs/N/format accepts.
-inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd", "vat"};
+inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd", "vat", "skinned_glb"};
 
 // One element of /outputs => options. Keys that do not apply to the format are left
 // undeclared, so the scene reader reports them as unknown.

@@ -43,6 +43,7 @@ std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::pat
   if (options.format == "pc2") return make_pc2_sink(options, path, model, info);
   if (options.format == "mdd") return make_mdd_sink(options, path, model, info);
   if (options.format == "vat") return make_vat_sink(options, path, model, info);
+  if (options.format == "skinned_glb") return make_skinned_glb_sink(options, path, model, info);
   throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
 }
 
@@ -254,6 +255,13 @@ void OutputSet::abort() noexcept {
     worker->sink->abort();
   }
   impl_->done = true;
+}
+
+std::vector<std::pair<fs::path, std::string>> OutputSet::reports() const {
+  std::vector<std::pair<fs::path, std::string>> reports;
+  for (const auto& worker : impl_->workers)
+    if (std::string line = worker->sink->report(); !line.empty()) reports.emplace_back(worker->first_path, line);
+  return reports;
 }
 
 std::vector<fs::path> OutputSet::final_paths() const {

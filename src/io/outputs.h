@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/output_options.h"
@@ -60,6 +61,8 @@ class OutputSet {
   void abort() noexcept;
   // Final paths (files, or the first file of a sequence pattern) for the summary line.
   std::vector<std::filesystem::path> final_paths() const;
+  // After finish(): what outputs have to say besides their paths (a fit's error), by output path.
+  std::vector<std::pair<std::filesystem::path, std::string>> reports() const;
 
  private:
   struct Impl;

@@ -16,16 +16,11 @@ import os
 import sys
 
 import bpy
-import h5py
 import numpy as np
 
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_bake_check  # noqa: E402
+from blender_bake_check import check  # noqa: E402
 
 def texture(path):
     """EXR => (height, width, 3) float array, row 0 the top of the image."""
@@ -92,20 +87,5 @@ def check_stem(stem, bake):
            f"{layout['texture_height']}, positions within {worst_position:.3g} m, normals within {worst_normal:.3g}"
 
 
-def main():
-    argv = sys.argv[sys.argv.index("--") + 1:]
-    if len(argv) < 2:
-        print(__doc__)
-        return 2
-    with h5py.File(argv[0], "r") as bake:
-        summary = [check_stem(stem, bake) for stem in argv[1:]]
-    for failure in failures:
-        print(f"check_vat: {failure}")
-    print(f"check_vat: {'FAILED' if failures else 'ok'}: {'; '.join(summary)}")
-    return 1 if failures else 0
-
-
 if __name__ == "__main__":
-    code = main()
-    sys.stdout.flush()
-    os._exit(code)  # Blender ignores a script's exit status unless it leaves itself
+    blender_bake_check.run("check_vat", __doc__, check_stem)

@@ -133,12 +133,13 @@ def tree_state(folder):
 
 
 # Every file the bake scene's outputs write (one frame of each sequence), plus the formats it
-# does not list: a glTF sequence, an MDD cache and vertex animation textures.
+# does not list: a glTF sequence, an MDD cache, vertex animation textures and a skinned GLB.
 WITH_GLTF = ["--set", "outputs.4={\"format\": \"gltf\", \"path\": \"gltf/tree\"}",
              "--set", "outputs.5={\"format\": \"mdd\", \"path\": \"cache/tree.mdd\"}",
-             "--set", "outputs.6={\"format\": \"vat\", \"path\": \"vat/tree\"}"]
+             "--set", "outputs.6={\"format\": \"vat\", \"path\": \"vat/tree\"}",
+             "--set", "outputs.7={\"format\": \"skinned_glb\", \"path\": \"skinned.glb\"}"]
 TARGETS = ["bake.h5", "seq/tree.0005.obj", "seq/tree.rest.obj", "tree.glb", "tree.pc2", "tree.rest.obj",
-           "gltf/tree.0003.glb", "cache/tree.mdd", "vat/tree.positions.exr", "vat/tree.glb"]
+           "gltf/tree.0003.glb", "cache/tree.mdd", "vat/tree.positions.exr", "vat/tree.glb", "skinned.glb"]
 
 
 def output_not_a_regular_file(bake):

@@ -1,0 +1,292 @@
+// Skinned glTF ("skinned_glb", docs/outputs.md "Skinned glTF"): the rest mesh bound to one joint
+// per cluster (or per limb, option max_joints), and per joint a translation and a rotation key
+// per written frame, fitted so that the skinned mesh follows the bake (io/skin_fit.h). The RMS
+// and largest error of the skinned mesh against the bake, relative to the bake's RMS
+// displacement, go into the asset's extras ("skinning") and the run's summary. Written with tinygltf at the
+// end: the keys of every frame are kept until then (28 bytes per joint and frame).
+#include <tiny_gltf.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "common/errors.h"
+#include "io/frame_sink.h"
+#include "io/glb_size.h"
+#include "io/obj_format.h"
+#include "io/skin_fit.h"
+#include "io/staged_files.h"
+#include "io/vertex_normals.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Appends views and accessors to a tinygltf model over one growing buffer.
+class GltfBuilder {
+ public:
+  explicit GltfBuilder(tinygltf::Model& gltf) : gltf_(gltf) { gltf_.buffers.emplace_back(); }
+
+  int accessor(const void* data, size_t bytes, int component, size_t count, int type, int target = 0) {
+    auto& buffer = gltf_.buffers[0].data;
+    buffer.resize((buffer.size() + 3) / 4 * 4, 0);  // every view 4-byte aligned
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.size();
+    view.byteLength = bytes;
+    view.target = target;
+    const auto* begin = static_cast<const unsigned char*>(data);
+    buffer.insert(buffer.end(), begin, begin + bytes);
+    gltf_.bufferViews.push_back(view);
+    tinygltf::Accessor a;
+    a.bufferView = int(gltf_.bufferViews.size() - 1);
+    a.componentType = component;
+    a.count = count;
+    a.type = type;
+    gltf_.accessors.push_back(a);
+    return int(gltf_.accessors.size() - 1);
+  }
+
+  int floats(const std::vector<float>& values, int type, int components, int target = 0) {
+    return accessor(values.data(), 4 * values.size(), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                    values.size() / size_t(components), type, target);
+  }
+
+  // Per-component bounds of a float accessor (glTF asks them of POSITION and animation inputs).
+  void bound(int index, const std::vector<float>& values, int components) {
+    std::vector<double> low(size_t(components), std::numeric_limits<double>::max());
+    std::vector<double> high(size_t(components), -std::numeric_limits<double>::max());
+    for (size_t i = 0; i < values.size(); ++i) {
+      low[i % size_t(components)] = std::min(low[i % size_t(components)], double(values[i]));
+      high[i % size_t(components)] = std::max(high[i % size_t(components)], double(values[i]));
+    }
+    gltf_.accessors[size_t(index)].minValues = low;
+    gltf_.accessors[size_t(index)].maxValues = high;
+  }
+
+ private:
+  tinygltf::Model& gltf_;
+};
+
+// Bytes of the file, bounded from above before simulating (a GLB states its length in 32 bits).
+uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frames) {
+  const uint64_t n = model.vertex_count(), t = model.triangle_count(), j = joints;
+  constexpr uint64_t kJsonPerJoint = 1024, kJsonFixed = 4096;  // generous: nodes, samplers, channels, accessors
+  return kJsonFixed + kJsonPerJoint * j + 12 * t + n * (12 + 12 + 8 + 8 + 16) + 64 * j + 4 * frames +
+         28 * frames * j + 8 * (2 * j + 16);
+}
+
+class SkinnedGlbSink final : public FrameSink {
+ public:
+  SkinnedGlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
+      : path_(std::move(path)), model_(model), info_(info),
+        selection_{info.frame_start, info.frame_count, options.frame_step},
+        skin_(build_skin(model, options.max_joints > 0 ? options.max_joints : model.cluster_count())) {
+    const uint64_t bytes = skinned_glb_bytes(model, skin_.joint_count(), uint64_t(selection_.written()));
+    if (bytes > kGlbMaxBytes)
+      throw OutputError(path_.string() + ": the skinned GLB would pass glTF's 4 GiB GLB limit (" +
+                        std::to_string(skin_.joint_count()) + " joints x " + std::to_string(selection_.written()) +
+                        " frames); lower max_joints, raise frame_step or shorten the bake");
+  }
+
+  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
+  std::vector<fs::path> summary_paths() const override { return {path_}; }
+
+  void begin() override {
+    temporary_ = staged_.stage(path_);
+    rest_ = rest_positions_f32(model_);
+    previous_rotation_.assign(skin_.joint_count(), Eigen::Quaterniond::Identity());
+  }
+
+  void write(const FrameData& frame) override {
+    fit_joints(skin_, model_, frame.positions.data(), motions_);
+    for (size_t j = 0; j < skin_.joint_count(); ++j) {
+      const auto [rotation, translation] = local_transform(j);
+      Eigen::Quaterniond q(rotation);
+      q.normalize();
+      if (q.dot(previous_rotation_[j]) < 0) q.coeffs() = -q.coeffs();  // keys interpolate the short way
+      previous_rotation_[j] = q;
+      for (int a = 0; a < 3; ++a) translations_.push_back(float(translation[a]));
+      for (double c : {q.x(), q.y(), q.z(), q.w()}) rotations_.push_back(float(c));
+    }
+    double frame_squared_error = 0;
+    for (size_t v = 0; v < model_.vertex_count(); ++v) {
+      const Eigen::Vector3d baked(frame.positions[3 * v], frame.positions[3 * v + 1], frame.positions[3 * v + 2]);
+      const double error = (skinned_position(skin_, model_, motions_, v) - baked).norm();
+      frame_squared_error += error * error;
+      largest_error_ = std::max(largest_error_, error);
+      squared_displacement_ += (baked - model_.rest_positions.col(long(v))).squaredNorm();
+    }
+    squared_error_ += frame_squared_error;
+    frame_rms_error_.push_back(model_.vertex_count() ? std::sqrt(frame_squared_error / double(model_.vertex_count())) : 0.0);
+    times_.push_back(float(frame.time));
+  }
+
+  void finish() override {
+    const double samples = double(times_.size()) * double(model_.vertex_count());
+    const double rms_displacement = samples > 0 ? std::sqrt(squared_displacement_ / samples) : 0.0;
+    const double rms_error = samples > 0 ? std::sqrt(squared_error_ / samples) : 0.0;
+    relative_rms_ = rms_displacement > 0 ? rms_error / rms_displacement : 0.0;
+    relative_max_ = rms_displacement > 0 ? largest_error_ / rms_displacement : 0.0;
+    tinygltf::Model gltf = assemble(rms_displacement, rms_error);
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToFile(&gltf, temporary_.string(), false, true, false, true))
+      throw OutputError(io_failure(path_, "tinygltf could not write the skinned GLB"));
+  }
+
+  std::string report() const override {
+    char text[200];
+    std::snprintf(text, sizeof text, "skinning error RMS %.2f %%, max %.2f %% of the RMS displacement, %zu joints",
+                  100 * relative_rms_, 100 * relative_max_, skin_.joint_count());
+    return text;
+  }
+
+ private:
+  // Joint j's transform relative to its parent's: world_j = M_j T(pivot_j), local = world_parent^-1 world_j.
+  std::pair<Eigen::Matrix3d, Eigen::Vector3d> local_transform(size_t j) const {
+    const RigidMotion& m = motions_[j];
+    const Eigen::Vector3d& pivot = skin_.joint_pivot[j];
+    const int32_t parent = skin_.joint_parent[j];
+    if (parent < 0) return {m.rotation, m.rotation * pivot + m.translation};
+    const RigidMotion& p = motions_[size_t(parent)];
+    const Eigen::Matrix3d rotation = p.rotation.transpose() * m.rotation;
+    return {rotation, rotation * pivot + p.rotation.transpose() * (m.translation - p.translation) -
+                          skin_.joint_pivot[size_t(parent)]};
+  }
+
+  tinygltf::Model assemble(double rms_displacement, double rms_error) const {
+    tinygltf::Model gltf;
+    GltfBuilder add(gltf);
+    const size_t n = model_.vertex_count(), joints = skin_.joint_count(), frames = times_.size();
+    tinygltf::Primitive primitive;
+    primitive.mode = TINYGLTF_MODE_TRIANGLES;
+    primitive.indices = add.accessor(model_.triangles.data(), 4 * model_.triangles.size(),
+                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, model_.triangles.size(), TINYGLTF_TYPE_SCALAR,
+                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    primitive.attributes["POSITION"] = add.floats(rest_, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    add.bound(primitive.attributes["POSITION"], rest_, 3);
+    primitive.attributes["NORMAL"] = add.floats(rest_normals(model_), TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    std::vector<float> uvs(2 * n), weights(4 * n);
+    std::vector<uint16_t> joint_ids(4 * n);
+    for (size_t v = 0; v < n; ++v) {
+      uvs[2 * v] = model_.uvs(0, long(v));
+      uvs[2 * v + 1] = 1.0f - model_.uvs(1, long(v));  // glTF's v runs down the image
+      for (size_t k = 0; k < 4; ++k) {
+        joint_ids[4 * v + k] = skin_.vertex_joints[v][k];
+        weights[4 * v + k] = skin_.vertex_weights[v][k];
+      }
+    }
+    primitive.attributes["TEXCOORD_0"] = add.floats(uvs, TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes["JOINTS_0"] = add.accessor(joint_ids.data(), 2 * joint_ids.size(),
+                                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, n, TINYGLTF_TYPE_VEC4,
+                                                    TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes["WEIGHTS_0"] = add.floats(weights, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    tinygltf::Mesh mesh;
+    mesh.name = "tree";
+    mesh.primitives.push_back(primitive);
+    gltf.meshes.push_back(mesh);
+
+    // Node 0 holds the skinned mesh; nodes 1 + j are the joints, at their rest pivots.
+    tinygltf::Node mesh_node;
+    mesh_node.name = "tree";
+    mesh_node.mesh = 0;
+    mesh_node.skin = 0;
+    gltf.nodes.push_back(mesh_node);
+    tinygltf::Skin skin;
+    skin.name = "clusters";
+    std::vector<float> inverse_binds(16 * joints, 0.0f);
+    tinygltf::Value::Array frame_errors;
+    for (double error : frame_rms_error_) frame_errors.emplace_back(error);
+    tinygltf::Scene scene;
+    scene.nodes.push_back(0);
+    for (size_t j = 0; j < joints; ++j) {
+      tinygltf::Node joint;
+      joint.name = "joint_" + std::to_string(j);
+      const Eigen::Vector3d& pivot = skin_.joint_pivot[j];
+      const int32_t parent = skin_.joint_parent[j];
+      const Eigen::Vector3d local = parent < 0 ? pivot : Eigen::Vector3d(pivot - skin_.joint_pivot[size_t(parent)]);
+      joint.translation = {local.x(), local.y(), local.z()};
+      gltf.nodes.push_back(joint);
+      skin.joints.push_back(int(1 + j));
+      if (parent < 0) scene.nodes.push_back(int(1 + j));
+      for (int d = 0; d < 4; ++d) inverse_binds[16 * j + size_t(5 * d)] = 1.0f;  // column-major T(-pivot)
+      for (int a = 0; a < 3; ++a) inverse_binds[16 * j + 12 + size_t(a)] = float(-pivot[a]);
+    }
+    for (size_t j = 0; j < joints; ++j)
+      if (skin_.joint_parent[j] >= 0) gltf.nodes[size_t(1 + skin_.joint_parent[j])].children.push_back(int(1 + j));
+    skin.inverseBindMatrices = add.floats(inverse_binds, TINYGLTF_TYPE_MAT4, 16);
+    // In the asset's extras: tinygltf writes no skin extras.
+    gltf.asset.extras = tinygltf::Value(tinygltf::Value::Object{{"skinning", tinygltf::Value(tinygltf::Value::Object{
+        {"skinning_error_rms", tinygltf::Value(relative_rms_)},
+        {"skinning_error_max", tinygltf::Value(relative_max_)},
+        {"skinning_error_relative_to", tinygltf::Value(std::string("the bake's RMS displacement from rest"))},
+        {"rms_displacement_m", tinygltf::Value(rms_displacement)},
+        {"rms_error_m", tinygltf::Value(rms_error)},
+        {"largest_error_m", tinygltf::Value(largest_error_)},
+        {"frame_rms_error_m", tinygltf::Value(frame_errors)},
+        {"clusters", tinygltf::Value(int(model_.cluster_count()))},
+        {"joints", tinygltf::Value(int(joints))}})}});
+    gltf.skins.push_back(skin);
+
+    if (frames > 0) {
+      tinygltf::Animation animation;
+      animation.name = "wind";
+      const int input = add.floats(times_, TINYGLTF_TYPE_SCALAR, 1);
+      add.bound(input, times_, 1);
+      std::vector<float> keys;
+      for (size_t j = 0; j < joints; ++j) {
+        for (const auto& [path, width] : {std::pair{"translation", 3}, std::pair{"rotation", 4}}) {
+          const std::vector<float>& all = width == 3 ? translations_ : rotations_;
+          keys.clear();
+          for (size_t f = 0; f < frames; ++f)
+            keys.insert(keys.end(), all.begin() + long((f * joints + j) * size_t(width)),
+                        all.begin() + long((f * joints + j + 1) * size_t(width)));
+          tinygltf::AnimationSampler sampler;
+          sampler.input = input;
+          sampler.output = add.floats(keys, width == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4, width);
+          sampler.interpolation = "LINEAR";
+          animation.samplers.push_back(sampler);
+          tinygltf::AnimationChannel channel;
+          channel.sampler = int(animation.samplers.size() - 1);
+          channel.target_node = int(1 + j);
+          channel.target_path = path;
+          animation.channels.push_back(channel);
+        }
+      }
+      gltf.animations.push_back(animation);
+    }
+    gltf.scenes.push_back(scene);
+    gltf.defaultScene = 0;
+    gltf.asset.version = "2.0";
+    gltf.asset.generator = info_.generator;
+    return gltf;
+  }
+
+  fs::path path_;
+  fs::path temporary_;
+  const TreeModel& model_;
+  BakeInfo info_;
+  FrameSelection selection_;
+  Skin skin_;
+  std::vector<float> rest_;                          // (N*3) m, the bind pose
+  std::vector<RigidMotion> motions_;                 // (J) scratch: this frame's fitted motions
+  std::vector<Eigen::Quaterniond> previous_rotation_;  // (J) last key, for sign continuity
+  std::vector<float> translations_;                  // (F*J*3) m, local to the parent joint
+  std::vector<float> rotations_;                     // (F*J*4) unit quaternions (x, y, z, w)
+  std::vector<float> times_;                         // (F) s
+  std::vector<double> frame_rms_error_;              // (F) m, RMS over the vertices of skinned - baked
+  double squared_error_ = 0, largest_error_ = 0, squared_displacement_ = 0;  // m^2, m, m^2
+  double relative_rms_ = 0, relative_max_ = 0;       // of the RMS displacement, after finish()
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const fs::path& path,
+                                                 const TreeModel& model, const BakeInfo& info) {
+  return std::make_unique<SkinnedGlbSink>(options, path, model, info);
+}
+
+}  // namespace treeanim
