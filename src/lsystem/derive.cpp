@@ -1,6 +1,7 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <bit>
 #include <span>
 #include <string>
 #include <utility>
@@ -14,26 +15,33 @@ namespace {
 
 // Keys of the random streams, so that the same (step, position) never shares draws between
 // purposes.
-enum Purpose : uint64_t { kAxiom = 1, kProduction = 2, kDecomposition = 3, kHomomorphism = 4 };
+enum Purpose : uint64_t { kAxiom = 1, kProduction = 2, kDecomposition = 3, kHomomorphism = 4, kBlock = 5 };
 
 constexpr int kMaxSlots = 64;  // formal parameters of one rule (the parser enforces it)
 
 class Deriver {
  public:
   Deriver(const Grammar& grammar, const DerivationSettings& settings)
-      : g_(grammar), settings_(settings) {}
+      : g_(grammar), settings_(settings), variables_(grammar.variables.size() + 1, 0.0) {}
 
+  // Start, then per step StartEach / productions / decomposition / EndEach, then End (CPFG
+  // manual 4.1).
   ModuleString derive() {
     ModuleString word;
     word.clear();
+    run_block(g_.start_block);
     emit_axiom(&word);
     word = finish_step(std::move(word), 0);
     ModuleString next;
     for (step_ = 1; step_ <= settings_.iterations; ++step_) {
+      run_block(g_.start_each_block);
       rewrite(word, &next);
       std::swap(word, next);
       word = finish_step(std::move(word), step_);
+      run_block(g_.end_each_block);
     }
+    step_ = settings_.iterations;
+    run_block(g_.end_block);
     return word;
   }
 
@@ -55,13 +63,29 @@ class Deriver {
   }
 
  private:
+  // The seed of the random streams: the settings' one, changed by the last srand() (cpfg 5.3).
+  uint64_t seed() const {
+    const double srand_value = variables_[kSrandVariable];
+    return srand_value == 0.0 ? settings_.seed
+                              : settings_.seed ^ (std::bit_cast<uint64_t>(srand_value) * 0x9e3779b97f4a7c15ULL);
+  }
+
+  // A Start/StartEach/EndEach/End block, its draws keyed by the step.
+  void run_block(const Expr& block) {
+    if (!block.present()) return;
+    rule_ = nullptr;
+    RandomStream random = RandomStream::keyed(seed(), kBlock, static_cast<uint64_t>(step_), block.begin);
+    double no_slots[1] = {0.0};
+    execute(g_.program, block, no_slots, random, variables_.data());
+  }
+
   // The axiom's modules, their parameters evaluated with the axiom's random stream.
   void emit_axiom(ModuleString* out) {
-    RandomStream random = RandomStream::keyed(settings_.seed, kAxiom, 0, 0);
+    RandomStream random = RandomStream::keyed(seed(), kAxiom, 0, 0);
     for (const SuccessorModule& m : g_.axiom) {
       out->symbols.push_back(m.symbol);
       for (uint32_t p = 0; p < m.arity; ++p)
-        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random));
+        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random, variables_.data()));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
     }
     check_cap(*out);
@@ -114,7 +138,7 @@ class Deriver {
         copy_module(word, i, next);
         continue;
       }
-      RandomStream random = RandomStream::keyed(settings_.seed, kProduction, static_cast<uint64_t>(step_), i);
+      RandomStream random = RandomStream::keyed(seed(), kProduction, static_cast<uint64_t>(step_), i);
       const Rule* rule = select(set, word.symbols[i], word.params_of(i), i, slots, random);
       if (rule) emit_successor(set, *rule, slots, random, next);
       else copy_module(word, i, next);
@@ -154,13 +178,15 @@ class Deriver {
         continue;
       }
       rule_ = &rule;
-      const double weight = evaluate(g_.program, rule.probability, slots, random);
+      const double weight = evaluate(g_.program, rule.probability, slots, random, variables_.data());
       if (weight < 0)
         throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + std::to_string(weight)};
       weights_.resize(candidates + 1);
       chosen_.resize(candidates + 1);
+      chosen_slots_.resize((candidates + 1) * kMaxSlots);
       weights_[candidates] = weight;
       chosen_[candidates] = &rule;
+      std::copy(slots, slots + rule.slot_count, chosen_slots_.begin() + static_cast<std::ptrdiff_t>(candidates * kMaxSlots));
       ++candidates;
       total += weight;
     }
@@ -176,7 +202,9 @@ class Deriver {
       }
     }
     const Rule* rule = chosen_[pick];
-    applies(set, *rule, params, index, slots, random);  // rebinds its formals
+    // Its formals and locals as they were bound (running its blocks again would repeat their effects).
+    const auto bound = chosen_slots_.begin() + static_cast<std::ptrdiff_t>(pick * kMaxSlots);
+    std::copy(bound, bound + rule->slot_count, slots);
     return rule;
   }
 
@@ -187,9 +215,15 @@ class Deriver {
     for (size_t p = 0; p < params.size(); ++p) slots[rule.predecessor_slot + p] = params[p];
     if (rule.left_end > rule.left_begin && !match_left(set, rule, index, slots)) return false;
     if (rule.right_end > rule.right_begin && !match_right(set, rule, index, slots)) return false;
-    if (!rule.condition.present()) return true;
     rule_ = &rule;
-    return evaluate(g_.program, rule.condition, slots, random) != 0.0;
+    if (rule.before.present()) {
+      std::fill(slots + rule.predecessor_slot + rule.arity, slots + rule.slot_count, 0.0);  // locals start at 0
+      execute(g_.program, rule.before, slots, random, variables_.data());
+    }
+    if (rule.condition.present() && evaluate(g_.program, rule.condition, slots, random, variables_.data()) == 0.0)
+      return false;
+    if (rule.after.present()) execute(g_.program, rule.after, slots, random, variables_.data());
+    return true;
   }
 
   static void bind(const ModuleString& word, size_t j, const PatternModule& pattern, double* slots) {
@@ -248,14 +282,15 @@ class Deriver {
     return true;
   }
 
-  void emit_successor(const RuleSet& set, const Rule& rule, const double* slots, RandomStream& random,
+  void emit_successor(const RuleSet& set, const Rule& rule, double* slots, RandomStream& random,
                       ModuleString* out) {
     rule_ = &rule;
     for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m) {
       const SuccessorModule& module = set.successor[m];
       out->symbols.push_back(module.symbol);
       for (uint32_t p = 0; p < module.arity; ++p)
-        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
+        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
+                                       variables_.data()));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
     }
   }
@@ -266,35 +301,64 @@ class Deriver {
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
     for (size_t i = 0; i < word.size(); ++i) {
-      RandomStream random = RandomStream::keyed(settings_.seed, purpose, static_cast<uint64_t>(step_), i);
+      RandomStream random = RandomStream::keyed(seed(), purpose, static_cast<uint64_t>(step_), i);
       const std::span<const double> params = word.params_of(i);
-      expand(set, word.symbols[i], params.data(), params.size(), 0, random, out);
+      expand(set, word.symbols[i], params, random, out);
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
   }
 
-  // One module (params must stay valid until bound) => its expansion appended to *out.
-  void expand(const RuleSet& set, char symbol, const double* params, size_t arity, int depth,
-              RandomStream& random, ModuleString* out) {
+  // A rule being expanded: its bound slots live in frame_slots_[slots, slots + slot_count).
+  struct Frame {
+    const Rule* rule;
+    uint32_t next;   // next successor module
+    int depth;
+    size_t slots;
+  };
+
+  // One module => its expansion appended to *out, depth first in successor order, with an
+  // explicit stack (frames_) instead of recursion; the last module of a successor replaces its
+  // rule's frame, so a rule that ends by calling itself runs in constant space.
+  void expand(const RuleSet& set, char symbol, std::span<const double> params, RandomStream& random,
+              ModuleString* out) {
+    frames_.clear();
+    frame_slots_.clear();
+    begin_module(set, symbol, params, 0, random, out);
+    while (!frames_.empty()) {
+      Frame& frame = frames_.back();
+      const Rule& rule = *frame.rule;
+      rule_ = &rule;
+      const SuccessorModule& module = set.successor[frame.next++];
+      const int depth = frame.depth + 1;
+      double* slots = frame_slots_.data() + frame.slots;
+      scratch_.clear();
+      for (uint32_t p = 0; p < module.arity; ++p)
+        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
+                                    variables_.data()));
+      if (frame.next == rule.successor_end) {
+        frame_slots_.resize(frame.slots);
+        frames_.pop_back();
+      }
+      params_.assign(scratch_.begin(), scratch_.end());
+      begin_module(set, module.symbol, params_, depth, random, out);
+      if (out->size() > settings_.max_modules) check_cap(*out);
+    }
+  }
+
+  // A module at `depth`: copied to *out when no rule applies, else its rule's frame pushed.
+  void begin_module(const RuleSet& set, char symbol, std::span<const double> params, int depth,
+                    RandomStream& random, ModuleString* out) {
     double slots[kMaxSlots];
-    const Rule* rule = depth < set.max_depth ? select(set, symbol, {params, arity}, 0, slots, random) : nullptr;
+    const Rule* rule = depth < set.max_depth ? select(set, symbol, params, 0, slots, random) : nullptr;
     if (!rule) {
       out->symbols.push_back(symbol);
-      out->params.insert(out->params.end(), params, params + arity);
+      out->params.insert(out->params.end(), params.begin(), params.end());
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
       return;
     }
-    rule_ = rule;
-    for (uint32_t m = rule->successor_begin; m < rule->successor_end; ++m) {
-      const SuccessorModule& module = set.successor[m];
-      const size_t base = scratch_.size();
-      for (uint32_t p = 0; p < module.arity; ++p)
-        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
-      expand(set, module.symbol, scratch_.data() + base, module.arity, depth + 1, random, out);
-      scratch_.resize(base);
-      rule_ = rule;
-      if (out->size() > settings_.max_modules) check_cap(*out);
-    }
+    if (rule->successor_begin == rule->successor_end) return;  // erased
+    frames_.push_back({rule, rule->successor_begin, depth, frame_slots_.size()});
+    frame_slots_.insert(frame_slots_.end(), slots, slots + rule->slot_count);
   }
 
   // '%' removes itself and the rest of its branch (up to, not including, the closing ']').
@@ -325,7 +389,12 @@ class Deriver {
   std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere
   std::vector<double> weights_;         // stochastic candidates' weights
   std::vector<const Rule*> chosen_;     // stochastic candidates
-  std::vector<double> scratch_;         // parameter values of modules being expanded
+  std::vector<double> scratch_;         // parameter values of the module being expanded
+  std::vector<double> params_;          // the same, while its own rule is selected
+  std::vector<Frame> frames_;           // rules being expanded, innermost last
+  std::vector<double> frame_slots_;     // their bound formals and locals
+  std::vector<double> chosen_slots_;    // (candidates x kMaxSlots) slots of stochastic candidates
+  std::vector<double> variables_;       // global variables; [0] the last srand() argument
 };
 
 }  // namespace

@@ -40,7 +40,9 @@ struct Rule {
   uint32_t left_begin = 0, left_end = 0;    // RuleSet::patterns, in text order
   uint32_t right_begin = 0, right_end = 0;  // RuleSet::patterns, in text order
   uint32_t successor_begin = 0, successor_end = 0;  // RuleSet::successor
+  Expr before;       // block run when the contexts match, before the condition (cpfg)
   Expr condition;    // absent: always true
+  Expr after;        // block run when the condition holds, before the successor (cpfg)
   Expr probability;  // absent: deterministic
   SourcePos pos;     // the rule's first character
   bool has_context() const { return left_end > left_begin || right_end > right_begin; }
@@ -74,6 +76,8 @@ struct Grammar {
   std::optional<double> angle;        // degrees
   std::optional<double> width_factor;
   uint64_t seed = 0;
+  std::vector<std::string> variables;      // global variables (assigned in Start/End blocks); slot i + 1
+  Expr start_block, start_each_block, end_each_block, end_block;  // cpfg control blocks (manual 4.1)
   std::optional<Eigen::Vector3d> tropism;  // T of "tropism:"
   double tropism_elasticity = 0.0;         // e of "tropism:"
   std::array<bool, 256> context_skips{};   // symbols passed over when matching contexts
@@ -95,8 +99,10 @@ struct GrammarText {
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError
 // "name:line:column: message".
+// `functions` are the view file's, for func(id, x). A file's #include is read beside it.
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
-                      const std::optional<GrammarText>& axiom_text = std::nullopt);
+                      const std::optional<GrammarText>& axiom_text = std::nullopt,
+                      std::vector<std::vector<double>> functions = {});
 
 }  // namespace treeanim
