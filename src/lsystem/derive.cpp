@@ -21,8 +21,10 @@ constexpr int kMaxSlots = 64;  // formal parameters of one rule (the parser enfo
 
 class Deriver {
  public:
-  Deriver(const Grammar& grammar, const DerivationSettings& settings)
-      : g_(grammar), settings_(settings), variables_(grammar.variables.size() + 1, 0.0) {}
+  Deriver(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {})
+      : g_(grammar), settings_(settings), turtle_(turtle), variables_(grammar.initial_values) {
+    variables_.resize(grammar.variables.size() + 1, 0.0);
+  }
 
   // Start, then per step StartEach / productions / decomposition / EndEach, then End (CPFG
   // manual 4.1).
@@ -100,7 +102,28 @@ class Deriver {
       word = std::move(out);
     }
     if (g_.productions.any_cut || g_.decomposition.any_cut) cut_branches(&word);
+    if (g_.queries) answer(&word);
     return word;
+  }
+
+  // Query modules (CPFG manual 6.9): the turtle interprets the word as it is drawn, through the
+  // homomorphism, and every '?' with its letter that the homomorphism leaves as it is takes the
+  // value it asks for.
+  void answer(ModuleString* word) {
+    if (g_.homomorphism.empty()) return answer_queries(word, turtle_);
+    const int step = step_;
+    step_ = settings_.iterations + 1;
+    ModuleString drawn;
+    expand_all(g_.homomorphism, *word, kHomomorphism, &drawn, &drawn_at_);
+    step_ = step;
+    answer_queries(&drawn, turtle_);
+    for (size_t i = 1; i < word->size(); ++i) {
+      const uint32_t d = drawn_at_[i];
+      if (word->symbols[i - 1] != '?' || drawn_at_[i + 1] != d + 1 || drawn_at_[i] != drawn_at_[i - 1] + 1 ||
+          drawn.symbols[d] != word->symbols[i] || drawn.params_of(d).size() != word->params_of(i).size())
+        continue;
+      std::copy(drawn.params_of(d).begin(), drawn.params_of(d).end(), word->params.begin() + word->param_offsets[i]);
+    }
   }
 
   void check_cap(const ModuleString& word) const {
@@ -140,8 +163,12 @@ class Deriver {
       }
       RandomStream random = RandomStream::keyed(seed(), kProduction, static_cast<uint64_t>(step_), i);
       const Rule* rule = select(set, word.symbols[i], word.params_of(i), i, slots, random);
-      if (rule) emit_successor(set, *rule, slots, random, next);
-      else copy_module(word, i, next);
+      if (rule) {
+        emit_successor(set, *rule, slots, random, next);
+        i += rule->length() - 1;
+      } else {
+        copy_module(word, i, next);
+      }
       if (next->size() > settings_.max_modules) check_cap(*next);
     }
     word_ = nullptr;
@@ -161,7 +188,8 @@ class Deriver {
     }
   }
 
-  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts apply),
+  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts or a strict
+  // predecessor of several modules apply; word_ null: only rules of one module apply),
   // its formal parameters bound in slots; nullptr when none applies. The first applicable rule
   // wins; when it has a probability, one of all applicable rules with a probability is drawn
   // with weights proportional to them.
@@ -208,11 +236,13 @@ class Deriver {
     return rule;
   }
 
-  // Symbol arity, contexts and condition of one rule; binds its formals into slots.
+  // Symbol arity, strict predecessor, contexts and condition of one rule; binds its formals
+  // into slots.
   bool applies(const RuleSet& set, const Rule& rule, std::span<const double> params, size_t index,
                double* slots, RandomStream& random) {
     if (rule.arity != params.size()) return false;
     for (size_t p = 0; p < params.size(); ++p) slots[rule.predecessor_slot + p] = params[p];
+    if (rule.tail_end > rule.tail_begin && !match_tail(set, rule, index, slots)) return false;
     if (rule.left_end > rule.left_begin && !match_left(set, rule, index, slots)) return false;
     if (rule.right_end > rule.right_begin && !match_right(set, rule, index, slots)) return false;
     rule_ = &rule;
@@ -229,6 +259,19 @@ class Deriver {
   static void bind(const ModuleString& word, size_t j, const PatternModule& pattern, double* slots) {
     const std::span<const double> values = word.params_of(j);
     for (size_t p = 0; p < values.size(); ++p) slots[pattern.first_slot + p] = values[p];
+  }
+
+  // The strict predecessor after its first module: the modules right after it, one by one
+  // (no module passed over; CPFG manual 3.1).
+  bool match_tail(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+    if (!word_ || index + rule.length() > word_->size()) return false;
+    for (uint32_t p = rule.tail_begin; p < rule.tail_end; ++p) {
+      const PatternModule& pattern = set.patterns[p];
+      const size_t j = index + 1 + (p - rule.tail_begin);
+      if (word_->symbols[j] != pattern.symbol || word_->params_of(j).size() != pattern.arity) return false;
+      bind(*word_, j, pattern, slots);
+    }
+    return true;
   }
 
   // Left context: walks left, skipping complete branches (']' ... '[') and climbing out of the
@@ -258,7 +301,7 @@ class Deriver {
   bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
     const ModuleString& w = *word_;
     const size_t n = w.size();
-    size_t j = index + 1;
+    size_t j = index + rule.length();
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
       if (pattern.symbol == ']') {
@@ -296,14 +339,20 @@ class Deriver {
   }
 
   // Context-free rules applied recursively (up to set.max_depth) to every module: word => *out.
-  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out) {
+  // at, when given: (word size + 1) where each module's expansion starts in *out (the modules
+  // a strict predecessor of several replaces start where the next one does).
+  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out,
+                  std::vector<uint32_t>* at = nullptr) {
     out->clear();
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
-    for (size_t i = 0; i < word.size(); ++i) {
+    if (at) at->assign(word.size() + 1, 0);
+    for (size_t i = 0; i < word.size();) {
       RandomStream random = RandomStream::keyed(seed(), purpose, static_cast<uint64_t>(step_), i);
-      const std::span<const double> params = word.params_of(i);
-      expand(set, word.symbols[i], params, random, out);
+      const size_t used = expand(set, word, i, random, out);
+      if (at) std::fill(at->begin() + static_cast<std::ptrdiff_t>(i) + 1, at->begin() + static_cast<std::ptrdiff_t>(i + used) + 1,
+                        static_cast<uint32_t>(out->size()));
+      i += used;
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
   }
@@ -316,14 +365,19 @@ class Deriver {
     size_t slots;
   };
 
-  // One module => its expansion appended to *out, depth first in successor order, with an
-  // explicit stack (frames_) instead of recursion; the last module of a successor replaces its
-  // rule's frame, so a rule that ends by calling itself runs in constant space.
-  void expand(const RuleSet& set, char symbol, std::span<const double> params, RandomStream& random,
-              ModuleString* out) {
+  // Module `index` of word (with the modules after it, for a strict predecessor of several)
+  // => its expansion appended to *out, depth first in successor order, with an explicit stack
+  // (frames_) instead of recursion; the last module of a successor replaces its rule's frame,
+  // so a rule that ends by calling itself runs in constant space. Successor modules are
+  // expanded one by one (a rule of several modules applies to the word only). => the modules
+  // of word used.
+  size_t expand(const RuleSet& set, const ModuleString& word, size_t index, RandomStream& random,
+                ModuleString* out) {
     frames_.clear();
     frame_slots_.clear();
-    begin_module(set, symbol, params, 0, random, out);
+    word_ = &word;
+    const size_t used = begin_module(set, word.symbols[index], word.params_of(index), index, 0, random, out);
+    word_ = nullptr;
     while (!frames_.empty()) {
       Frame& frame = frames_.back();
       const Rule& rule = *frame.rule;
@@ -340,25 +394,29 @@ class Deriver {
         frames_.pop_back();
       }
       params_.assign(scratch_.begin(), scratch_.end());
-      begin_module(set, module.symbol, params_, depth, random, out);
+      begin_module(set, module.symbol, params_, 0, depth, random, out);
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
+    return used;
   }
 
-  // A module at `depth`: copied to *out when no rule applies, else its rule's frame pushed.
-  void begin_module(const RuleSet& set, char symbol, std::span<const double> params, int depth,
-                    RandomStream& random, ModuleString* out) {
+  // A module at `depth` (at `index` of word_ when that is set): copied to *out when no rule
+  // applies, else its rule's frame pushed. => the modules its rule replaces (1 when none).
+  size_t begin_module(const RuleSet& set, char symbol, std::span<const double> params, size_t index, int depth,
+                      RandomStream& random, ModuleString* out) {
     double slots[kMaxSlots];
-    const Rule* rule = depth < set.max_depth ? select(set, symbol, params, 0, slots, random) : nullptr;
+    const Rule* rule = depth < set.max_depth ? select(set, symbol, params, index, slots, random) : nullptr;
     if (!rule) {
       out->symbols.push_back(symbol);
       out->params.insert(out->params.end(), params.begin(), params.end());
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
-      return;
+      return 1;
     }
-    if (rule->successor_begin == rule->successor_end) return;  // erased
-    frames_.push_back({rule, rule->successor_begin, depth, frame_slots_.size()});
-    frame_slots_.insert(frame_slots_.end(), slots, slots + rule->slot_count);
+    if (rule->successor_begin != rule->successor_end) {  // else erased
+      frames_.push_back({rule, rule->successor_begin, depth, frame_slots_.size()});
+      frame_slots_.insert(frame_slots_.end(), slots, slots + rule->slot_count);
+    }
+    return rule->length();
   }
 
   // '%' removes itself and the rest of its branch (up to, not including, the closing ']').
@@ -383,6 +441,7 @@ class Deriver {
 
   const Grammar& g_;
   const DerivationSettings& settings_;
+  const TurtleSettings turtle_;         // answers the query modules
   int step_ = 0;
   const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
   const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
@@ -395,12 +454,13 @@ class Deriver {
   std::vector<double> frame_slots_;     // their bound formals and locals
   std::vector<double> chosen_slots_;    // (candidates x kMaxSlots) slots of stochastic candidates
   std::vector<double> variables_;       // global variables; [0] the last srand() argument
+  std::vector<uint32_t> drawn_at_;      // where each module's homomorphism starts (query pass)
 };
 
 }  // namespace
 
-ModuleString derive(const Grammar& grammar, const DerivationSettings& settings) {
-  Deriver deriver(grammar, settings);
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle) {
+  Deriver deriver(grammar, settings, turtle);
   try {
     return deriver.derive();
   } catch (const EvalError& error) {

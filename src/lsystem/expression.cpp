@@ -4,7 +4,9 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <numbers>
 
 #include "common/scene_reader.h"
@@ -45,7 +47,8 @@ int arity_of(Op op) {
   switch (op) {
     case Op::kConst: case Op::kParam: case Op::kLoadVar: case Op::kJump: return 0;
     case Op::kNeg: case Op::kNot: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
-    case Op::kJumpIfZero: return 1;
+    case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: return 1;
+    case Op::kStoreElem: return 2;
     case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem:
     case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe:
     case Op::kAnd: case Op::kOr: return 2;
@@ -60,6 +63,7 @@ int arity_of(Op op) {
 int results_of(Op op) {
   switch (op) {
     case Op::kStoreVar: case Op::kStoreParam: case Op::kPop: case Op::kJump: case Op::kJumpIfZero:
+    case Op::kStoreElem:
       return 0;
     default: return 1;
   }
@@ -70,7 +74,7 @@ bool foldable(Op op) {
   switch (op) {
     case Op::kConst: case Op::kParam: case Op::kRan: case Op::kNran: case Op::kBran: case Op::kBiran:
     case Op::kSrand: case Op::kLoadVar: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
-    case Op::kJump: case Op::kJumpIfZero:
+    case Op::kJump: case Op::kJumpIfZero: case Op::kLoadElem: case Op::kStoreElem:
       return false;
     default: return true;
   }
@@ -298,8 +302,14 @@ class Compiler {
     } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
       const std::string name(text_.substr(start, pos_ - start));
-      if (peek() == '(') parse_call(name, start);
-      else parse_name(name, start);
+      if (peek() == '(') {
+        parse_call(name, start);
+      } else if (const ArrayDecl* array = array_named(name)) {
+        parse_index(*array, start);
+        emit(Op::kLoadElem, array->base, start);
+      } else {
+        parse_name(name, start);
+      }
     } else if (accept("(")) {
       parse_conditional();
       skip_space();
@@ -332,6 +342,38 @@ class Compiler {
     const auto it = std::find(names->begin(), names->end(), name);
     return it == names->end() ? -1 : static_cast<int>(it - names->begin());
   }
+  const ArrayDecl* array_named(const std::string& name) const {
+    for (const ArrayDecl& array : program_.arrays)
+      if (array.name == name) return &array;
+    return nullptr;
+  }
+  // "[i][j]" or "[i, j]" after an array's name => its row-major element number on the stack,
+  // each index truncated and checked against its dimension when evaluated.
+  void parse_index(const ArrayDecl& array, size_t start) {
+    skip_space();
+    if (!accept("[")) fail(pos_, "expected '[' after the array '" + array.name + "', got " + describe_next());
+    for (size_t d = 0; d < array.dims.size(); ++d) {
+      if (d > 0) {
+        const size_t where = pos_;
+        if (!accept(",") && !(accept("]") && accept("[")))
+          fail(where, "expected " + indices(array) + ", got " + describe_next());
+        emit_constant(array.dims[d], where);
+        emit(Op::kMul, 0, where);
+      }
+      const size_t where = (skip_space(), pos_);
+      parse_conditional();
+      emit(Op::kIndex, array.dims[d], where);
+      if (d > 0) emit(Op::kAdd, 0, where);
+    }
+    skip_space();
+    if (!accept("]"))
+      fail(pos_, "expected ']' after the " + indices(array) + " (at column " + std::to_string(start + 1) + "), got " +
+                     describe_next());
+  }
+  static std::string indices(const ArrayDecl& array) {
+    return std::to_string(array.dims.size()) + (array.dims.size() == 1 ? " index" : " indices") + " of '" +
+           array.name + "'";
+  }
   void parse_name(const std::string& name, size_t start) {
     if (const int slot = index_of(scope_.formals, name); slot >= 0) {
       emit(Op::kParam, static_cast<uint32_t>(slot), start);
@@ -353,7 +395,9 @@ class Compiler {
   std::string known_names(const std::string& name) const {
     std::vector<std::string> candidates;
     std::string list;
-    auto add_all = [&](const std::vector<std::string>& names, const char* what) {
+    auto add_all = [&](const std::vector<std::string>& all, const char* what) {
+      std::vector<std::string> names;  // without arrays' elements after the first (unnamed)
+      std::copy_if(all.begin(), all.end(), std::back_inserter(names), [](const std::string& n) { return !n.empty(); });
       if (names.empty()) return;
       list += std::string(list.empty() ? "" : " or ") + what + " (";
       for (size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
@@ -370,7 +414,25 @@ class Compiler {
     const std::string near = suggestion(name, candidates);
     return " (expected " + list + (near.empty() ? "" : "; did you mean '" + near + "'?") + ")";
   }
+  // printf("format", values...) (CPFG manual 5.4): its values are computed and nothing is
+  // printed (the output streams are treeanim's own); its value is 0.
+  void parse_printf(size_t start) {
+    ++pos_;  // '('
+    skip_space();
+    if (peek() != '"') fail(pos_, "expected a format string \"...\" after 'printf(', got " + describe_next());
+    ++pos_;
+    while (pos_ < text_.size() && text_[pos_] != '"') pos_ += text_[pos_] == '\\' ? 2 : 1;
+    if (pos_ >= text_.size()) fail(start, "the format string of printf is never closed (expected '\"')");
+    ++pos_;
+    while (accept(",")) {
+      parse_conditional();
+      emit(Op::kPop, 0, start);
+    }
+    expect(")", "to close printf(");
+    emit_constant(0.0, start);
+  }
   void parse_call(const std::string& name, size_t start) {
+    if (name == "printf") return parse_printf(start);
     const Function* function = nullptr;
     for (const Function& f : kFunctions)
       if (name == f.name) function = &f;
@@ -487,8 +549,12 @@ class Compiler {
     while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
     const std::string name(text_.substr(start, pos_ - start));
     skip_space();
-    if (peek() == '[') fail(pos_, "arrays are not supported (cpfg manual 2.2.2)");
-    if (peek() == '=' && peek(1) != '=') {
+    if (const ArrayDecl* array = array_named(name); array && peek() == '[') {
+      parse_index(*array, start);
+      expect("=", ("to assign an element of '" + name + "'").c_str());
+      parse_conditional();
+      emit(Op::kStoreElem, array->base, start);
+    } else if (peek() == '=' && peek(1) != '=') {
       ++pos_;
       parse_conditional();
       emit_store(name, start);
@@ -551,6 +617,12 @@ double sample_function(const std::vector<double>& samples, double x) {
   const double t = std::clamp(x, 0.0, 1.0) * static_cast<double>(samples.size() - 1);
   const size_t k = std::min(static_cast<size_t>(t), samples.size() - 2);
   return samples[k] + (t - static_cast<double>(k)) * (samples[k + 1] - samples[k]);
+}
+
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
 }
 
 [[noreturn]] void eval_fail(const ExprProgram& program, uint32_t instruction, const char* message) {
@@ -678,6 +750,17 @@ double run(const ExprProgram& program, const Expr& expr, double* slots, RandomSt
       case Op::kStoreVar: if (variables) variables[in.arg] = b; --top; continue;
       case Op::kStoreParam: slots[in.arg] = b; --top; continue;
       case Op::kPop: --top; continue;
+      case Op::kIndex:
+        stack[top] = std::trunc(b);
+        if (!(stack[top] >= 0.0 && stack[top] < static_cast<double>(in.arg)))
+          throw EvalError{program.code_pos[k], "array index " + format_number(b) + " is outside 0 ... " +
+                                                    std::to_string(in.arg - 1)};
+        break;
+      case Op::kLoadElem: stack[top] = variables ? variables[in.arg + static_cast<uint32_t>(b)] : 0.0; break;
+      case Op::kStoreElem:
+        if (variables) variables[in.arg + static_cast<uint32_t>(a)] = b;
+        top -= 2;
+        continue;
       case Op::kJumpIfZero:
         --top;
         if (b == 0.0) k = in.arg - 1;

@@ -65,6 +65,7 @@ enum class Op : uint8_t {
   kFunc,                                           // view-file function functions[arg] at x
   kRan, kNran, kBran, kBiran, kSrand,              // random: never folded
   kLoadVar, kStoreVar, kStoreParam, kPop,          // variables[arg], formals[arg] (statements)
+  kIndex, kLoadElem, kStoreElem,                   // array index < arg; variables[arg + index]
   kJump, kJumpIfZero,                              // to code[arg] (?:, if, while)
 };
 
@@ -81,12 +82,20 @@ struct Expr {
   bool present() const { return end > begin; }
 };
 
+// A cpfg array (manual 2.2.2): its elements are global variables base, base + 1, ... in row-major order.
+struct ArrayDecl {
+  std::string name;
+  uint32_t base = 0;            // variables index of element 0
+  std::vector<uint32_t> dims;   // sizes of its dimensions
+};
+
 // The code of every expression of one grammar.
 struct ExprProgram {
   std::vector<Instruction> code;     // (instructions)
   std::vector<SourcePos> code_pos;   // (instructions) the operator's place, for runtime errors
   std::vector<double> constants;     // (constants)
   std::vector<std::vector<double>> functions;  // (functions x samples) func(id, x) on [0, 1], equally spaced
+  std::vector<ArrayDecl> arrays;     // names the compiler resolves to array elements
   // expr => true when it is one constant (its value in *value).
   bool is_constant(const Expr& expr, double* value) const;
 };

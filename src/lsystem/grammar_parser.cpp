@@ -17,6 +17,7 @@ namespace {
 constexpr size_t kNone = std::string_view::npos;
 constexpr int kMaxSlots = 64;   // formal parameters of one rule (lc, pred, rc)
 constexpr int kMaxDepth = 100'000;  // "maximum depth:" bound (the expansion keeps its own stack)
+constexpr long long kMaxArrayElements = 1'000'000;  // elements of one cpfg array
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
@@ -170,7 +171,10 @@ class Parser {
     if (ended_) return;
     size_t begin = 0, end = line.text.size();
     trim(line.text, &begin, &end);
-    if (begin == end) return flush();
+    if (begin == end) {  // a blank line ends a statement, unless it has open parentheses or blocks
+      if (!open_nesting(pending_.text)) flush();
+      return;
+    }
     if (!pending_.text.empty() && continues(line.text, begin, end)) {
       pending_.text += ' ';
       pending_.columns.push_back(line.columns[begin]);
@@ -191,11 +195,17 @@ class Parser {
     const bool rule = find_arrow(last, b, e) != kNone;
     const bool axiom = match_keyword(last, b, e, "axiom", true, &value);
     // A rule's head not yet at its arrow ("A(x) :" then a block on the next line) goes on.
-    if (!rule && !axiom) return !starts_directive(last, b, e) && find_top_level(last, b, e, ':') != kNone;
+    if (!rule && !axiom) return !starts_directive(last, b, e) && looks_like_head(last, b, e);
     if (find_arrow(text, begin, end) != kNone || starts_directive(text, begin, end)) return false;
-    // A rule's head written over lines ("A(x) : {x=x+1;" ...) starts with its own ':' and '{'.
-    const size_t colon = find_top_level(text, begin, end, ':');
-    return !(colon != kNone && text.find('{', colon) != kNone);
+    // A rule's head written over lines starts with its own context or condition.
+    return !looks_like_head(text, begin, end);
+  }
+
+  // Whether text[begin, end) has a context ('<', '>') or a condition (':') outside parentheses
+  // and blocks: a rule's head, which no successor has.
+  static bool looks_like_head(std::string_view text, size_t begin, size_t end) {
+    return find_top_level(text, begin, end, ':') != kNone || find_top_level(text, begin, end, '<') != kNone ||
+           find_top_level(text, begin, end, '>') != kNone;
   }
 
   void flush() {
@@ -282,13 +292,15 @@ class Parser {
     }
     for (const std::string& keyword : kValueDirectives) {
       if (!match_keyword(text, begin, end, keyword, true, &value)) continue;
+      // "AXIOM : c --> ..." is a rule whose predecessor spells a directive.
+      if (keyword == "axiom" && find_arrow(text, value, end) != kNone) return false;
       size_t vbegin = value, vend = end;
       trim(text, &vbegin, &vend);
       if (vbegin == vend && keyword != "ignore" && keyword != "consider")
         fail(line, value, "expected a value after '" + keyword + ":'");
       if (keyword == "start" || keyword == "starteach" || keyword == "end" || keyword == "endeach")
         parse_control_block(text, vbegin, vend, line, keyword);
-      else if (keyword == "define") fail(line, begin, "arrays ('define: { array ... }') are not supported (CPFG manual 2.2.2)");
+      else if (keyword == "define") parse_arrays(text, vbegin, vend, line);
       else if (keyword == "axiom") set_axiom(text, vbegin, vend, line, at_column(line, begin));
       else if (keyword == "derivation length") g_.derivation_length = integer_value(text, vbegin, vend, line, 0, 100000);
       else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
@@ -393,6 +405,99 @@ class Parser {
     return false;
   }
 
+  // "define: { array name[d1][d2] = { values }; array other[d]; }" (CPFG manual 2.2.2):
+  // dimensions are constants ("[d1, d2]" also), values fill the elements in row-major order
+  // (the rest start at 0).
+  void parse_arrays(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
+    const std::string_view body = text.substr(0, end);
+    size_t k = begin;
+    auto skip = [&] { while (k < end && is_space(body[k])) ++k; };
+    auto expect = [&](char c, const std::string& what) {
+      skip();
+      if (k >= end || body[k] != c) fail(line, k, std::string("expected '") + c + "' " + what);
+      ++k;
+    };
+    expect('{', "after 'define:'");
+    for (;;) {
+      skip();
+      if (k < end && body[k] == '}') break;
+      size_t value = 0;
+      if (!match_keyword(body, k, end, "array", false, &value) || value >= end || !is_space(body[value]))
+        fail(line, k, "expected 'array name[dimensions];' or '}' in 'define:'");
+      k = value;
+      skip();
+      const size_t name_at = k;
+      while (k < end && (std::isalnum(static_cast<unsigned char>(body[k])) || body[k] == '_')) ++k;
+      const std::string name(body.substr(name_at, k - name_at));
+      if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])))
+        fail(line, name_at, "expected an array name after 'array'");
+      if (std::find(g_.variables.begin(), g_.variables.end(), name) != g_.variables.end() ||
+          std::any_of(g_.defines.begin(), g_.defines.end(), [&](const auto& d) { return d.first == name; }))
+        fail(line, name_at, "'" + name + "' is already a variable or a define");
+      ArrayDecl array{name, static_cast<uint32_t>(g_.variables.size() + 1), {}};
+      size_t elements = 1;
+      expect('[', "after the array's name");
+      for (;;) {
+        const size_t at = k;
+        const long long size = integer_value(body, k, dimension_end(body, k, end), line, 1, kMaxArrayElements);
+        k = dimension_end(body, k, end);
+        elements *= static_cast<size_t>(size);
+        if (elements > kMaxArrayElements)
+          fail(line, at, "more than " + std::to_string(kMaxArrayElements) + " elements in the array '" + name + "'");
+        array.dims.push_back(static_cast<uint32_t>(size));
+        if (k < end && body[k] == ',') { ++k; continue; }
+        expect(']', "after a dimension");
+        skip();
+        if (k < end && body[k] == '[') { ++k; continue; }
+        break;
+      }
+      g_.variables.push_back(name);
+      g_.variables.resize(g_.variables.size() + elements - 1);
+      g_.initial_values.resize(g_.variables.size() + 1, 0.0);
+      skip();
+      if (k < end && body[k] == '=') {
+        ++k;
+        expect('{', "to open the values of '" + name + "'");
+        for (size_t n = 0;; ++n) {
+          skip();
+          const size_t at = k;
+          const size_t stop = value_end(body, k, end);
+          if (stop == end) fail(line, k, "expected '}' to close the values of '" + name + "'");
+          if (n == elements) fail(line, at, "more values than the " + std::to_string(elements) + " elements of '" + name + "'");
+          size_t vb = k, ve = stop;
+          trim(body, &vb, &ve);
+          g_.initial_values[array.base + n] = constant_value(body, vb, ve, line);
+          k = stop + 1;
+          if (body[stop] == '}') break;
+        }
+      }
+      g_.program.arrays.push_back(std::move(array));
+      expect(';', "after the array '" + name + "'");
+    }
+    ++k;
+    skip();
+    if (k < end && body[k] == ';') ++k;
+    skip();
+    if (k < end) fail(line, k, "expected the end of 'define:', got '" + std::string(1, body[k]) + "'");
+  }
+
+  // The end of a dimension starting at text[k]: the ',' or ']' after it (or end).
+  static size_t dimension_end(std::string_view text, size_t k, size_t end) {
+    return std::min({find_top_level(text, k, end, ','), find_top_level(text, k, end, ']'), end});
+  }
+
+  // The end of an initial value starting at text[k]: the ',' or '}' after it outside
+  // parentheses (or end).
+  static size_t value_end(std::string_view text, size_t k, size_t end) {
+    int depth = 0;
+    for (; k < end; ++k) {
+      if (text[k] == '(') ++depth;
+      else if (text[k] == ')') --depth;
+      else if (depth == 0 && (text[k] == ',' || text[k] == '}')) return k;
+    }
+    return end;
+  }
+
   // "Lsystem: label": a number or a name (used by sub-L-systems, which are not supported).
   void lsystem_label(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     for (size_t k = begin; k < end; ++k)
@@ -419,7 +524,8 @@ class Parser {
     if (axiom_seen_) throw GrammarError{directive, "a second 'axiom:'; the grammar has one already"};
     axiom_seen_ = true;
     const std::vector<std::string> no_formals;
-    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines}, &g_.axiom, &g_.axiom_params, "axiom");
+    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines, &g_.variables}, &g_.axiom, &g_.axiom_params,
+               "axiom");
     if (g_.axiom.empty()) fail(line, begin, "expected at least one module in the axiom");
   }
 
@@ -433,6 +539,7 @@ class Parser {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
       check_symbol(text, k, line, what);
+      if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
       if (c == '[') open.push_back(k);
       if (c == ']') {
         if (open.empty()) fail(line, k, "unbalanced brackets: ']' closes no '[' in the " + std::string(what));
@@ -463,6 +570,17 @@ class Parser {
     if (!open.empty())
       fail(line, open.back(), "unbalanced brackets: '[' is never closed (expected ']' before the end of the " +
                                   std::string(what) + ")");
+  }
+
+  // '?' at text[k]: true for a query module ?P ?H ?U ?L (CPFG manual 6.9); a lone '?' is a
+  // module like any other; sub-L-systems and ?E are refused.
+  static bool is_query(std::string_view text, size_t k, size_t end, const TextOrigin& line) {
+    const char next = k + 1 < end ? text[k + 1] : ' ';
+    if (next == '(')
+      fail(line, k, "sub-L-systems ('?(id, scale) ... $') are not supported (CPFG manual 7.2)");
+    if (next == 'E')
+      fail(line, k, "'?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
+    return next == 'P' || next == 'H' || next == 'U' || next == 'L';
   }
 
   static void check_symbol(std::string_view text, size_t k, const TextOrigin& line, const char* what) {
@@ -508,7 +626,7 @@ class Parser {
       parse_pattern(text, begin, lt, line, false, &set, &formals, "left context");
       rule.left_end = static_cast<uint32_t>(set.patterns.size());
     }
-    parse_predecessor(text, pred_begin, pred_end, line, &rule, &formals);
+    parse_predecessor(text, pred_begin, pred_end, line, &rule, &set, &formals);
     if (gt != kNone) {
       rule.right_begin = static_cast<uint32_t>(set.patterns.size());
       parse_pattern(text, gt + 1, head_end, line, true, &set, &formals, "right context");
@@ -574,20 +692,20 @@ class Parser {
     return expr;
   }
 
+  // The strict predecessor: its first module, then any more (CPFG manual 3.1) as patterns.
   void parse_predecessor(std::string_view text, size_t begin, size_t end, const TextOrigin& line, Rule* rule,
-                         std::vector<std::string>* formals) {
+                         RuleSet* set, std::vector<std::string>* formals) {
     trim(text, &begin, &end);
     if (begin == end) fail(line, begin, "expected a predecessor module before the arrow");
     check_symbol(text, begin, line, "predecessor");
-    if (text[begin] == '[' || text[begin] == ']') fail(line, begin, "a bracket cannot be a predecessor");
+    if (text[begin] == '[' || text[begin] == ']') fail(line, begin, "a bracket cannot be in a predecessor");
     rule->predecessor = text[begin];
     rule->predecessor_slot = static_cast<uint16_t>(formals->size());
     size_t k = begin + 1;
     rule->arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
-    while (k < end && is_space(text[k])) ++k;
-    if (k < end)
-      fail(line, k, "expected one module as predecessor (write a context with '<' or '>'), got '" +
-                        std::string(text.substr(begin, end - begin)) + "'");
+    rule->tail_begin = static_cast<uint32_t>(set->patterns.size());
+    parse_modules(text, k, end, line, false, set, formals, "predecessor");
+    rule->tail_end = static_cast<uint32_t>(set->patterns.size());
   }
 
   // Context modules with formal parameters in text[begin, end); '*' alone = no context.
@@ -596,12 +714,20 @@ class Parser {
     trim(text, &begin, &end);
     if (begin == end) fail(line, begin, std::string("expected a ") + what + " (or '*' for none)");
     if (end == begin + 1 && text[begin] == '*') return;
+    parse_modules(text, begin, end, line, brackets, set, formals, what);
+  }
+
+  // Modules with formal parameters in text[begin, end) => appended to set->patterns.
+  void parse_modules(std::string_view text, size_t begin, size_t end, const TextOrigin& line, bool brackets,
+                     RuleSet* set, std::vector<std::string>* formals, const char* what) {
     for (size_t k = begin; k < end;) {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
       check_symbol(text, k, line, what);
+      if (c == '?') is_query(text, k, end, line);
       if (!brackets && (c == '[' || c == ']'))
-        fail(line, k, "brackets are not supported in a left context (it already skips branches)");
+        fail(line, k, std::string("a bracket cannot be in a ") + what +
+                          (std::string_view(what) == "left context" ? " (it already skips branches)" : ""));
       PatternModule module{c, 0, static_cast<uint16_t>(formals->size())};
       ++k;
       module.arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));

@@ -82,12 +82,13 @@ Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
   const ViewSettings view = load_view(options);
   const Grammar grammar = load_grammar(options, view);
   const DerivationSettings settings = derivation_settings(options, grammar);
-  const ModuleString word = derive(grammar, settings);
+  const TurtleSettings turtle = turtle_settings(options, grammar, view);
+  const ModuleString word = derive(grammar, settings, turtle);
   if (stats) {
     stats->modules = word.size();
     stats->iterations = settings.iterations;
   }
-  return interpret(apply_homomorphism(grammar, word, settings), turtle_settings(options, grammar, view));
+  return interpret(apply_homomorphism(grammar, word, settings), turtle);
 }
 
 }  // namespace treeanim

@@ -99,9 +99,10 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
     if (stop == std::string::npos) stop = clean.size();
     SourceLine line = make_line(std::string_view(clean).substr(start, stop - start), {source, single_line ? 0 : number, 1});
     const size_t hash = skip_spaces(line.text, 0);
-    // A line continues on the next one after a trailing backslash, as in cpp.
+    // A line continues on the next one after a trailing backslash, as in cpp; cpfg files also
+    // end continued lines with two backslashes, read as one continuation.
     while (!line.text.empty() && line.text.back() == '\\' && stop < clean.size()) {
-      line.text.back() = ' ';
+      for (size_t b = line.text.size(); b > 0 && line.text[b - 1] == '\\'; --b) line.text[b - 1] = ' ';
       start = stop + 1;
       stop = clean.find('\n', start);
       if (stop == std::string::npos) stop = clean.size();

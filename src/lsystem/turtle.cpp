@@ -140,8 +140,10 @@ size_t end_of_branch(const std::vector<char>& symbols, size_t cut) {
 
 class Turtle {
  public:
-  Turtle(const ModuleString& word, const TurtleSettings& settings)
+  // answers: word's parameters, written by the query modules (null: only drawing).
+  Turtle(const ModuleString& word, const TurtleSettings& settings, double* answers = nullptr)
       : word_(word),
+        answers_(answers),
         settings_(settings),
         default_turn_{std::cos(settings.angle_degrees * kDegToRad),
                       std::sin(settings.angle_degrees * kDegToRad)},
@@ -194,6 +196,7 @@ class Turtle {
         case 'L': add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {}); break;
         case '~': i = surface(i); break;
         case '@': i = at_command(i); break;
+        case '?': i = query(i); break;
         case '{': polygons_.push_back({s_, points_.size()}); break;
         case '.':
           if (!polygons_.empty()) points_.push_back(s_.position);
@@ -221,6 +224,26 @@ class Turtle {
     }
     add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {});
     return i;
+  }
+
+  // '?' and its letter (cpfg's query modules, CPFG manual 6.9): ?P ?H ?U ?L take the turtle's
+  // position, heading, up and left vectors (x, y[, z]) when answering; they draw nothing.
+  // => the last module used.
+  size_t query(size_t i) {
+    if (i + 1 >= word_.size()) return i;
+    const Vector3d* v = nullptr;
+    switch (word_.symbols[i + 1]) {
+      case 'P': v = &s_.position; break;
+      case 'H': v = &s_.heading; break;
+      case 'U': v = &s_.up; break;
+      case 'L': v = &s_.left; break;
+      default: return i;
+    }
+    if (answers_) {
+      const uint32_t b = word_.param_offsets[i + 1], e = word_.param_offsets[i + 2];
+      for (uint32_t k = b; k < e && k - b < 3; ++k) answers_[k] = (*v)[static_cast<Eigen::Index>(k - b)];
+    }
+    return i + 1;
   }
 
   // '@' and the letter after it (cpfg's two-character modules, CPFG manual 6): @v rolls L
@@ -360,6 +383,7 @@ class Turtle {
   }
 
   const ModuleString& word_;
+  double* const answers_;  // word_'s parameters, when answering queries
   const TurtleSettings& settings_;
   const SinCos default_turn_;  // cos, sin of settings.angle_degrees
   const bool bends_;           // tropism on
@@ -375,6 +399,10 @@ class Turtle {
 
 Skeleton interpret(const ModuleString& word, const TurtleSettings& settings) {
   return Turtle(word, settings).run();
+}
+
+void answer_queries(ModuleString* word, const TurtleSettings& settings) {
+  Turtle(*word, settings, word->params.data()).run();
 }
 
 }  // namespace treeanim

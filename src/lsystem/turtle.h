@@ -24,4 +24,8 @@ struct TurtleSettings {
 // without its '[' and an unclosed '{' are ignored (the grammar checks brackets).
 Skeleton interpret(const ModuleString& word, const TurtleSettings& settings);
 
+// The turtle interprets word and its query modules (CPFG manual 6.9) take the values they ask
+// for: ?P(x, y[, z]) the position, ?H the heading, ?U the up and ?L the left vector.
+void answer_queries(ModuleString* word, const TurtleSettings& settings);
+
 }  // namespace treeanim
