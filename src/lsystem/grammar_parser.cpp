@@ -17,7 +17,7 @@ namespace {
 constexpr size_t kNone = std::string_view::npos;
 constexpr int kMaxSlots = 64;   // formal parameters of one rule (lc, pred, rc)
 constexpr int kMaxDepth = 100'000;  // "maximum depth:" bound (the expansion keeps its own stack)
-constexpr long long kMaxArrayElements = 1'000'000;  // elements of one cpfg array
+constexpr long long kMaxArrayElements = 1'000'000;  // elements of all cpfg arrays together
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
@@ -442,8 +442,8 @@ class Parser {
         const long long size = integer_value(body, k, dimension_end(body, k, end), line, 1, kMaxArrayElements);
         k = dimension_end(body, k, end);
         elements *= static_cast<size_t>(size);
-        if (elements > kMaxArrayElements)
-          fail(line, at, "more than " + std::to_string(kMaxArrayElements) + " elements in the array '" + name + "'");
+        if (g_.variables.size() + elements > kMaxArrayElements)
+          fail(line, at, "more than " + std::to_string(kMaxArrayElements) + " array elements in the grammar");
         array.dims.push_back(static_cast<uint32_t>(size));
         if (k < end && body[k] == ',') { ++k; continue; }
         expect(']', "after a dimension");
