@@ -223,6 +223,8 @@ class Parser {
     if (parse_directive(text, begin, end, line)) return;
     const size_t arrow = find_arrow(text, begin, end);
     if (arrow != kNone) return parse_rule(text, begin, arrow, end, line);
+    if (same_letters(text.substr(begin, end - begin), "ring lsystem"))
+      fail(line, begin, "ring L-systems ('ring lsystem') are not supported (CPFG manual 3.1.1)");
     report_non_rule(text, begin, end, line);
   }
 
