@@ -1,6 +1,7 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <bit>
 #include <span>
 #include <string>
 #include <utility>
@@ -14,26 +15,35 @@ namespace {
 
 // Keys of the random streams, so that the same (step, position) never shares draws between
 // purposes.
-enum Purpose : uint64_t { kAxiom = 1, kProduction = 2, kDecomposition = 3, kHomomorphism = 4 };
+enum Purpose : uint64_t { kAxiom = 1, kProduction = 2, kDecomposition = 3, kHomomorphism = 4, kBlock = 5 };
 
 constexpr int kMaxSlots = 64;  // formal parameters of one rule (the parser enforces it)
 
 class Deriver {
  public:
-  Deriver(const Grammar& grammar, const DerivationSettings& settings)
-      : g_(grammar), settings_(settings) {}
+  Deriver(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {})
+      : g_(grammar), settings_(settings), turtle_(turtle), variables_(grammar.initial_values) {
+    variables_.resize(grammar.variables.size() + 1, 0.0);
+  }
 
+  // Start, then per step StartEach / productions / decomposition / EndEach, then End (CPFG
+  // manual 4.1).
   ModuleString derive() {
     ModuleString word;
     word.clear();
+    run_block(g_.start_block);
     emit_axiom(&word);
     word = finish_step(std::move(word), 0);
     ModuleString next;
     for (step_ = 1; step_ <= settings_.iterations; ++step_) {
+      run_block(g_.start_each_block);
       rewrite(word, &next);
       std::swap(word, next);
       word = finish_step(std::move(word), step_);
+      run_block(g_.end_each_block);
     }
+    step_ = settings_.iterations;
+    run_block(g_.end_block);
     return word;
   }
 
@@ -55,13 +65,29 @@ class Deriver {
   }
 
  private:
+  // The seed of the random streams: the settings' one, changed by the last srand() (cpfg 5.3).
+  uint64_t seed() const {
+    const double srand_value = variables_[kSrandVariable];
+    return srand_value == 0.0 ? settings_.seed
+                              : settings_.seed ^ (std::bit_cast<uint64_t>(srand_value) * 0x9e3779b97f4a7c15ULL);
+  }
+
+  // A Start/StartEach/EndEach/End block, its draws keyed by the step.
+  void run_block(const Expr& block) {
+    if (!block.present()) return;
+    rule_ = nullptr;
+    RandomStream random = RandomStream::keyed(seed(), kBlock, static_cast<uint64_t>(step_), block.begin);
+    double no_slots[1] = {0.0};
+    execute(g_.program, block, no_slots, random, variables_.data());
+  }
+
   // The axiom's modules, their parameters evaluated with the axiom's random stream.
   void emit_axiom(ModuleString* out) {
-    RandomStream random = RandomStream::keyed(settings_.seed, kAxiom, 0, 0);
+    RandomStream random = RandomStream::keyed(seed(), kAxiom, 0, 0);
     for (const SuccessorModule& m : g_.axiom) {
       out->symbols.push_back(m.symbol);
       for (uint32_t p = 0; p < m.arity; ++p)
-        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random));
+        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random, variables_.data()));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
     }
     check_cap(*out);
@@ -76,7 +102,28 @@ class Deriver {
       word = std::move(out);
     }
     if (g_.productions.any_cut || g_.decomposition.any_cut) cut_branches(&word);
+    if (g_.queries) answer(&word);
     return word;
+  }
+
+  // Query modules (CPFG manual 6.9): the turtle interprets the word as it is drawn, through the
+  // homomorphism, and every '?' with its letter that the homomorphism leaves as it is takes the
+  // value it asks for.
+  void answer(ModuleString* word) {
+    if (g_.homomorphism.empty()) return answer_queries(word, turtle_);
+    const int step = step_;
+    step_ = settings_.iterations + 1;
+    ModuleString drawn;
+    expand_all(g_.homomorphism, *word, kHomomorphism, &drawn, &drawn_at_);
+    step_ = step;
+    answer_queries(&drawn, turtle_);
+    for (size_t i = 1; i < word->size(); ++i) {
+      const uint32_t d = drawn_at_[i];
+      if (word->symbols[i - 1] != '?' || drawn_at_[i + 1] != d + 1 || drawn_at_[i] != drawn_at_[i - 1] + 1 ||
+          drawn.symbols[d] != word->symbols[i] || drawn.params_of(d).size() != word->params_of(i).size())
+        continue;
+      std::copy(drawn.params_of(d).begin(), drawn.params_of(d).end(), word->params.begin() + word->param_offsets[i]);
+    }
   }
 
   void check_cap(const ModuleString& word) const {
@@ -114,10 +161,14 @@ class Deriver {
         copy_module(word, i, next);
         continue;
       }
-      RandomStream random = RandomStream::keyed(settings_.seed, kProduction, static_cast<uint64_t>(step_), i);
+      RandomStream random = RandomStream::keyed(seed(), kProduction, static_cast<uint64_t>(step_), i);
       const Rule* rule = select(set, word.symbols[i], word.params_of(i), i, slots, random);
-      if (rule) emit_successor(set, *rule, slots, random, next);
-      else copy_module(word, i, next);
+      if (rule) {
+        emit_successor(set, *rule, slots, random, next);
+        i += rule->length() - 1;
+      } else {
+        copy_module(word, i, next);
+      }
       if (next->size() > settings_.max_modules) check_cap(*next);
     }
     word_ = nullptr;
@@ -137,7 +188,8 @@ class Deriver {
     }
   }
 
-  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts apply),
+  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts or a strict
+  // predecessor of several modules apply; word_ null: only rules of one module apply),
   // its formal parameters bound in slots; nullptr when none applies. The first applicable rule
   // wins; when it has a probability, one of all applicable rules with a probability is drawn
   // with weights proportional to them.
@@ -154,13 +206,15 @@ class Deriver {
         continue;
       }
       rule_ = &rule;
-      const double weight = evaluate(g_.program, rule.probability, slots, random);
+      const double weight = evaluate(g_.program, rule.probability, slots, random, variables_.data());
       if (weight < 0)
         throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + std::to_string(weight)};
       weights_.resize(candidates + 1);
       chosen_.resize(candidates + 1);
+      chosen_slots_.resize((candidates + 1) * kMaxSlots);
       weights_[candidates] = weight;
       chosen_[candidates] = &rule;
+      std::copy(slots, slots + rule.slot_count, chosen_slots_.begin() + static_cast<std::ptrdiff_t>(candidates * kMaxSlots));
       ++candidates;
       total += weight;
     }
@@ -176,25 +230,48 @@ class Deriver {
       }
     }
     const Rule* rule = chosen_[pick];
-    applies(set, *rule, params, index, slots, random);  // rebinds its formals
+    // Its formals and locals as they were bound (running its blocks again would repeat their effects).
+    const auto bound = chosen_slots_.begin() + static_cast<std::ptrdiff_t>(pick * kMaxSlots);
+    std::copy(bound, bound + rule->slot_count, slots);
     return rule;
   }
 
-  // Symbol arity, contexts and condition of one rule; binds its formals into slots.
+  // Symbol arity, strict predecessor, contexts and condition of one rule; binds its formals
+  // into slots.
   bool applies(const RuleSet& set, const Rule& rule, std::span<const double> params, size_t index,
                double* slots, RandomStream& random) {
     if (rule.arity != params.size()) return false;
     for (size_t p = 0; p < params.size(); ++p) slots[rule.predecessor_slot + p] = params[p];
+    if (rule.tail_end > rule.tail_begin && !match_tail(set, rule, index, slots)) return false;
     if (rule.left_end > rule.left_begin && !match_left(set, rule, index, slots)) return false;
     if (rule.right_end > rule.right_begin && !match_right(set, rule, index, slots)) return false;
-    if (!rule.condition.present()) return true;
     rule_ = &rule;
-    return evaluate(g_.program, rule.condition, slots, random) != 0.0;
+    if (rule.before.present()) {
+      std::fill(slots + rule.predecessor_slot + rule.arity, slots + rule.slot_count, 0.0);  // locals start at 0
+      execute(g_.program, rule.before, slots, random, variables_.data());
+    }
+    if (rule.condition.present() && evaluate(g_.program, rule.condition, slots, random, variables_.data()) == 0.0)
+      return false;
+    if (rule.after.present()) execute(g_.program, rule.after, slots, random, variables_.data());
+    return true;
   }
 
   static void bind(const ModuleString& word, size_t j, const PatternModule& pattern, double* slots) {
     const std::span<const double> values = word.params_of(j);
     for (size_t p = 0; p < values.size(); ++p) slots[pattern.first_slot + p] = values[p];
+  }
+
+  // The strict predecessor after its first module: the modules right after it, one by one
+  // (no module passed over; CPFG manual 3.1).
+  bool match_tail(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+    if (!word_ || index + rule.length() > word_->size()) return false;
+    for (uint32_t p = rule.tail_begin; p < rule.tail_end; ++p) {
+      const PatternModule& pattern = set.patterns[p];
+      const size_t j = index + 1 + (p - rule.tail_begin);
+      if (word_->symbols[j] != pattern.symbol || word_->params_of(j).size() != pattern.arity) return false;
+      bind(*word_, j, pattern, slots);
+    }
+    return true;
   }
 
   // Left context: walks left, skipping complete branches (']' ... '[') and climbing out of the
@@ -224,7 +301,7 @@ class Deriver {
   bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
     const ModuleString& w = *word_;
     const size_t n = w.size();
-    size_t j = index + 1;
+    size_t j = index + rule.length();
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
       if (pattern.symbol == ']') {
@@ -248,53 +325,98 @@ class Deriver {
     return true;
   }
 
-  void emit_successor(const RuleSet& set, const Rule& rule, const double* slots, RandomStream& random,
+  void emit_successor(const RuleSet& set, const Rule& rule, double* slots, RandomStream& random,
                       ModuleString* out) {
     rule_ = &rule;
     for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m) {
       const SuccessorModule& module = set.successor[m];
       out->symbols.push_back(module.symbol);
       for (uint32_t p = 0; p < module.arity; ++p)
-        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
+        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
+                                       variables_.data()));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
     }
   }
 
   // Context-free rules applied recursively (up to set.max_depth) to every module: word => *out.
-  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out) {
+  // at, when given: (word size + 1) where each module's expansion starts in *out (the modules
+  // a strict predecessor of several replaces start where the next one does).
+  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out,
+                  std::vector<uint32_t>* at = nullptr) {
     out->clear();
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
-    for (size_t i = 0; i < word.size(); ++i) {
-      RandomStream random = RandomStream::keyed(settings_.seed, purpose, static_cast<uint64_t>(step_), i);
-      const std::span<const double> params = word.params_of(i);
-      expand(set, word.symbols[i], params.data(), params.size(), 0, random, out);
+    if (at) at->assign(word.size() + 1, 0);
+    for (size_t i = 0; i < word.size();) {
+      RandomStream random = RandomStream::keyed(seed(), purpose, static_cast<uint64_t>(step_), i);
+      const size_t used = expand(set, word, i, random, out);
+      if (at) std::fill(at->begin() + static_cast<std::ptrdiff_t>(i) + 1, at->begin() + static_cast<std::ptrdiff_t>(i + used) + 1,
+                        static_cast<uint32_t>(out->size()));
+      i += used;
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
   }
 
-  // One module (params must stay valid until bound) => its expansion appended to *out.
-  void expand(const RuleSet& set, char symbol, const double* params, size_t arity, int depth,
-              RandomStream& random, ModuleString* out) {
-    double slots[kMaxSlots];
-    const Rule* rule = depth < set.max_depth ? select(set, symbol, {params, arity}, 0, slots, random) : nullptr;
-    if (!rule) {
-      out->symbols.push_back(symbol);
-      out->params.insert(out->params.end(), params, params + arity);
-      out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
-      return;
-    }
-    rule_ = rule;
-    for (uint32_t m = rule->successor_begin; m < rule->successor_end; ++m) {
-      const SuccessorModule& module = set.successor[m];
-      const size_t base = scratch_.size();
+  // A rule being expanded: its bound slots live in frame_slots_[slots, slots + slot_count).
+  struct Frame {
+    const Rule* rule;
+    uint32_t next;   // next successor module
+    int depth;
+    size_t slots;
+  };
+
+  // Module `index` of word (with the modules after it, for a strict predecessor of several)
+  // => its expansion appended to *out, depth first in successor order, with an explicit stack
+  // (frames_) instead of recursion; the last module of a successor replaces its rule's frame,
+  // so a rule that ends by calling itself runs in constant space. Successor modules are
+  // expanded one by one (a rule of several modules applies to the word only). => the modules
+  // of word used.
+  size_t expand(const RuleSet& set, const ModuleString& word, size_t index, RandomStream& random,
+                ModuleString* out) {
+    frames_.clear();
+    frame_slots_.clear();
+    word_ = &word;
+    const size_t used = begin_module(set, word.symbols[index], word.params_of(index), index, 0, random, out);
+    word_ = nullptr;
+    while (!frames_.empty()) {
+      Frame& frame = frames_.back();
+      const Rule& rule = *frame.rule;
+      rule_ = &rule;
+      const SuccessorModule& module = set.successor[frame.next++];
+      const int depth = frame.depth + 1;
+      double* slots = frame_slots_.data() + frame.slots;
+      scratch_.clear();
       for (uint32_t p = 0; p < module.arity; ++p)
-        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random));
-      expand(set, module.symbol, scratch_.data() + base, module.arity, depth + 1, random, out);
-      scratch_.resize(base);
-      rule_ = rule;
+        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
+                                    variables_.data()));
+      if (frame.next == rule.successor_end) {
+        frame_slots_.resize(frame.slots);
+        frames_.pop_back();
+      }
+      params_.assign(scratch_.begin(), scratch_.end());
+      begin_module(set, module.symbol, params_, 0, depth, random, out);
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
+    return used;
+  }
+
+  // A module at `depth` (at `index` of word_ when that is set): copied to *out when no rule
+  // applies, else its rule's frame pushed. => the modules its rule replaces (1 when none).
+  size_t begin_module(const RuleSet& set, char symbol, std::span<const double> params, size_t index, int depth,
+                      RandomStream& random, ModuleString* out) {
+    double slots[kMaxSlots];
+    const Rule* rule = depth < set.max_depth ? select(set, symbol, params, index, slots, random) : nullptr;
+    if (!rule) {
+      out->symbols.push_back(symbol);
+      out->params.insert(out->params.end(), params.begin(), params.end());
+      out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+      return 1;
+    }
+    if (rule->successor_begin != rule->successor_end) {  // else erased
+      frames_.push_back({rule, rule->successor_begin, depth, frame_slots_.size()});
+      frame_slots_.insert(frame_slots_.end(), slots, slots + rule->slot_count);
+    }
+    return rule->length();
   }
 
   // '%' removes itself and the rest of its branch (up to, not including, the closing ']').
@@ -319,19 +441,26 @@ class Deriver {
 
   const Grammar& g_;
   const DerivationSettings& settings_;
+  const TurtleSettings turtle_;         // answers the query modules
   int step_ = 0;
   const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
   const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
   std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere
   std::vector<double> weights_;         // stochastic candidates' weights
   std::vector<const Rule*> chosen_;     // stochastic candidates
-  std::vector<double> scratch_;         // parameter values of modules being expanded
+  std::vector<double> scratch_;         // parameter values of the module being expanded
+  std::vector<double> params_;          // the same, while its own rule is selected
+  std::vector<Frame> frames_;           // rules being expanded, innermost last
+  std::vector<double> frame_slots_;     // their bound formals and locals
+  std::vector<double> chosen_slots_;    // (candidates x kMaxSlots) slots of stochastic candidates
+  std::vector<double> variables_;       // global variables; [0] the last srand() argument
+  std::vector<uint32_t> drawn_at_;      // where each module's homomorphism starts (query pass)
 };
 
 }  // namespace
 
-ModuleString derive(const Grammar& grammar, const DerivationSettings& settings) {
-  Deriver deriver(grammar, settings);
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle) {
+  Deriver deriver(grammar, settings, turtle);
   try {
     return deriver.derive();
   } catch (const EvalError& error) {

@@ -6,6 +6,7 @@
 
 #include "lsystem/grammar.h"
 #include "lsystem/module_string.h"
+#include "lsystem/turtle.h"
 
 namespace treeanim {
 
@@ -16,10 +17,13 @@ struct DerivationSettings {
 };
 
 // grammar + settings => the word after settings.iterations steps; decomposition rules are
-// applied to the axiom and after every step, and '%' removes the rest of its branch.
+// applied to the axiom and after every step, and '%' removes the rest of its branch. When the
+// grammar writes query modules, the turtle interprets the word (through the homomorphism)
+// after the axiom and after every step, and they take their values (CPFG manual 6.9).
 // Throws InputError at the module cap and on runtime errors (division by zero...), naming the
 // step and the production.
-ModuleString derive(const Grammar& grammar, const DerivationSettings& settings);
+// `turtle` is the one that answers the query modules.
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {});
 
 // word => word with the homomorphism rules applied (what the turtle reads; the derivation
 // never sees it). Throws InputError like derive.

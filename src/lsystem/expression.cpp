@@ -4,7 +4,9 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <numbers>
 
 #include "common/scene_reader.h"
@@ -27,20 +29,27 @@ struct Function {
   int arity;
 };
 
-constexpr std::array<Function, 17> kFunctions{{
+// The cpfg manual's function library (chapter 5), plus abs, min and max.
+constexpr std::array<Function, 26> kFunctions{{
     {"sin", Op::kSin, 1},   {"cos", Op::kCos, 1},     {"tan", Op::kTan, 1},
     {"asin", Op::kAsin, 1}, {"acos", Op::kAcos, 1},   {"atan", Op::kAtan, 1},
     {"atan2", Op::kAtan2, 2}, {"sqrt", Op::kSqrt, 1}, {"exp", Op::kExp, 1},
-    {"log", Op::kLog, 1},   {"abs", Op::kAbs, 1},     {"min", Op::kMin, 2},
-    {"max", Op::kMax, 2},   {"floor", Op::kFloor, 1}, {"ceil", Op::kCeil, 1},
-    {"ran", Op::kRan, 1},   {"nran", Op::kNran, 2},
+    {"log", Op::kLog, 1},   {"abs", Op::kAbs, 1},     {"fabs", Op::kAbs, 1},
+    {"min", Op::kMin, 2},   {"max", Op::kMax, 2},     {"floor", Op::kFloor, 1},
+    {"ceil", Op::kCeil, 1}, {"trunc", Op::kTrunc, 1}, {"sign", Op::kSign, 1},
+    {"pow", Op::kPow, 2},   {"func", Op::kFunc, 2},   {"ran", Op::kRan, 1},
+    {"nran", Op::kNran, 2}, {"bran", Op::kBran, 2},   {"biran", Op::kBiran, 2},
+    {"srand", Op::kSrand, 1}, {"fmod", Op::kRem, 2},
 }};
 
+// Operands an instruction pops.
 int arity_of(Op op) {
   switch (op) {
-    case Op::kConst: case Op::kParam: return 0;
-    case Op::kNeg: case Op::kNot: return 1;
-    case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow:
+    case Op::kConst: case Op::kParam: case Op::kLoadVar: case Op::kJump: return 0;
+    case Op::kNeg: case Op::kNot: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
+    case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: return 1;
+    case Op::kStoreElem: return 2;
+    case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem:
     case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe:
     case Op::kAnd: case Op::kOr: return 2;
     default: break;
@@ -48,6 +57,27 @@ int arity_of(Op op) {
   for (const Function& f : kFunctions)
     if (f.op == op) return f.arity;
   return 0;
+}
+
+// Values an instruction pushes.
+int results_of(Op op) {
+  switch (op) {
+    case Op::kStoreVar: case Op::kStoreParam: case Op::kPop: case Op::kJump: case Op::kJumpIfZero:
+    case Op::kStoreElem:
+      return 0;
+    default: return 1;
+  }
+}
+
+// Pure operations of constants may be computed when compiled.
+bool foldable(Op op) {
+  switch (op) {
+    case Op::kConst: case Op::kParam: case Op::kRan: case Op::kNran: case Op::kBran: case Op::kBiran:
+    case Op::kSrand: case Op::kLoadVar: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
+    case Op::kJump: case Op::kJumpIfZero: case Op::kLoadElem: case Op::kStoreElem:
+      return false;
+    default: return true;
+  }
 }
 
 std::string plural(int n, const char* word) {
@@ -68,7 +98,7 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
 // || && comparisons +- */ unary ^).
 class Compiler {
  public:
-  Compiler(ExprProgram& program, std::string_view text, size_t pos, SourcePos line,
+  Compiler(ExprProgram& program, std::string_view text, size_t pos, const TextOrigin& line,
            const ExprScope& scope)
       : program_(program), text_(text), pos_(pos), line_(line), scope_(scope) {}
 
@@ -78,16 +108,28 @@ class Compiler {
     skip_space();
     expr.pos = at(pos_);
     expr.begin = static_cast<uint32_t>(program_.code.size());
-    parse_or();
+    barrier_ = program_.code.size();
+    parse_conditional();
     expr.end = static_cast<uint32_t>(program_.code.size());
     return expr;
+  }
+
+  // "{ statements }" at pos() => the compiled block (it leaves nothing on the stack).
+  Expr compile_block(const StatementScope& statements) {
+    statements_ = &statements;
+    Expr block;
+    skip_space();
+    block.pos = at(pos_);
+    block.begin = static_cast<uint32_t>(program_.code.size());
+    barrier_ = program_.code.size();
+    parse_block();
+    block.end = static_cast<uint32_t>(program_.code.size());
+    return block;
   }
   size_t pos() const { return pos_; }
 
  private:
-  SourcePos at(size_t index) const {
-    return {line_.source, line_.line, static_cast<int32_t>(index) + 1};
-  }
+  SourcePos at(size_t index) const { return line_.at(index); }
   [[noreturn]] void fail(size_t index, const std::string& message) const {
     throw GrammarError{at(index), message};
   }
@@ -112,9 +154,19 @@ class Compiler {
   void emit(Op op, uint32_t arg, size_t where) {
     program_.code.push_back({op, arg});
     program_.code_pos.push_back(at(where));
-    depth_ += 1 - arity_of(op);
+    depth_ += results_of(op) - arity_of(op);
     if (depth_ > kMaxExprStack) fail(where, "expression too deeply nested");
-    if (op != Op::kRan && op != Op::kNran && op != Op::kConst && op != Op::kParam) fold(arity_of(op));
+    if (foldable(op)) fold(arity_of(op));
+  }
+  // A jump whose target is patched later; returns its index.
+  size_t emit_jump(Op op, size_t where) {
+    emit(op, 0, where);
+    return program_.code.size() - 1;
+  }
+  // The jump at `index` goes to the next instruction; nothing before it may be folded since.
+  void land(size_t index) {
+    program_.code[index].arg = static_cast<uint32_t>(program_.code.size());
+    barrier_ = program_.code.size();
   }
   void emit_constant(double value, size_t where) {
     program_.constants.push_back(value);
@@ -124,6 +176,7 @@ class Compiler {
   // by their value (division by zero or a non-finite value is then a compile-time error).
   void fold(int operands) {
     const size_t n = program_.code.size();
+    if (n < barrier_ + 1 + static_cast<size_t>(operands)) return;  // an operand is a jump's target
     for (int k = 1; k <= operands; ++k)
       if (program_.code[n - 1 - k].op != Op::kConst) return;
     Expr tail;
@@ -142,6 +195,23 @@ class Compiler {
     program_.constants.push_back(value);
     program_.code.push_back({Op::kConst, static_cast<uint32_t>(program_.constants.size() - 1)});
     program_.code_pos.push_back(where);
+  }
+
+  // c ? a : b (right-associative, below ||), compiled with jumps so that only one side runs.
+  void parse_conditional() {
+    parse_or();
+    skip_space();
+    const size_t where = pos_;
+    if (!accept("?")) return;
+    const size_t skip_then = emit_jump(Op::kJumpIfZero, where);
+    parse_conditional();
+    skip_space();
+    if (!accept(":")) fail(pos_, "expected ':' of the '?' at column " + std::to_string(where + 1) + ", got " + describe_next());
+    const size_t skip_else = emit_jump(Op::kJump, where);
+    --depth_;  // one of the two sides is on the stack
+    land(skip_then);
+    parse_conditional();
+    land(skip_else);
   }
 
   void parse_or() {
@@ -197,6 +267,7 @@ class Compiler {
       const size_t where = pos_;
       if (accept("*")) { parse_unary(); emit(Op::kMul, 0, where); }
       else if (accept("/")) { parse_unary(); emit(Op::kDiv, 0, where); }
+      else if (accept("%")) { parse_unary(); emit(Op::kRem, 0, where); }
       else return;
     }
   }
@@ -231,10 +302,16 @@ class Compiler {
     } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
       const std::string name(text_.substr(start, pos_ - start));
-      if (peek() == '(') parse_call(name, start);
-      else parse_name(name, start);
+      if (peek() == '(') {
+        parse_call(name, start);
+      } else if (const ArrayDecl* array = array_named(name)) {
+        parse_index(*array, start);
+        emit(Op::kLoadElem, array->base, start);
+      } else {
+        parse_name(name, start);
+      }
     } else if (accept("(")) {
-      parse_or();
+      parse_conditional();
       skip_space();
       if (!accept(")")) fail(pos_, "expected ')' to close the '(' at column " +
                                        std::to_string(start + 1) + ", got " + describe_next());
@@ -260,14 +337,51 @@ class Compiler {
     if (!std::isfinite(value)) fail(start, "number out of range");
     emit_constant(value, start);
   }
-  void parse_name(const std::string& name, size_t start) {
-    if (scope_.formals) {
-      const auto& formals = *scope_.formals;
-      const auto it = std::find(formals.begin(), formals.end(), name);
-      if (it != formals.end()) {
-        emit(Op::kParam, static_cast<uint32_t>(it - formals.begin()), start);
-        return;
+  static int index_of(const std::vector<std::string>* names, const std::string& name) {
+    if (!names) return -1;
+    const auto it = std::find(names->begin(), names->end(), name);
+    return it == names->end() ? -1 : static_cast<int>(it - names->begin());
+  }
+  const ArrayDecl* array_named(const std::string& name) const {
+    for (const ArrayDecl& array : program_.arrays)
+      if (array.name == name) return &array;
+    return nullptr;
+  }
+  // "[i][j]" or "[i, j]" after an array's name => its row-major element number on the stack,
+  // each index truncated and checked against its dimension when evaluated.
+  void parse_index(const ArrayDecl& array, size_t start) {
+    skip_space();
+    if (!accept("[")) fail(pos_, "expected '[' after the array '" + array.name + "', got " + describe_next());
+    for (size_t d = 0; d < array.dims.size(); ++d) {
+      if (d > 0) {
+        const size_t where = pos_;
+        if (!accept(",") && !(accept("]") && accept("[")))
+          fail(where, "expected " + indices(array) + ", got " + describe_next());
+        emit_constant(array.dims[d], where);
+        emit(Op::kMul, 0, where);
       }
+      const size_t where = (skip_space(), pos_);
+      parse_conditional();
+      emit(Op::kIndex, array.dims[d], where);
+      if (d > 0) emit(Op::kAdd, 0, where);
+    }
+    skip_space();
+    if (!accept("]"))
+      fail(pos_, "expected ']' after the " + indices(array) + " (at column " + std::to_string(start + 1) + "), got " +
+                     describe_next());
+  }
+  static std::string indices(const ArrayDecl& array) {
+    return std::to_string(array.dims.size()) + (array.dims.size() == 1 ? " index" : " indices") + " of '" +
+           array.name + "'";
+  }
+  void parse_name(const std::string& name, size_t start) {
+    if (const int slot = index_of(scope_.formals, name); slot >= 0) {
+      emit(Op::kParam, static_cast<uint32_t>(slot), start);
+      return;
+    }
+    if (const int variable = index_of(scope_.variables, name); variable >= 0) {
+      emit(Op::kLoadVar, static_cast<uint32_t>(variable) + 1, start);
+      return;
     }
     if (scope_.defines)
       for (const auto& [define, value] : *scope_.defines)
@@ -281,7 +395,9 @@ class Compiler {
   std::string known_names(const std::string& name) const {
     std::vector<std::string> candidates;
     std::string list;
-    auto add_all = [&](const std::vector<std::string>& names, const char* what) {
+    auto add_all = [&](const std::vector<std::string>& all, const char* what) {
+      std::vector<std::string> names;  // without arrays' elements after the first (unnamed)
+      std::copy_if(all.begin(), all.end(), std::back_inserter(names), [](const std::string& n) { return !n.empty(); });
       if (names.empty()) return;
       list += std::string(list.empty() ? "" : " or ") + what + " (";
       for (size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
@@ -289,6 +405,7 @@ class Compiler {
       candidates.insert(candidates.end(), names.begin(), names.end());
     };
     if (scope_.formals) add_all(*scope_.formals, "a formal parameter");
+    if (scope_.variables) add_all(*scope_.variables, "a variable");
     std::vector<std::string> defines;
     if (scope_.defines)
       for (const auto& entry : *scope_.defines) defines.push_back(entry.first);
@@ -297,7 +414,25 @@ class Compiler {
     const std::string near = suggestion(name, candidates);
     return " (expected " + list + (near.empty() ? "" : "; did you mean '" + near + "'?") + ")";
   }
+  // printf("format", values...) (CPFG manual 5.4): its values are computed and nothing is
+  // printed (the output streams are treeanim's own); its value is 0.
+  void parse_printf(size_t start) {
+    ++pos_;  // '('
+    skip_space();
+    if (peek() != '"') fail(pos_, "expected a format string \"...\" after 'printf(', got " + describe_next());
+    ++pos_;
+    while (pos_ < text_.size() && text_[pos_] != '"') pos_ += text_[pos_] == '\\' ? 2 : 1;
+    if (pos_ >= text_.size()) fail(start, "the format string of printf is never closed (expected '\"')");
+    ++pos_;
+    while (accept(",")) {
+      parse_conditional();
+      emit(Op::kPop, 0, start);
+    }
+    expect(")", "to close printf(");
+    emit_constant(0.0, start);
+  }
   void parse_call(const std::string& name, size_t start) {
+    if (name == "printf") return parse_printf(start);
     const Function* function = nullptr;
     for (const Function& f : kFunctions)
       if (name == f.name) function = &f;
@@ -310,11 +445,12 @@ class Compiler {
     }
     ++pos_;  // '('
     int count = 0;
+    size_t first_argument_end = 0;
     skip_space();
     if (!accept(")")) {
       for (;;) {
-        parse_or();
-        ++count;
+        parse_conditional();
+        if (++count == 1) first_argument_end = program_.code.size();
         skip_space();
         if (accept(")")) break;
         if (!accept(",")) fail(pos_, "expected ',' or ')' in the arguments of " + name + ", got " +
@@ -324,18 +460,170 @@ class Compiler {
     if (count != function->arity)
       fail(start, name + " expects " + plural(function->arity, "argument") + ", got " +
                       std::to_string(count));
-    emit(function->op, 0, start);
+    emit(function->op, function->op == Op::kFunc ? function_number(first_argument_end, start) : 0, start);
+  }
+  // func(id, x): id, the code ending at first_argument_end, must be a constant naming one of
+  // the view file's functions => its index.
+  uint32_t function_number(size_t first_argument_end, size_t start) const {
+    const Instruction id = program_.code[first_argument_end - 1];
+    const double value = id.op == Op::kConst ? program_.constants[id.arg] : -1.0;
+    const size_t count = program_.functions.size();
+    if (id.op != Op::kConst || value != std::floor(value) || value < 1 || value > double(count))
+      fail(start, "func expects a constant function number 1 ... " + std::to_string(count) +
+                      " (the view file's 'function:' lines" + (count ? ")" : ": it has none)"));
+    return static_cast<uint32_t>(value) - 1;
+  }
+
+  // --- statements (cpfg manual 3.2) ---
+  void expect(std::string_view token, const char* what) {
+    skip_space();
+    if (!accept(token)) fail(pos_, "expected '" + std::string(token) + "' " + what + ", got " + describe_next());
+  }
+  void parse_block() {
+    if (++nesting_ > kMaxNesting) fail(pos_, "statements too deeply nested");
+    expect("{", "to open a block of statements");
+    for (;;) {
+      skip_space();
+      if (accept("}")) break;
+      if (pos_ >= text_.size()) fail(pos_, "expected '}' to close the block of statements, got the end of the text");
+      parse_statement();
+    }
+    --nesting_;
+  }
+  void parse_condition_in_parentheses(const char* keyword) {
+    expect("(", (std::string("after '") + keyword + "'").c_str());
+    parse_conditional();
+    expect(")", (std::string("to close the condition of '") + keyword + "'").c_str());
+  }
+  bool accept_keyword(std::string_view word) {
+    skip_space();
+    if (text_.substr(pos_, word.size()) != word) return false;
+    const char next = pos_ + word.size() < text_.size() ? text_[pos_ + word.size()] : '\0';
+    if (std::isalnum(static_cast<unsigned char>(next)) || next == '_') return false;
+    pos_ += word.size();
+    return true;
+  }
+  void parse_statement() {
+    skip_space();
+    const size_t start = pos_;
+    if (accept_keyword("if")) {
+      parse_condition_in_parentheses("if");
+      const size_t skip_then = emit_jump(Op::kJumpIfZero, start);
+      parse_block();
+      if (accept_keyword("else")) {
+        const size_t skip_else = emit_jump(Op::kJump, start);
+        land(skip_then);
+        parse_block();
+        land(skip_else);
+      } else {
+        land(skip_then);
+      }
+    } else if (accept_keyword("while")) {
+      const size_t top = program_.code.size();
+      barrier_ = top;
+      parse_condition_in_parentheses("while");
+      const size_t exit = emit_jump(Op::kJumpIfZero, start);
+      parse_block();
+      emit(Op::kJump, static_cast<uint32_t>(top), start);
+      land(exit);
+    } else if (accept_keyword("do")) {
+      const size_t top = program_.code.size();
+      barrier_ = top;
+      parse_block();
+      if (!accept_keyword("while")) fail(pos_, "expected 'while' after the block of 'do', got " + describe_next());
+      parse_condition_in_parentheses("while");
+      const size_t exit = emit_jump(Op::kJumpIfZero, start);
+      emit(Op::kJump, static_cast<uint32_t>(top), start);
+      land(exit);
+      skip_space();
+      accept(";");
+    } else {
+      parse_simple_statement(start);
+    }
+  }
+  // "name = expression;" or "call(...);".
+  void parse_simple_statement(size_t start) {
+    const char c = peek();
+    if (!(std::isalpha(static_cast<unsigned char>(c)) || c == '_'))
+      fail(start, "expected a statement (an assignment 'name = expression;', if, while or do), got " + describe_next());
+    while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
+    const std::string name(text_.substr(start, pos_ - start));
+    skip_space();
+    if (const ArrayDecl* array = array_named(name); array && peek() == '[') {
+      parse_index(*array, start);
+      expect("=", ("to assign an element of '" + name + "'").c_str());
+      parse_conditional();
+      emit(Op::kStoreElem, array->base, start);
+    } else if (peek() == '=' && peek(1) != '=') {
+      ++pos_;
+      parse_conditional();
+      emit_store(name, start);
+    } else {
+      pos_ = start;
+      parse_conditional();
+      emit(Op::kPop, 0, start);
+    }
+    expect(";", "after the statement");
+  }
+  void emit_store(const std::string& name, size_t start) {
+    if (scope_.defines)
+      for (const auto& entry : *scope_.defines)
+        if (entry.first == name) fail(start, "'" + name + "' is a #define constant and cannot be assigned");
+    std::vector<std::string>* locals = statements_->locals;
+    std::vector<std::string>* globals = statements_->globals;
+    int slot = index_of(locals, name);
+    if (slot >= 0) return emit(Op::kStoreParam, static_cast<uint32_t>(slot), start);
+    int variable = index_of(globals, name);
+    if (variable < 0 && statements_->assign_globals) {
+      globals->push_back(name);
+      variable = static_cast<int>(globals->size()) - 1;
+    }
+    if (variable >= 0) return emit(Op::kStoreVar, static_cast<uint32_t>(variable) + 1, start);
+    if (!locals) fail(start, "cannot assign '" + name + "' here");
+    if (locals->size() >= kMaxLocals) fail(start, "more than 64 parameters and local variables in one rule");
+    locals->push_back(name);
+    emit(Op::kStoreParam, static_cast<uint32_t>(locals->size() - 1), start);
   }
 
   ExprProgram& program_;
   std::string_view text_;
   size_t pos_;
-  SourcePos line_;
+  const TextOrigin& line_;
   const ExprScope& scope_;
+  const StatementScope* statements_ = nullptr;  // set while compiling a block
   int depth_ = 0;    // operand stack depth after the code emitted so far
-  int nesting_ = 0;  // recursion depth of parse_unary (bounds the parser's own stack)
+  int nesting_ = 0;  // recursion depth of parse_unary and blocks (bounds the parser's own stack)
+  size_t barrier_ = 0;  // code before this index is a jump target's past: never folded into
   static constexpr int kMaxNesting = 256;
+  static constexpr size_t kMaxLocals = 64;  // slots of one rule (derive.cpp's kMaxSlots)
 };
+
+// Beta(a, b) by two gamma draws (Marsaglia and Tsang; a shape below 1 boosted by u^(1/a)).
+double gamma_draw(double shape, RandomStream& random) {
+  const double boost = shape < 1.0 ? std::pow(1.0 - random.uniform(), 1.0 / shape) : 1.0;
+  const double d = (shape < 1.0 ? shape + 1.0 : shape) - 1.0 / 3.0;
+  const double c = 1.0 / std::sqrt(9.0 * d);
+  for (;;) {
+    const double x = random.normal();
+    const double v = std::pow(1.0 + c * x, 3);
+    if (v <= 0) continue;
+    const double u = 1.0 - random.uniform();
+    if (std::log(u) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v * boost;
+  }
+}
+
+// samples of f on [0, 1], x => f(x), linear between samples, clamped at the ends (cpfg 5.5).
+double sample_function(const std::vector<double>& samples, double x) {
+  const double t = std::clamp(x, 0.0, 1.0) * static_cast<double>(samples.size() - 1);
+  const size_t k = std::min(static_cast<size_t>(t), samples.size() - 2);
+  return samples[k] + (t - static_cast<double>(k)) * (samples[k + 1] - samples[k]);
+}
+
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
 
 [[noreturn]] void eval_fail(const ExprProgram& program, uint32_t instruction, const char* message) {
   throw EvalError{program.code_pos[instruction], message};
@@ -367,17 +655,30 @@ bool ExprProgram::is_constant(const Expr& expr, double* value) const {
 }
 
 Expr compile_expression(ExprProgram& program, std::string_view text, size_t* pos,
-                        SourcePos line, const ExprScope& scope) {
+                        const TextOrigin& line, const ExprScope& scope) {
   Compiler compiler(program, text, *pos, line, scope);
   const Expr expr = compiler.compile();
   *pos = compiler.pos();
   return expr;
 }
 
-double evaluate(const ExprProgram& program, const Expr& expr, const double* formals,
-                RandomStream& random) {
+Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, const TextOrigin& line,
+                   const StatementScope& scope) {
+  const ExprScope names{scope.locals, scope.defines, scope.globals};
+  Compiler compiler(program, text, *pos, line, names);
+  const Expr block = compiler.compile_block(scope);
+  *pos = compiler.pos();
+  return block;
+}
+
+namespace {
+
+// The interpreter of expressions and blocks; slots are written only by blocks' stores.
+double run(const ExprProgram& program, const Expr& expr, double* slots, RandomStream& random,
+           double* variables) {
   double stack[kMaxExprStack];
   int top = -1;
+  uint64_t jumps_back = 0;
   const Instruction* code = program.code.data();
   for (uint32_t k = expr.begin; k < expr.end; ++k) {
     const Instruction in = code[k];
@@ -385,13 +686,16 @@ double evaluate(const ExprProgram& program, const Expr& expr, const double* form
     const double b = top >= 0 ? stack[top] : 0.0;
     switch (in.op) {
       case Op::kConst: stack[++top] = program.constants[in.arg]; break;
-      case Op::kParam: stack[++top] = formals[in.arg]; break;
+      case Op::kParam: stack[++top] = slots[in.arg]; break;
       case Op::kAdd: a = a + b; --top; break;
       case Op::kSub: a = a - b; --top; break;
       case Op::kMul: a = a * b; --top; break;
       case Op::kDiv:
         if (b == 0.0) eval_fail(program, k, "division by zero");
         a = a / b; --top; break;
+      case Op::kRem:
+        if (b == 0.0) eval_fail(program, k, "division by zero");
+        a = std::fmod(a, b); --top; break;
       case Op::kPow: a = std::pow(a, b); --top; break;
       case Op::kNeg: stack[top] = -b; break;
       case Op::kNot: stack[top] = b == 0.0 ? 1.0 : 0.0; break;
@@ -418,14 +722,73 @@ double evaluate(const ExprProgram& program, const Expr& expr, const double* form
       case Op::kMax: a = std::max(a, b); --top; break;
       case Op::kFloor: stack[top] = std::floor(b); break;
       case Op::kCeil: stack[top] = std::ceil(b); break;
+      case Op::kTrunc: stack[top] = std::trunc(b); break;
+      case Op::kSign: stack[top] = b > 0.0 ? 1.0 : (b < 0.0 ? -1.0 : 0.0); break;
+      case Op::kFunc: a = sample_function(program.functions[in.arg], b); --top; break;
       case Op::kRan: stack[top] = random.uniform() * b; break;
       case Op::kNran: a = a + b * random.normal(); --top; break;
+      case Op::kBran: {
+        if (!(a > 0.0 && b > 0.0)) eval_fail(program, k, "bran expects two positive shapes");
+        const double x = gamma_draw(a, random);
+        a = x / (x + gamma_draw(b, random));
+        --top;
+        break;
+      }
+      case Op::kBiran: {
+        if (!(a >= 0.0 && a <= 1e6)) eval_fail(program, k, "biran expects a count in [0, 1000000]");
+        double hits = 0;
+        for (int n = static_cast<int>(a); n > 0; --n) hits += random.uniform() < b ? 1.0 : 0.0;
+        a = hits;
+        --top;
+        break;
+      }
+      case Op::kSrand:
+        if (variables) variables[kSrandVariable] = b;
+        stack[top] = 0.0;
+        break;
+      case Op::kLoadVar: stack[++top] = variables ? variables[in.arg] : 0.0; break;
+      case Op::kStoreVar: if (variables) variables[in.arg] = b; --top; continue;
+      case Op::kStoreParam: slots[in.arg] = b; --top; continue;
+      case Op::kPop: --top; continue;
+      case Op::kIndex:
+        stack[top] = std::trunc(b);
+        if (!(stack[top] >= 0.0 && stack[top] < static_cast<double>(in.arg)))
+          throw EvalError{program.code_pos[k], "array index " + format_number(b) + " is outside 0 ... " +
+                                                    std::to_string(in.arg - 1)};
+        break;
+      case Op::kLoadElem: stack[top] = variables ? variables[in.arg + static_cast<uint32_t>(b)] : 0.0; break;
+      case Op::kStoreElem:
+        if (variables) variables[in.arg + static_cast<uint32_t>(a)] = b;
+        top -= 2;
+        continue;
+      case Op::kJumpIfZero:
+        --top;
+        if (b == 0.0) k = in.arg - 1;
+        continue;
+      case Op::kJump:
+        if (in.arg <= k && ++jumps_back > kMaxLoopIterations)
+          eval_fail(program, k, "a loop ran more than 10000000 times");
+        k = in.arg - 1;  // the loop's ++k lands on the target
+        continue;
     }
     if (!std::isfinite(stack[top]))
       eval_fail(program, k, "the value is not a finite number (a square root or arcsine of an "
                             "out-of-range value, log of 0, or an overflow)");
   }
-  return stack[0];
+  return top >= 0 ? stack[0] : 0.0;
+}
+
+}  // namespace
+
+double evaluate(const ExprProgram& program, const Expr& expr, const double* formals,
+                RandomStream& random, double* variables) {
+  // An expression only reads its slots; stores come from blocks (compile_block).
+  return run(program, expr, const_cast<double*>(formals), random, variables);
+}
+
+void execute(const ExprProgram& program, const Expr& block, double* slots, RandomStream& random,
+             double* variables) {
+  run(program, block, slots, random, variables);
 }
 
 }  // namespace treeanim

@@ -20,6 +20,23 @@ struct SourcePos {
   int32_t column = 0;  // 1-based byte column
 };
 
+// Where the characters of a text come from: column index + 1 of `line`, or per character
+// (a statement joined from several lines, or with #define macros expanded at their use).
+struct TextOrigin {
+  SourcePos line;
+  const std::vector<SourcePos>* columns = nullptr;  // (text size) when present
+  TextOrigin(SourcePos l) : line(l) {}  // NOLINT: a plain line converts implicitly
+  TextOrigin(SourcePos l, const std::vector<SourcePos>* c) : line(l), columns(c) {}
+  SourcePos at(size_t index) const {
+    if (!columns) return {line.source, line.line, static_cast<int32_t>(index) + 1};
+    if (columns->empty()) return line;
+    if (index < columns->size()) return (*columns)[index];
+    SourcePos past = columns->back();  // past the end: the columns after the last character
+    past.column += static_cast<int32_t>(index - columns->size()) + 1;
+    return past;
+  }
+};
+
 // A syntax or semantic error found while reading a grammar; load_grammar turns it into an
 // InputError "file:line:column: message".
 struct GrammarError {
@@ -44,7 +61,12 @@ enum class Op : uint8_t {
   kLt, kLe, kGt, kGe, kEq, kNe, kAnd, kOr,         // comparisons and logic: 1 or 0
   kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2,   // degrees
   kSqrt, kExp, kLog, kAbs, kMin, kMax, kFloor, kCeil,
-  kRan, kNran,                                     // random: never folded
+  kRem, kTrunc, kSign,                             // C's fmod, trunc; sign: -1, 0, 1
+  kFunc,                                           // view-file function functions[arg] at x
+  kRan, kNran, kBran, kBiran, kSrand,              // random: never folded
+  kLoadVar, kStoreVar, kStoreParam, kPop,          // variables[arg], formals[arg] (statements)
+  kIndex, kLoadElem, kStoreElem,                   // array index < arg; variables[arg + index]
+  kJump, kJumpIfZero,                              // to code[arg] (?:, if, while)
 };
 
 struct Instruction {
@@ -60,11 +82,20 @@ struct Expr {
   bool present() const { return end > begin; }
 };
 
+// A cpfg array (manual 2.2.2): its elements are global variables base, base + 1, ... in row-major order.
+struct ArrayDecl {
+  std::string name;
+  uint32_t base = 0;            // variables index of element 0
+  std::vector<uint32_t> dims;   // sizes of its dimensions
+};
+
 // The code of every expression of one grammar.
 struct ExprProgram {
   std::vector<Instruction> code;     // (instructions)
   std::vector<SourcePos> code_pos;   // (instructions) the operator's place, for runtime errors
   std::vector<double> constants;     // (constants)
+  std::vector<std::vector<double>> functions;  // (functions x samples) func(id, x) on [0, 1], equally spaced
+  std::vector<ArrayDecl> arrays;     // names the compiler resolves to array elements
   // expr => true when it is one constant (its value in *value).
   bool is_constant(const Expr& expr, double* value) const;
 };
@@ -75,10 +106,20 @@ struct EvalError {
   std::string message;
 };
 
-// Names an expression may use: the production's formal parameters (which shadow defines),
-// then the grammar's defines (already resolved to numbers).
+// Names an expression may use: the production's formal parameters and local variables
+// (which shadow the rest), the grammar's global variables, then its defines (numbers).
 struct ExprScope {
   const std::vector<std::string>* formals = nullptr;
+  const std::vector<std::pair<std::string, double>>* defines = nullptr;
+  const std::vector<std::string>* variables = nullptr;  // globals: variables[i] is slot i
+};
+
+// Where statements put a name assigned for the first time (cpfg manual 2.2.1): a production's
+// block makes it local (a slot after the formals), a Start/End block global.
+struct StatementScope {
+  std::vector<std::string>* locals = nullptr;     // the rule's formals, then its locals
+  std::vector<std::string>* globals = nullptr;    // the grammar's variables
+  bool assign_globals = false;                    // true in Start/StartEach/EndEach/End blocks
   const std::vector<std::pair<std::string, double>>* defines = nullptr;
 };
 
@@ -90,11 +131,26 @@ constexpr int kMaxExprStack = 32;
 // source and line of `text` (column = index + 1). Constant sub-expressions are folded.
 // Throws GrammarError.
 Expr compile_expression(ExprProgram& program, std::string_view text, size_t* pos,
-                        SourcePos line, const ExprScope& scope);
+                        const TextOrigin& line, const ExprScope& scope);
 
-// (expr, formal values, random stream) => value. Throws EvalError on division by zero or a
-// non-finite result (sqrt of a negative number, log of 0, overflow).
+// text at *pos = '{' => the block "{ statement ... }" compiled (cpfg manual 3.2: assignments
+// "name = expression;", "if (c) {...} [else {...}]", "while (c) {...}", "do {...} while (c);",
+// calls such as "srand(s);"); *pos is left after the closing '}'. Throws GrammarError.
+Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, const TextOrigin& line,
+                   const StatementScope& scope);
+
+// Variable 0 holds the last srand() argument (0 until one is made); names start at 1.
+constexpr uint32_t kSrandVariable = 0;
+
+// (expr, formal values, random stream, global variables) => value. Throws EvalError on
+// division by zero or a non-finite result (sqrt of a negative number, log of 0, overflow).
 double evaluate(const ExprProgram& program, const Expr& expr, const double* formals,
-                RandomStream& random);
+                RandomStream& random, double* variables = nullptr);
+
+// Runs a compiled block: it may assign the formals and locals (slots) and the globals
+// (variables). Loops stop with an EvalError after kMaxLoopIterations jumps back.
+void execute(const ExprProgram& program, const Expr& block, double* slots, RandomStream& random,
+             double* variables);
+constexpr uint64_t kMaxLoopIterations = 10'000'000;
 
 }  // namespace treeanim

@@ -32,18 +32,25 @@ struct SuccessorModule {
 };
 
 // [lc <] pred [> rc] [: condition] --> successor [: probability]
+// A strict predecessor of several modules (CPFG manual 3.1) is its first module (predecessor,
+// arity) followed by the modules of tail_begin..tail_end, matched one after the other.
 struct Rule {
   char predecessor = 0;
   uint8_t arity = 0;
   uint16_t predecessor_slot = 0;  // first slot of the predecessor's formals
   uint16_t slot_count = 0;        // formals of lc, pred and rc together
   uint32_t left_begin = 0, left_end = 0;    // RuleSet::patterns, in text order
+  uint32_t tail_begin = 0, tail_end = 0;    // RuleSet::patterns: the strict predecessor after its first module
   uint32_t right_begin = 0, right_end = 0;  // RuleSet::patterns, in text order
   uint32_t successor_begin = 0, successor_end = 0;  // RuleSet::successor
+  Expr before;       // block run when the contexts match, before the condition (cpfg)
   Expr condition;    // absent: always true
+  Expr after;        // block run when the condition holds, before the successor (cpfg)
   Expr probability;  // absent: deterministic
   SourcePos pos;     // the rule's first character
   bool has_context() const { return left_end > left_begin || right_end > right_begin; }
+  // Modules the strict predecessor replaces.
+  uint32_t length() const { return 1 + tail_end - tail_begin; }
 };
 
 // The rules of one section, indexed by predecessor symbol.
@@ -74,9 +81,14 @@ struct Grammar {
   std::optional<double> angle;        // degrees
   std::optional<double> width_factor;
   uint64_t seed = 0;
+  std::vector<std::string> variables;      // global variables (assigned in Start/End blocks); slot i + 1
+                                           // (an array: its name, then "" for its other elements)
+  std::vector<double> initial_values;      // (variables + 1) their values before the Start block (arrays' initialisers)
+  Expr start_block, start_each_block, end_each_block, end_block;  // cpfg control blocks (manual 4.1)
   std::optional<Eigen::Vector3d> tropism;  // T of "tropism:"
   double tropism_elasticity = 0.0;         // e of "tropism:"
   std::array<bool, 256> context_skips{};   // symbols passed over when matching contexts
+  bool queries = false;                    // the axiom or a production writes ?P ?H ?U or ?L
   RuleSet productions;
   RuleSet decomposition;
   RuleSet homomorphism;
@@ -95,8 +107,10 @@ struct GrammarText {
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError
 // "name:line:column: message".
+// `functions` are the view file's, for func(id, x). A file's #include is read beside it.
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
-                      const std::optional<GrammarText>& axiom_text = std::nullopt);
+                      const std::optional<GrammarText>& axiom_text = std::nullopt,
+                      std::vector<std::vector<double>> functions = {});
 
 }  // namespace treeanim

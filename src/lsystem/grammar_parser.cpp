@@ -5,8 +5,10 @@
 #include <cmath>
 
 #include "common/errors.h"
+#include "common/read_text_file.h"
 #include "common/scene_reader.h"
 #include "lsystem/grammar.h"
+#include "lsystem/preprocess.h"
 
 namespace treeanim {
 
@@ -14,17 +16,26 @@ namespace {
 
 constexpr size_t kNone = std::string_view::npos;
 constexpr int kMaxSlots = 64;   // formal parameters of one rule (lc, pred, rc)
-constexpr int kMaxDepth = 64;   // "maximum depth:" bound (recursion of decomposition/homomorphism)
+constexpr int kMaxDepth = 100'000;  // "maximum depth:" bound (the expansion keeps its own stack)
+constexpr long long kMaxArrayElements = 1'000'000;  // elements of all cpfg arrays together
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
 enum class Section { kProductions, kDecomposition, kHomomorphism };
 
 // Directives that end with ':' and take a value, and section headers that take none.
+// Matched without regard to case (cpfg writes "Axiom:", "Lsystem:"...).
 const std::vector<std::string> kValueDirectives = {
     "axiom", "derivation length", "angle", "seed", "ignore", "consider",
-    "tropism", "maximum depth", "width factor", "lsystem"};
+    "tropism", "maximum depth", "width factor", "lsystem", "start", "starteach", "end", "endeach",
+    "define"};
 const std::vector<std::string> kSectionDirectives = {"homomorphism", "decomposition", "endlsystem"};
+
+bool same_letters(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
 
 std::string expected_directives() {
   std::string out;
@@ -33,12 +44,13 @@ std::string expected_directives() {
   return out + "#define";
 }
 
-// Index of the first `c` at parenthesis depth 0 in text[begin, end), or kNone.
+// Index of the first `c` at parenthesis (and brace: statement blocks of a rule's head) depth 0
+// in text[begin, end), or kNone.
 size_t find_top_level(std::string_view text, size_t begin, size_t end, char c) {
   int depth = 0;
   for (size_t k = begin; k < end; ++k) {
-    if (text[k] == '(') ++depth;
-    else if (text[k] == ')') --depth;
+    if (text[k] == '(' || text[k] == '{') ++depth;
+    else if (text[k] == ')' || text[k] == '}') --depth;
     else if (depth == 0 && text[k] == c) return k;
   }
   return kNone;
@@ -68,23 +80,25 @@ class Parser {
     g_.defines = overrides;
   }
 
-  // One grammar text, line by line.
+  // One grammar text: preprocessed (comments, #define, #include), then one statement at a
+  // time; a statement continues over lines while parentheses or a block's braces are open, and
+  // a rule's successor or the axiom continues on lines that start no other statement.
   void parse_text(const GrammarText& text) {
-    const int32_t source = add_source(text.name);
-    if (source == 0) first_pos_ = {source, text.single_line ? 0 : 1, 1};
-    std::string_view all(text.text);
-    int32_t line = 1;
-    size_t start = 0;
-    while (start <= all.size() && !ended_) {
-      size_t stop = all.find('\n', start);
-      if (stop == kNone) stop = all.size();
-      std::string_view content = all.substr(start, stop - start);
-      if (!content.empty() && content.back() == '\r') content.remove_suffix(1);
-      parse_line(content, {source, text.single_line ? 0 : line, 0});
-      if (stop == all.size()) break;
-      start = stop + 1;
-      ++line;
-    }
+    PreprocessHooks hooks;
+    hooks.add_source = [this](const std::string& name) { return add_source(name); };
+    hooks.include = [this](const std::string& path, const std::string& from, SourcePos at) {
+      return read_include(path, from, at);
+    };
+    hooks.define_number = [this](const std::string& name, const SourceLine& body, SourcePos at) {
+      return define_number(name, body, at);
+    };
+    hooks.is_number = [this](const std::string& name) {
+      return std::any_of(g_.defines.begin(), g_.defines.end(), [&](const auto& d) { return d.first == name; });
+    };
+    hooks.line = [this](const SourceLine& line) { feed(line); };
+    if (g_.sources.empty()) first_pos_ = {0, text.single_line ? 0 : 1, 1};
+    Preprocessor(hooks).run(text.name, text.text, text.single_line);
+    flush();
   }
 
   // An inline axiom (the whole text is the axiom's modules).
@@ -97,9 +111,6 @@ class Parser {
   void finish() {
     if (!axiom_seen_) throw GrammarError{first_pos_, "expected an 'axiom:' line; the grammar has none"};
     for (RuleSet* set : {&g_.productions, &g_.decomposition, &g_.homomorphism}) set->index();
-    check_arities(g_.axiom);
-    for (RuleSet* set : {&g_.productions, &g_.decomposition, &g_.homomorphism})
-      check_arities(set->successor);
   }
 
  private:
@@ -107,10 +118,8 @@ class Parser {
     g_.sources.push_back(name);
     return static_cast<int32_t>(g_.sources.size() - 1);
   }
-  static SourcePos at_column(SourcePos line, size_t index) {
-    return {line.source, line.line, static_cast<int32_t>(index) + 1};
-  }
-  [[noreturn]] static void fail(SourcePos line, size_t index, const std::string& message) {
+  static SourcePos at_column(const TextOrigin& line, size_t index) { return line.at(index); }
+  [[noreturn]] static void fail(const TextOrigin& line, size_t index, const std::string& message) {
     throw GrammarError{at_column(line, index), message};
   }
   RuleSet& current() {
@@ -122,34 +131,101 @@ class Parser {
     return g_.productions;
   }
 
-  void parse_line(std::string_view text, SourcePos line) {
-    size_t end = strip_comment(text, line);
+  // A file #included by `from`, found beside it.
+  std::pair<std::string, std::string> read_include(const std::string& path, const std::string& from, SourcePos at) {
+    const std::filesystem::path resolved = std::filesystem::path(from).parent_path() / path;
+    std::string text, reason;
+    if (!read_text_file(resolved, text, reason))
+      throw GrammarError{at, "cannot read the included file '" + resolved.string() + "' (" + reason + ")"};
+    return {resolved.string(), text};
+  }
+
+  // Nesting of parentheses everywhere and of braces before the arrow (blocks of a rule's head,
+  // Start: blocks): a statement with some open goes on to the next line.
+  static bool open_nesting(std::string_view text) {
+    int parens = 0, braces = 0;
+    const size_t arrow = find_arrow(text, 0, text.size());
+    for (size_t k = 0; k < text.size(); ++k) {
+      if (text[k] == '(') ++parens;
+      else if (text[k] == ')') --parens;
+      else if (k < arrow && text[k] == '{') ++braces;
+      else if (k < arrow && text[k] == '}') --braces;
+    }
+    return parens > 0 || braces > 0;
+  }
+
+  // Whether text starts with a directive keyword ("name:" or a section word).
+  static bool starts_directive(std::string_view text, size_t begin, size_t end) {
+    size_t value = 0;
+    for (const std::string& keyword : kSectionDirectives)
+      if (match_keyword(text, begin, end, keyword, false, &value)) return true;
+    const size_t colon = text.find(':', begin);
+    if (colon == kNone || colon >= end) return false;
+    const std::string_view word = text.substr(begin, colon - begin);
+    return word.size() >= 2 && std::all_of(word.begin(), word.end(), [](char c) {
+             return std::isalpha(static_cast<unsigned char>(c)) || c == ' ';
+           });
+  }
+
+  void feed(const SourceLine& line) {
+    if (ended_) return;
+    size_t begin = 0, end = line.text.size();
+    trim(line.text, &begin, &end);
+    if (begin == end) {  // a blank line ends a statement, unless it has open parentheses or blocks
+      if (!open_nesting(pending_.text)) flush();
+      return;
+    }
+    if (!pending_.text.empty() && continues(line.text, begin, end)) {
+      pending_.text += ' ';
+      pending_.columns.push_back(line.columns[begin]);
+      pending_.text += line.text;
+      pending_.columns.insert(pending_.columns.end(), line.columns.begin(), line.columns.end());
+      return;
+    }
+    flush();
+    pending_ = line;
+  }
+
+  bool continues(std::string_view text, size_t begin, size_t end) const {
+    const std::string_view last = pending_.text;
+    if (open_nesting(last)) return true;
+    if (text.substr(begin, 2) == "->" || text.substr(begin, 3) == "-->") return true;
+    size_t b = 0, e = last.size(), value = 0;
+    trim(last, &b, &e);
+    const bool rule = find_arrow(last, b, e) != kNone;
+    const bool axiom = match_keyword(last, b, e, "axiom", true, &value);
+    // A rule's head not yet at its arrow ("A(x) :" then a block on the next line) goes on.
+    if (!rule && !axiom) return !starts_directive(last, b, e) && looks_like_head(last, b, e);
+    if (find_arrow(text, begin, end) != kNone || starts_directive(text, begin, end)) return false;
+    // A rule's head written over lines starts with its own context or condition.
+    return !looks_like_head(text, begin, end);
+  }
+
+  // Whether text[begin, end) has a context ('<', '>') or a condition (':') outside parentheses
+  // and blocks: a rule's head, which no successor has.
+  static bool looks_like_head(std::string_view text, size_t begin, size_t end) {
+    return find_top_level(text, begin, end, ':') != kNone || find_top_level(text, begin, end, '<') != kNone ||
+           find_top_level(text, begin, end, '>') != kNone;
+  }
+
+  void flush() {
+    if (pending_.text.empty()) return;
+    const SourceLine statement = std::move(pending_);
+    pending_ = SourceLine{};
+    parse_line(statement.text, TextOrigin{statement.start, &statement.columns});
+  }
+
+  void parse_line(std::string_view text, const TextOrigin& line) {
+    size_t end = text.size();
     size_t begin = 0;
     trim(text, &begin, &end);
-    if (begin == end) return;
-    if (text.substr(begin, 7) == "#define" && (begin + 7 == end || is_space(text[begin + 7])))
-      return parse_define(text, begin + 7, end, line);
+    if (begin == end || ended_) return;
     if (parse_directive(text, begin, end, line)) return;
     const size_t arrow = find_arrow(text, begin, end);
     if (arrow != kNone) return parse_rule(text, begin, arrow, end, line);
+    if (same_letters(text.substr(begin, end - begin), "ring lsystem"))
+      fail(line, begin, "ring L-systems ('ring lsystem') are not supported (CPFG manual 3.1.1)");
     report_non_rule(text, begin, end, line);
-  }
-
-  // '#' starts a comment at the line's start or after a space; returns where the content ends.
-  static size_t strip_comment(std::string_view text, SourcePos line) {
-    for (size_t k = 0; k < text.size(); ++k) {
-      if (text[k] != '#' || (k > 0 && !is_space(text[k - 1]))) continue;
-      if (text.substr(k, 7) == "#define" && text.find_first_not_of(" \t") == k) continue;
-      for (const char* unsupported : {"#include", "#ifdef", "#ifndef", "#if", "#else", "#endif", "#undef"}) {
-        const std::string_view word(unsupported);
-        if (text.substr(k, word.size()) == word &&
-            (k + word.size() == text.size() || !std::isalpha(static_cast<unsigned char>(text[k + word.size()]))))
-          fail(line, k, "unsupported preprocessor directive '" + std::string(word) +
-                            "' (only #define is supported; '# ' starts a comment)");
-      }
-      return k;
-    }
-    return text.size();
   }
 
   // Start of "-->" or "->" (the first '>' right after a '-'), kNone when there is none.
@@ -160,7 +236,7 @@ class Parser {
   }
 
   // A line that is neither a directive nor a production: say which it looks like.
-  [[noreturn]] void report_non_rule(std::string_view text, size_t begin, size_t end, SourcePos line) {
+  [[noreturn]] void report_non_rule(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     const size_t colon = text.find(':', begin);
     if (colon != kNone && colon < end) {
       size_t word_end = colon;
@@ -184,7 +260,7 @@ class Parser {
   // "name:" or "name :" at text[begin]; on a match, *value is just after the colon.
   static bool match_keyword(std::string_view text, size_t begin, size_t end,
                             const std::string& keyword, bool colon, size_t* value) {
-    if (text.substr(begin, keyword.size()) != keyword) return false;
+    if (!same_letters(text.substr(begin, keyword.size()), keyword)) return false;
     size_t k = begin + keyword.size();
     if (k < end && (std::isalnum(static_cast<unsigned char>(text[k])) || text[k] == '_')) return false;
     if (!colon) {
@@ -197,14 +273,20 @@ class Parser {
     return true;
   }
 
-  bool parse_directive(std::string_view text, size_t begin, size_t end, SourcePos line) {
+  bool parse_directive(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     size_t value = 0;
     for (const std::string& keyword : kSectionDirectives) {
       if (!match_keyword(text, begin, end, keyword, false, &value)) continue;
       size_t rest = value;
+      while (rest < end && is_space(text[rest])) ++rest;
       if (rest < end && text[rest] == ':') ++rest;
       while (rest < end && is_space(text[rest])) ++rest;
-      if (rest < end) fail(line, rest, "expected nothing after '" + keyword + "'");
+      // cpfg's "homomorphism: warnings" / "no warnings" only choose messages (manual 4.3.1).
+      const std::string_view option = text.substr(rest, end - rest);
+      if (rest < end && keyword != "endlsystem" && (same_letters(option, "warnings") || same_letters(option, "no warnings")))
+        rest = end;
+      if (rest < end) fail(line, rest, "expected nothing after '" + keyword + "'" +
+                                           (keyword == "endlsystem" ? "" : " (or ': warnings', ': no warnings')"));
       if (keyword == "homomorphism") section_ = Section::kHomomorphism;
       else if (keyword == "decomposition") section_ = Section::kDecomposition;
       else ended_ = true;
@@ -212,16 +294,21 @@ class Parser {
     }
     for (const std::string& keyword : kValueDirectives) {
       if (!match_keyword(text, begin, end, keyword, true, &value)) continue;
+      // "AXIOM : c --> ..." is a rule whose predecessor spells a directive.
+      if (keyword == "axiom" && find_arrow(text, value, end) != kNone) return false;
       size_t vbegin = value, vend = end;
       trim(text, &vbegin, &vend);
       if (vbegin == vend && keyword != "ignore" && keyword != "consider")
         fail(line, value, "expected a value after '" + keyword + ":'");
-      if (keyword == "axiom") set_axiom(text, vbegin, vend, line, at_column(line, begin));
+      if (keyword == "start" || keyword == "starteach" || keyword == "end" || keyword == "endeach")
+        parse_control_block(text, vbegin, vend, line, keyword);
+      else if (keyword == "define") parse_arrays(text, vbegin, vend, line);
+      else if (keyword == "axiom") set_axiom(text, vbegin, vend, line, at_column(line, begin));
       else if (keyword == "derivation length") g_.derivation_length = integer_value(text, vbegin, vend, line, 0, 100000);
       else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
       else if (keyword == "width factor") g_.width_factor = constant_value(text, vbegin, vend, line);
       else if (keyword == "seed") g_.seed = static_cast<uint64_t>(integer_value(text, vbegin, vend, line, 0, 1LL << 53));
-      else if (keyword == "lsystem") integer_value(text, vbegin, vend, line, 0, 1LL << 31);
+      else if (keyword == "lsystem") lsystem_label(text, vbegin, vend, line);
       else if (keyword == "maximum depth") current().max_depth = static_cast<int>(integer_value(text, vbegin, vend, line, 1, kMaxDepth));
       else if (keyword == "tropism") parse_tropism(text, vbegin, vend, line);
       else parse_skips(text, vbegin, vend, line, keyword == "consider", begin);
@@ -231,7 +318,7 @@ class Parser {
   }
 
   // A constant expression filling text[begin, end).
-  double constant_value(std::string_view text, size_t begin, size_t end, SourcePos line) {
+  double constant_value(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     const ExprScope scope{nullptr, &g_.defines};
     size_t pos = begin;
     const Expr expr = compile_expression(g_.program, text.substr(0, end), &pos, line, scope);
@@ -242,7 +329,7 @@ class Parser {
     return value;
   }
 
-  long long integer_value(std::string_view text, size_t begin, size_t end, SourcePos line,
+  long long integer_value(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
                           long long lo, long long hi) {
     const double v = constant_value(text, begin, end, line);
     if (std::floor(v) != v || v < double(lo) || v > double(hi))
@@ -252,7 +339,7 @@ class Parser {
   }
 
   // "tropism: Tx Ty Tz e" (spaces or commas between the four values).
-  void parse_tropism(std::string_view text, size_t begin, size_t end, SourcePos line) {
+  void parse_tropism(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     double values[4];
     size_t k = begin;
     for (int i = 0; i < 4; ++i) {
@@ -272,7 +359,7 @@ class Parser {
   }
 
   // "ignore: symbols" or "consider: symbols".
-  void parse_skips(std::string_view text, size_t begin, size_t end, SourcePos line, bool consider,
+  void parse_skips(std::string_view text, size_t begin, size_t end, const TextOrigin& line, bool consider,
                    size_t directive) {
     if (skips_kind_ != 0 && skips_kind_ != (consider ? 2 : 1))
       fail(line, directive, "'ignore:' and 'consider:' cannot both be given");
@@ -281,42 +368,172 @@ class Parser {
     for (size_t k = begin; k < end; ++k) {
       const char c = text[k];
       if (is_space(c)) continue;
-      if (c == '[' || c == ']') fail(line, k, "brackets cannot be listed: context matching always follows them");
+      if ((c == '[' || c == ']') && consider) continue;  // cpfg lists them; matching always follows them
+      if (c == '[' || c == ']') fail(line, k, "brackets cannot be ignored: context matching always follows them");
       if (!std::isgraph(static_cast<unsigned char>(c))) fail(line, k, "expected module symbols (printable ASCII)");
       g_.context_skips[static_cast<unsigned char>(c)] = !consider;
     }
   }
 
-  void parse_define(std::string_view text, size_t begin, size_t end, SourcePos line) {
-    size_t k = begin;
-    while (k < end && is_space(text[k])) ++k;
-    const size_t name_begin = k;
-    if (k < end && (std::isalpha(static_cast<unsigned char>(text[k])) || text[k] == '_'))
-      while (k < end && (std::isalnum(static_cast<unsigned char>(text[k])) || text[k] == '_')) ++k;
-    if (k == name_begin) fail(line, name_begin, "expected a name after '#define'");
-    const std::string name(text.substr(name_begin, k - name_begin));
-    while (k < end && is_space(text[k])) ++k;
-    if (k == end) fail(line, k, "expected a value after '#define " + name + "'");
+  // "#define NAME body" (no arguments) => true when body is a constant expression: the grammar
+  // keeps NAME as a number, which the scene's lsystem.defines may replace. Otherwise (ran(), a
+  // module text, a name defined later) the preprocessor expands the body as text.
+  bool define_number(const std::string& name, const SourceLine& body, SourcePos at) {
     if (std::find(g_.file_defines.begin(), g_.file_defines.end(), name) != g_.file_defines.end())
-      fail(line, name_begin, "'" + name + "' is already defined");
+      throw GrammarError{at, "'" + name + "' is already defined"};
     g_.file_defines.push_back(name);
     for (const auto& entry : overrides_)
-      if (entry.first == name) return;  // the scene's value wins
-    const double value = constant_value(text, k, end, line);
-    g_.defines.emplace_back(name, value);
+      if (entry.first == name) return true;  // the scene's value wins
+    const ExprScope scope{nullptr, &g_.defines, nullptr};
+    const TextOrigin origin{body.start, &body.columns};
+    const size_t code_size = g_.program.code.size(), constants = g_.program.constants.size();
+    try {
+      size_t pos = 0;
+      const Expr expr = compile_expression(g_.program, body.text, &pos, origin, scope);
+      double value = 0;
+      if (pos == body.text.size() && g_.program.is_constant(expr, &value)) {
+        g_.defines.emplace_back(name, value);
+        return true;
+      }
+    } catch (const GrammarError& error) {
+      // A constant that cannot be computed (division by zero...) is an error where it is
+      // written; anything else is text.
+      if (error.message.find("division by zero") != std::string::npos || error.message.find("finite") != std::string::npos)
+        throw;
+    }
+    g_.program.code.resize(code_size);
+    g_.program.code_pos.resize(code_size);
+    g_.program.constants.resize(constants);
+    return false;
   }
 
-  void set_axiom(std::string_view text, size_t begin, size_t end, SourcePos line, SourcePos directive) {
+  // "define: { array name[d1][d2] = { values }; array other[d]; }" (CPFG manual 2.2.2):
+  // dimensions are constants ("[d1, d2]" also), values fill the elements in row-major order
+  // (the rest start at 0).
+  void parse_arrays(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
+    const std::string_view body = text.substr(0, end);
+    size_t k = begin;
+    auto skip = [&] { while (k < end && is_space(body[k])) ++k; };
+    auto expect = [&](char c, const std::string& what) {
+      skip();
+      if (k >= end || body[k] != c) fail(line, k, std::string("expected '") + c + "' " + what);
+      ++k;
+    };
+    expect('{', "after 'define:'");
+    for (;;) {
+      skip();
+      if (k < end && body[k] == '}') break;
+      size_t value = 0;
+      if (!match_keyword(body, k, end, "array", false, &value) || value >= end || !is_space(body[value]))
+        fail(line, k, "expected 'array name[dimensions];' or '}' in 'define:'");
+      k = value;
+      skip();
+      const size_t name_at = k;
+      while (k < end && (std::isalnum(static_cast<unsigned char>(body[k])) || body[k] == '_')) ++k;
+      const std::string name(body.substr(name_at, k - name_at));
+      if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])))
+        fail(line, name_at, "expected an array name after 'array'");
+      if (std::find(g_.variables.begin(), g_.variables.end(), name) != g_.variables.end() ||
+          std::any_of(g_.defines.begin(), g_.defines.end(), [&](const auto& d) { return d.first == name; }))
+        fail(line, name_at, "'" + name + "' is already a variable or a define");
+      ArrayDecl array{name, static_cast<uint32_t>(g_.variables.size() + 1), {}};
+      size_t elements = 1;
+      expect('[', "after the array's name");
+      for (;;) {
+        const size_t at = k;
+        const long long size = integer_value(body, k, dimension_end(body, k, end), line, 1, kMaxArrayElements);
+        k = dimension_end(body, k, end);
+        elements *= static_cast<size_t>(size);
+        if (g_.variables.size() + elements > kMaxArrayElements)
+          fail(line, at, "more than " + std::to_string(kMaxArrayElements) + " array elements in the grammar");
+        array.dims.push_back(static_cast<uint32_t>(size));
+        if (k < end && body[k] == ',') { ++k; continue; }
+        expect(']', "after a dimension");
+        skip();
+        if (k < end && body[k] == '[') { ++k; continue; }
+        break;
+      }
+      g_.variables.push_back(name);
+      g_.variables.resize(g_.variables.size() + elements - 1);
+      g_.initial_values.resize(g_.variables.size() + 1, 0.0);
+      skip();
+      if (k < end && body[k] == '=') {
+        ++k;
+        expect('{', "to open the values of '" + name + "'");
+        for (size_t n = 0;; ++n) {
+          skip();
+          const size_t at = k;
+          const size_t stop = value_end(body, k, end);
+          if (stop == end) fail(line, k, "expected '}' to close the values of '" + name + "'");
+          if (n == elements) fail(line, at, "more values than the " + std::to_string(elements) + " elements of '" + name + "'");
+          size_t vb = k, ve = stop;
+          trim(body, &vb, &ve);
+          g_.initial_values[array.base + n] = constant_value(body, vb, ve, line);
+          k = stop + 1;
+          if (body[stop] == '}') break;
+        }
+      }
+      g_.program.arrays.push_back(std::move(array));
+      expect(';', "after the array '" + name + "'");
+    }
+    ++k;
+    skip();
+    if (k < end && body[k] == ';') ++k;
+    skip();
+    if (k < end) fail(line, k, "expected the end of 'define:', got '" + std::string(1, body[k]) + "'");
+  }
+
+  // The end of a dimension starting at text[k]: the ',' or ']' after it (or end).
+  static size_t dimension_end(std::string_view text, size_t k, size_t end) {
+    return std::min({find_top_level(text, k, end, ','), find_top_level(text, k, end, ']'), end});
+  }
+
+  // The end of an initial value starting at text[k]: the ',' or '}' after it outside
+  // parentheses (or end).
+  static size_t value_end(std::string_view text, size_t k, size_t end) {
+    int depth = 0;
+    for (; k < end; ++k) {
+      if (text[k] == '(') ++depth;
+      else if (text[k] == ')') --depth;
+      else if (depth == 0 && (text[k] == ',' || text[k] == '}')) return k;
+    }
+    return end;
+  }
+
+  // "Lsystem: label": a number or a name (used by sub-L-systems, which are not supported).
+  void lsystem_label(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
+    for (size_t k = begin; k < end; ++k)
+      if (!std::isalnum(static_cast<unsigned char>(text[k])) && text[k] != '_')
+        fail(line, k, "expected a label (a number or a name) after 'lsystem:'");
+  }
+
+  // "Start: { statements }" (also StartEach, EndEach, End), an optional ';' after it.
+  void parse_control_block(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
+                           const std::string& keyword) {
+    if (text[begin] != '{') fail(line, begin, "expected '{' after '" + keyword + ":'");
+    const StatementScope scope{nullptr, &g_.variables, true, &g_.defines};
+    size_t pos = begin;
+    const Expr block = compile_block(g_.program, text.substr(0, end), &pos, line, scope);
+    while (pos < end && (is_space(text[pos]) || text[pos] == ';')) ++pos;
+    if (pos < end) fail(line, pos, "expected the end of the '" + keyword + ":' block, got '" + std::string(1, text[pos]) + "'");
+    if (keyword == "start") g_.start_block = block;
+    else if (keyword == "starteach") g_.start_each_block = block;
+    else if (keyword == "endeach") g_.end_each_block = block;
+    else g_.end_block = block;
+  }
+
+  void set_axiom(std::string_view text, size_t begin, size_t end, const TextOrigin& line, SourcePos directive) {
     if (axiom_seen_) throw GrammarError{directive, "a second 'axiom:'; the grammar has one already"};
     axiom_seen_ = true;
     const std::vector<std::string> no_formals;
-    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines}, &g_.axiom, &g_.axiom_params, "axiom");
+    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines, &g_.variables}, &g_.axiom, &g_.axiom_params,
+               "axiom");
     if (g_.axiom.empty()) fail(line, begin, "expected at least one module in the axiom");
   }
 
   // Modules with actual parameters in text[begin, end) => appended to modules/params.
   // Brackets must balance within the word.
-  void parse_word(std::string_view text, size_t begin, size_t end, SourcePos line, const ExprScope& scope,
+  void parse_word(std::string_view text, size_t begin, size_t end, const TextOrigin& line, const ExprScope& scope,
                   std::vector<SuccessorModule>* modules, std::vector<Expr>* params, const char* what) {
     std::vector<size_t> open;  // positions of unclosed '['
     const std::string_view word = text.substr(0, end);
@@ -324,6 +541,7 @@ class Parser {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
       check_symbol(text, k, line, what);
+      if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
       if (c == '[') open.push_back(k);
       if (c == ']') {
         if (open.empty()) fail(line, k, "unbalanced brackets: ']' closes no '[' in the " + std::string(what));
@@ -356,7 +574,18 @@ class Parser {
                                   std::string(what) + ")");
   }
 
-  static void check_symbol(std::string_view text, size_t k, SourcePos line, const char* what) {
+  // '?' at text[k]: true for a query module ?P ?H ?U ?L (CPFG manual 6.9); a lone '?' is a
+  // module like any other; sub-L-systems and ?E are refused.
+  static bool is_query(std::string_view text, size_t k, size_t end, const TextOrigin& line) {
+    const char next = k + 1 < end ? text[k + 1] : ' ';
+    if (next == '(')
+      fail(line, k, "sub-L-systems ('?(id, scale) ... $') are not supported (CPFG manual 7.2)");
+    if (next == 'E')
+      fail(line, k, "'?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
+    return next == 'P' || next == 'H' || next == 'U' || next == 'L';
+  }
+
+  static void check_symbol(std::string_view text, size_t k, const TextOrigin& line, const char* what) {
     const char c = text[k];
     if (c == '(' || c == ')') fail(line, k, std::string("expected a module symbol, got '") + c + "'");
     if (c == '*') {
@@ -371,7 +600,7 @@ class Parser {
   }
 
   // [lc <] pred [> rc] [: cond] --> succ [: prob]
-  void parse_rule(std::string_view text, size_t begin, size_t arrow, size_t end, SourcePos line) {
+  void parse_rule(std::string_view text, size_t begin, size_t arrow, size_t end, const TextOrigin& line) {
     RuleSet& set = current();
     const size_t arrow_end = text[arrow + 1] == '-' ? arrow + 3 : arrow + 2;
     Rule rule;
@@ -399,15 +628,15 @@ class Parser {
       parse_pattern(text, begin, lt, line, false, &set, &formals, "left context");
       rule.left_end = static_cast<uint32_t>(set.patterns.size());
     }
-    parse_predecessor(text, pred_begin, pred_end, line, &rule, &formals);
+    parse_predecessor(text, pred_begin, pred_end, line, &rule, &set, &formals);
     if (gt != kNone) {
       rule.right_begin = static_cast<uint32_t>(set.patterns.size());
       parse_pattern(text, gt + 1, head_end, line, true, &set, &formals, "right context");
       rule.right_end = static_cast<uint32_t>(set.patterns.size());
     }
+    if (cond != kNone) parse_statements(text, cond + 1, arrow, line, &formals, &rule);
     rule.slot_count = static_cast<uint16_t>(formals.size());
-    const ExprScope scope{&formals, &g_.defines};
-    if (cond != kNone) rule.condition = optional_expression(text, cond + 1, arrow, line, scope, "condition");
+    const ExprScope scope{&formals, &g_.defines, &g_.variables};
 
     size_t succ_end = end;
     const size_t prob = find_last_top_level(text, arrow_end, end, ':');
@@ -428,8 +657,32 @@ class Parser {
     set.rules.push_back(rule);
   }
 
+  // "[{before}] [condition] [{after}]" between the predecessor's ':' and the arrow (CPFG
+  // manual 3.2); names the blocks assign for the first time become locals in formals.
+  void parse_statements(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
+                        std::vector<std::string>* formals, Rule* rule) {
+    const StatementScope statements{formals, &g_.variables, false, &g_.defines};
+    const std::string_view head = text.substr(0, end);
+    auto skip = [&](size_t k) { while (k < end && is_space(text[k])) ++k; return k; };
+    size_t k = skip(begin);
+    if (k < end && text[k] == '{') {
+      rule->before = compile_block(g_.program, head, &k, line, statements);
+      k = skip(k);
+    }
+    size_t stop = k;
+    while (stop < end && text[stop] != '{') ++stop;  // the condition ends at the after-block
+    const ExprScope scope{formals, &g_.defines, &g_.variables};
+    if (stop > k || !rule->before.present()) rule->condition = optional_expression(text, k, stop, line, scope, "condition");
+    k = skip(stop);
+    if (k < end && text[k] == '{') {
+      rule->after = compile_block(g_.program, head, &k, line, statements);
+      k = skip(k);
+    }
+    if (k < end) fail(line, k, "expected the arrow after the condition and its blocks, got '" + std::string(1, text[k]) + "'");
+  }
+
   // An expression filling text[begin, end), or none when it is '*'.
-  Expr optional_expression(std::string_view text, size_t begin, size_t end, SourcePos line,
+  Expr optional_expression(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
                            const ExprScope& scope, const char* what) {
     trim(text, &begin, &end);
     if (begin == end) fail(line, begin, std::string("expected a ") + what + " after ':'");
@@ -441,34 +694,42 @@ class Parser {
     return expr;
   }
 
-  void parse_predecessor(std::string_view text, size_t begin, size_t end, SourcePos line, Rule* rule,
-                         std::vector<std::string>* formals) {
+  // The strict predecessor: its first module, then any more (CPFG manual 3.1) as patterns.
+  void parse_predecessor(std::string_view text, size_t begin, size_t end, const TextOrigin& line, Rule* rule,
+                         RuleSet* set, std::vector<std::string>* formals) {
     trim(text, &begin, &end);
     if (begin == end) fail(line, begin, "expected a predecessor module before the arrow");
     check_symbol(text, begin, line, "predecessor");
-    if (text[begin] == '[' || text[begin] == ']') fail(line, begin, "a bracket cannot be a predecessor");
+    if (text[begin] == '[' || text[begin] == ']') fail(line, begin, "a bracket cannot be in a predecessor");
     rule->predecessor = text[begin];
     rule->predecessor_slot = static_cast<uint16_t>(formals->size());
     size_t k = begin + 1;
     rule->arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
-    while (k < end && is_space(text[k])) ++k;
-    if (k < end)
-      fail(line, k, "expected one module as predecessor (write a context with '<' or '>'), got '" +
-                        std::string(text.substr(begin, end - begin)) + "'");
+    rule->tail_begin = static_cast<uint32_t>(set->patterns.size());
+    parse_modules(text, k, end, line, false, set, formals, "predecessor");
+    rule->tail_end = static_cast<uint32_t>(set->patterns.size());
   }
 
   // Context modules with formal parameters in text[begin, end); '*' alone = no context.
-  void parse_pattern(std::string_view text, size_t begin, size_t end, SourcePos line, bool brackets,
+  void parse_pattern(std::string_view text, size_t begin, size_t end, const TextOrigin& line, bool brackets,
                      RuleSet* set, std::vector<std::string>* formals, const char* what) {
     trim(text, &begin, &end);
     if (begin == end) fail(line, begin, std::string("expected a ") + what + " (or '*' for none)");
     if (end == begin + 1 && text[begin] == '*') return;
+    parse_modules(text, begin, end, line, brackets, set, formals, what);
+  }
+
+  // Modules with formal parameters in text[begin, end) => appended to set->patterns.
+  void parse_modules(std::string_view text, size_t begin, size_t end, const TextOrigin& line, bool brackets,
+                     RuleSet* set, std::vector<std::string>* formals, const char* what) {
     for (size_t k = begin; k < end;) {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
       check_symbol(text, k, line, what);
+      if (c == '?') is_query(text, k, end, line);
       if (!brackets && (c == '[' || c == ']'))
-        fail(line, k, "brackets are not supported in a left context (it already skips branches)");
+        fail(line, k, std::string("a bracket cannot be in a ") + what +
+                          (std::string_view(what) == "left context" ? " (it already skips branches)" : ""));
       PatternModule module{c, 0, static_cast<uint16_t>(formals->size())};
       ++k;
       module.arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
@@ -478,7 +739,7 @@ class Parser {
   }
 
   // "(a, b)" at text[*k] => names appended to formals; returns their count.
-  int parse_formals(std::string_view text, size_t* k, size_t end, SourcePos line, std::vector<std::string>* formals) {
+  int parse_formals(std::string_view text, size_t* k, size_t end, const TextOrigin& line, std::vector<std::string>* formals) {
     if (*k >= end || text[*k] != '(') return 0;
     int count = 0;
     for (;;) {
@@ -502,28 +763,6 @@ class Parser {
     }
   }
 
-  // A module written with an arity that no rule for its symbol takes would never be rewritten
-  // (ABOP matches symbol and parameter count): almost always a typo, so it is an error.
-  void check_arities(const std::vector<SuccessorModule>& modules) const {
-    for (const SuccessorModule& m : modules) {
-      const Rule* example = nullptr;
-      bool matched = false;
-      for (const RuleSet* set : {&g_.productions, &g_.decomposition, &g_.homomorphism}) {
-        const auto s = static_cast<unsigned char>(m.symbol);
-        for (uint32_t i = set->first_rule[s]; i < set->first_rule[s + 1]; ++i) {
-          const Rule& r = set->rules[set->rule_order[i]];
-          example = &r;
-          if (r.arity == m.arity) matched = true;
-        }
-      }
-      if (example && !matched)
-        throw GrammarError{m.pos, std::string("wrong number of arguments: '") + m.symbol + "' has " +
-                                      std::to_string(m.arity) + " here, but its rule at " +
-                                      std::to_string(example->pos.line) + ":" + std::to_string(example->pos.column) +
-                                      " expects " + std::to_string(example->arity)};
-    }
-  }
-
   Grammar& g_;
   const std::vector<std::pair<std::string, double>>& overrides_;
   Section section_ = Section::kProductions;
@@ -531,6 +770,7 @@ class Parser {
   bool axiom_seen_ = false;
   bool ended_ = false;  // after "endlsystem"
   SourcePos first_pos_;  // the first text's start, for errors about what is missing
+  SourceLine pending_;   // the statement being joined from lines
 };
 
 }  // namespace
@@ -554,8 +794,10 @@ std::string Grammar::where(const SourcePos& pos) const {
 
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
-                      const std::optional<GrammarText>& axiom_text) {
+                      const std::optional<GrammarText>& axiom_text,
+                      std::vector<std::vector<double>> functions) {
   Grammar grammar;
+  grammar.program.functions = std::move(functions);
   Parser parser(grammar, define_overrides);
   try {
     if (axiom_text) parser.parse_inline_axiom(*axiom_text);

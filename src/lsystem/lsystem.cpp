@@ -30,10 +30,14 @@ void check_overrides(const LsystemOptions& options, const Grammar& grammar) {
 
 }  // namespace
 
-Grammar load_grammar(const LsystemOptions& options) {
+ViewSettings load_view(const LsystemOptions& options) {
+  return options.view ? read_view_file(*options.view) : ViewSettings{};
+}
+
+Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   if (options.grammar) {
     const std::vector<GrammarText> texts{{options.grammar->string(), read_file(*options.grammar), false}};
-    Grammar grammar = parse_grammar(texts, options.defines);
+    Grammar grammar = parse_grammar(texts, options.defines, std::nullopt, view.functions);
     check_overrides(options, grammar);
     return grammar;
   }
@@ -56,29 +60,35 @@ DerivationSettings derivation_settings(const LsystemOptions& options, const Gram
   return settings;
 }
 
-TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar) {
+TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar, const ViewSettings& view) {
   TurtleSettings turtle;
   turtle.step = options.step;
-  turtle.angle_degrees = options.angle.value_or(grammar.angle.value_or(turtle.angle_degrees));
+  turtle.angle_degrees = options.angle.value_or(view.angle.value_or(grammar.angle.value_or(turtle.angle_degrees)));
   turtle.width_factor = options.width_factor.value_or(grammar.width_factor.value_or(turtle.width_factor));
+  turtle.initial_width = view.initial_width.value_or(turtle.initial_width);
+  if (options.view) turtle.width_increment = view.width_increment.value_or(1.0);
   if (grammar.tropism) {
     turtle.tropism = *grammar.tropism;
     turtle.tropism_elasticity = grammar.tropism_elasticity;
   }
+  if (view.tropism) turtle.tropism = *view.tropism;
+  if (view.tropism_elasticity) turtle.tropism_elasticity = *view.tropism_elasticity;
   if (options.tropism) turtle.tropism = *options.tropism;
   if (options.tropism_elasticity) turtle.tropism_elasticity = *options.tropism_elasticity;
   return turtle;
 }
 
 Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
-  const Grammar grammar = load_grammar(options);
+  const ViewSettings view = load_view(options);
+  const Grammar grammar = load_grammar(options, view);
   const DerivationSettings settings = derivation_settings(options, grammar);
-  const ModuleString word = derive(grammar, settings);
+  const TurtleSettings turtle = turtle_settings(options, grammar, view);
+  const ModuleString word = derive(grammar, settings, turtle);
   if (stats) {
     stats->modules = word.size();
     stats->iterations = settings.iterations;
   }
-  return interpret(apply_homomorphism(grammar, word, settings), turtle_settings(options, grammar));
+  return interpret(apply_homomorphism(grammar, word, settings), turtle);
 }
 
 }  // namespace treeanim

@@ -7,6 +7,7 @@
 #include "lsystem/lsystem_options.h"
 #include "lsystem/skeleton.h"
 #include "lsystem/turtle.h"
+#include "lsystem/view_file.h"
 
 namespace treeanim {
 
@@ -17,14 +18,18 @@ struct GrowthStats {
 
 // options => grammar read from the file or the inline rules, scene defines applied.
 // Throws InputError (file:line:column, or a JSON pointer for a define the file lacks).
-Grammar load_grammar(const LsystemOptions& options);
+Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view = {});
+
+// options => the view file's settings (none without lsystem.view). Throws InputError.
+ViewSettings load_view(const LsystemOptions& options);
 
 // options + grammar => derivation settings: the scene's iterations override "derivation
 // length:", the scene seed is mixed with the grammar's "seed:".
 DerivationSettings derivation_settings(const LsystemOptions& options, const Grammar& grammar);
 
-// options + grammar => turtle settings (scene values override the grammar's directives).
-TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar);
+// options + grammar + view => turtle settings (scene values override the view file's, which
+// override the grammar's directives).
+TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar, const ViewSettings& view = {});
 
 // options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).
 // Throws InputError with file:line:column for grammar errors, and at the module cap.

@@ -57,6 +57,8 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
   if (options.grammar && !options.productions.empty())
     section.fail("productions", "inline productions go with /lsystem/axiom, not with a grammar file (/lsystem/grammar)");
   if (axiom) options.axiom = *axiom;
+  options.view = section.optional_path("view");
+  if (options.view && !options.grammar) section.fail("view", "a view file goes with a grammar file (/lsystem/grammar)");
   options.defines = read_defines(section);
   if (auto n = section.optional_integer("iterations", 0, 10000)) options.iterations = static_cast<int>(*n);
   options.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));

@@ -13,6 +13,7 @@ namespace treeanim {
 
 struct LsystemOptions {
   std::optional<std::filesystem::path> grammar;  // grammar file, resolved against the scene folder
+  std::optional<std::filesystem::path> view;     // cpfg view file (.v), with a grammar file
   std::string axiom;                             // inline grammar (when no file)
   std::vector<std::string> productions;          // inline productions, one rule per string
   std::vector<std::pair<std::string, double>> defines;  // override #define values

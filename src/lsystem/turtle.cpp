@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -43,6 +44,7 @@ struct State {
   int32_t material = 0;
   int32_t segment = -1;   // last segment drawn on this path: the parent of the next one
   bool branched = false;  // a '[' was opened since `segment` was drawn
+  bool cylinder = false;  // inside a generalised cylinder (@Gs ... @Ge): 'f' draws too
 };
 
 // A '{' not yet closed: the turtle state at the '{' (the leaf's base and frame) and where its
@@ -138,8 +140,10 @@ size_t end_of_branch(const std::vector<char>& symbols, size_t cut) {
 
 class Turtle {
  public:
-  Turtle(const ModuleString& word, const TurtleSettings& settings)
+  // answers: word's parameters, written by the query modules (null: only drawing).
+  Turtle(const ModuleString& word, const TurtleSettings& settings, double* answers = nullptr)
       : word_(word),
+        answers_(answers),
         settings_(settings),
         default_turn_{std::cos(settings.angle_degrees * kDegToRad),
                       std::sin(settings.angle_degrees * kDegToRad)},
@@ -178,13 +182,21 @@ class Turtle {
             stack_.pop_back();
           }
           break;
-        case '!': s_.width = has_param(i) ? first_param(i) : s_.width * settings_.width_factor; break;
-        case '\'': s_.material = has_param(i) ? material_index(first_param(i)) : s_.material + 1; break;
+        case '!':
+          if (has_param(i)) s_.width = first_param(i);
+          else if (settings_.width_increment) s_.width = std::max(s_.width - *settings_.width_increment, 0.0);
+          else s_.width *= settings_.width_factor;
+          break;
+        case '#': s_.width = has_param(i) ? first_param(i) : s_.width + settings_.width_increment.value_or(1.0); break;
+        case '\'':
+        case ';': s_.material = has_param(i) ? material_index(first_param(i)) : s_.material + 1; break;
         case ',':
           s_.material = has_param(i) ? material_index(first_param(i)) : std::max(s_.material - 1, 0);
           break;
-        case 'L':
-        case '~': add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {}); break;
+        case 'L': add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {}); break;
+        case '~': i = surface(i); break;
+        case '@': i = at_command(i); break;
+        case '?': i = query(i); break;
         case '{': polygons_.push_back({s_, points_.size()}); break;
         case '.':
           if (!polygons_.empty()) points_.push_back(s_.position);
@@ -201,6 +213,80 @@ class Turtle {
   bool has_param(size_t i) const { return word_.param_offsets[i] != word_.param_offsets[i + 1]; }
   double first_param(size_t i) const { return word_.params[word_.param_offsets[i]]; }
 
+  // '~' at i: a leaf of the default shape. cpfg writes a predefined surface as '~' and its id
+  // letter ("~l(s)", two modules here): the letter's parameter is then the scale. => the last
+  // module used.
+  size_t surface(size_t i) {
+    const size_t n = word_.size();
+    if (!has_param(i) && i + 1 < n && std::isalpha(static_cast<unsigned char>(word_.symbols[i + 1]))) {
+      add_leaf(s_, has_param(i + 1) ? first_param(i + 1) : 1.0, {});
+      return i + 1;
+    }
+    add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {});
+    return i;
+  }
+
+  // '?' and its letter (cpfg's query modules, CPFG manual 6.9): ?P ?H ?U ?L take the turtle's
+  // position, heading, up and left vectors (x, y[, z]) when answering; they draw nothing.
+  // => the last module used.
+  size_t query(size_t i) {
+    if (i + 1 >= word_.size()) return i;
+    const Vector3d* v = nullptr;
+    switch (word_.symbols[i + 1]) {
+      case 'P': v = &s_.position; break;
+      case 'H': v = &s_.heading; break;
+      case 'U': v = &s_.up; break;
+      case 'L': v = &s_.left; break;
+      default: return i;
+    }
+    if (answers_) {
+      const uint32_t b = word_.param_offsets[i + 1], e = word_.param_offsets[i + 2];
+      for (uint32_t k = b; k < e && k - b < 3; ++k) answers_[k] = (*v)[static_cast<Eigen::Index>(k - b)];
+    }
+    return i + 1;
+  }
+
+  // '@' and the letter after it (cpfg's two-character modules, CPFG manual 6): @v rolls L
+  // horizontal, @M(x,y,z) moves to a point, @R(hx,hy,hz[,ux,uy,uz]) sets the heading, @O(r) (a
+  // sphere) becomes a leaf of scale r, @Gs ... @Ge (a generalised cylinder) makes 'f' draw;
+  // circles (@o @c), textures (@T*), @Gc and the rest draw nothing. => the last module used.
+  size_t at_command(size_t i) {
+    if (i + 1 >= word_.size()) return i;
+    const size_t c = i + 1;
+    const std::span<const double> p = word_.params_of(c);
+    switch (word_.symbols[c]) {
+      case 'v': roll_to_horizontal(s_); break;
+      case 'G':  // @Gs starts a generalised cylinder, @Ge ends it (read from the next module)
+        if (c + 1 < word_.size() && (word_.symbols[c + 1] == 's' || word_.symbols[c + 1] == 'e')) {
+          s_.cylinder = word_.symbols[c + 1] == 's';
+          return c + 1;
+        }
+        break;
+      case 'O':  // a sphere: a leaf of the default shape scaled by its radius
+        add_leaf(s_, p.empty() ? 1.0 : p[0], {});
+        break;
+      case 'M':
+        if (p.size() >= 3) s_.position = Vector3d(p[0], p[1], p[2]);
+        break;
+      case 'R':
+        if (p.size() >= 3 && Vector3d(p[0], p[1], p[2]).norm() > 0) set_heading(Vector3d(p[0], p[1], p[2]), p);
+        break;
+      default: break;
+    }
+    return c;
+  }
+
+  // @R: heading h, and up from p[3..5] when given (else the nearest frame to the old one).
+  void set_heading(const Vector3d& h, std::span<const double> p) {
+    s_.heading = h.normalized();
+    const Vector3d up = p.size() >= 6 ? Vector3d(p[3], p[4], p[5]) : s_.up;
+    Vector3d left = up.cross(s_.heading);
+    if (left.norm() < kVerticalTolerance) left = s_.left - s_.left.dot(s_.heading) * s_.heading;
+    if (left.norm() < kVerticalTolerance) return;
+    s_.left = left.normalized();
+    s_.up = s_.heading.cross(s_.left);
+  }
+
   // module i, sign => cos/sin of its turn angle (its parameter, else the default δ).
   SinCos turn(size_t i, double sign) {
     const SinCos r = has_param(i) ? angles_.get(first_param(i)) : default_turn_;
@@ -214,7 +300,7 @@ class Turtle {
     if (!polygons_.empty()) {
       s_.position += length * s_.heading;
       if (records) points_.push_back(s_.position);
-    } else if (draws) {
+    } else if (draws || s_.cylinder) {
       draw_segment(static_cast<uint32_t>(i), length);
     } else {
       s_.position += length * s_.heading;
@@ -273,8 +359,9 @@ class Turtle {
     const std::vector<char>& symbols = word_.symbols;
     const auto count = [&](char c) { return static_cast<size_t>(std::count(symbols.begin(), symbols.end(), c)); };
     const size_t segments = count('F') + count('G');
-    const size_t leaves = count('L') + count('~') + count('{');
-    if (std::find(symbols.begin(), symbols.end(), '!') != symbols.end()) s_.width = settings_.initial_width;
+    const size_t leaves = count('L') + count('~') + count('{') + count('@');
+    if (std::find_if(symbols.begin(), symbols.end(), [](char c) { return c == '!' || c == '#'; }) != symbols.end())
+      s_.width = settings_.initial_width;
     Skeleton& k = out_;
     k.segment_start.reserve(segments);
     k.segment_end.reserve(segments);
@@ -296,6 +383,7 @@ class Turtle {
   }
 
   const ModuleString& word_;
+  double* const answers_;  // word_'s parameters, when answering queries
   const TurtleSettings& settings_;
   const SinCos default_turn_;  // cos, sin of settings.angle_degrees
   const bool bends_;           // tropism on
@@ -311,6 +399,10 @@ class Turtle {
 
 Skeleton interpret(const ModuleString& word, const TurtleSettings& settings) {
   return Turtle(word, settings).run();
+}
+
+void answer_queries(ModuleString* word, const TurtleSettings& settings) {
+  Turtle(*word, settings, word->params.data()).run();
 }
 
 }  // namespace treeanim

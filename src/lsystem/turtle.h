@@ -1,6 +1,7 @@
 #pragma once
 // The 3D turtle (lpfg conventions, DESIGN.md): module string => Skeleton.
 #include <Eigen/Core>
+#include <optional>
 
 #include "lsystem/module_string.h"
 #include "lsystem/skeleton.h"
@@ -11,7 +12,8 @@ struct TurtleSettings {
   double step = 1.0;                          // length of F/G/f/g without a parameter
   double angle_degrees = 90.0;                // δ of + - & ^ \ / without a parameter
   double width_factor = 0.707;                // '!' without a parameter multiplies the width by this
-  double initial_width = 1.0;                 // diameter before the first '!(w)' when the word uses '!' at all
+  double initial_width = 1.0;                 // diameter before the first '!(w)' when the word uses '!' or '#' at all
+  std::optional<double> width_increment;      // cpfg view file: '#' adds it, '!' without a parameter subtracts it
   Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
   double tropism_elasticity = 0.0;            // e; 0 = no tropism
 };
@@ -21,5 +23,9 @@ struct TurtleSettings {
 // symbols the turtle does not know are structural and ignored. Accepts any word: a ']'
 // without its '[' and an unclosed '{' are ignored (the grammar checks brackets).
 Skeleton interpret(const ModuleString& word, const TurtleSettings& settings);
+
+// The turtle interprets word and its query modules (CPFG manual 6.9) take the values they ask
+// for: ?P(x, y[, z]) the position, ?H the heading, ?U the up and ?L the left vector.
+void answer_queries(ModuleString* word, const TurtleSettings& settings);
 
 }  // namespace treeanim

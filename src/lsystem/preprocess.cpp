@@ -1,0 +1,294 @@
+// cpp subset for cpfg grammars (docs/grammar.md "Preprocessor"): comments, #define, #include,
+// #ifdef. Macro expansion is depth-limited (kMaxExpansion) and never re-expands a macro inside
+// its own expansion, so no input makes it loop or recurse without bound.
+#include "lsystem/preprocess.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace treeanim {
+
+namespace {
+
+constexpr int kMaxExpansion = 32;  // nested macro expansions
+constexpr int kMaxIncludes = 16;   // nested #include
+constexpr size_t kMaxLineLength = 1 << 20;  // one line after expansion
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+bool starts_name(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool in_name(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+[[noreturn]] void fail(SourcePos at, const std::string& message) { throw GrammarError{at, message}; }
+
+// text => the same text with comments blanked (newlines kept, so lines and columns stay).
+std::string strip_comments(const std::string& text, int32_t source, bool single_line) {
+  std::string out = text;
+  int32_t line = 1, column = 1;
+  for (size_t k = 0; k < out.size(); ++k, ++column) {
+    if (out[k] == '\n') {
+      ++line;
+      column = 0;
+      continue;
+    }
+    if (out[k] != '/' || k + 1 >= out.size()) continue;
+    // "//" is a comment at a line's start or after a space, unless more '/' follow: runs of '/'
+    // are roll modules (ABOP's "/////").
+    const bool line_comment = out[k + 1] == '/' && (k == 0 || is_space(out[k - 1]) || out[k - 1] == '\n') &&
+                              (k + 2 >= out.size() || out[k + 2] != '/');
+    if (line_comment) {
+      while (k < out.size() && out[k] != '\n') out[k++] = ' ';
+      --k;
+      --column;
+    } else if (out[k + 1] == '*') {
+      const SourcePos open{source, single_line ? 0 : line, column};
+      const size_t close = out.find("*/", k + 2);
+      if (close == std::string::npos) fail(open, "'/*' comment is never closed (expected '*/')");
+      for (size_t j = k; j < close + 2; ++j) {
+        if (out[j] == '\n') {
+          ++line;
+          column = 0;
+        } else {
+          out[j] = ' ';
+          ++column;
+        }
+      }
+      k = close + 1;
+      --column;
+    }
+  }
+  return out;
+}
+
+SourceLine make_line(std::string_view text, SourcePos start) {
+  SourceLine line;
+  line.text = std::string(text);
+  line.start = start;
+  line.columns.reserve(text.size());
+  for (size_t k = 0; k < text.size(); ++k) line.columns.push_back({start.source, start.line, start.column + static_cast<int32_t>(k)});
+  return line;
+}
+
+SourceLine slice(const SourceLine& line, size_t begin, size_t end) {
+  SourceLine out;
+  out.text = line.text.substr(begin, end - begin);
+  out.columns.assign(line.columns.begin() + static_cast<std::ptrdiff_t>(begin), line.columns.begin() + static_cast<std::ptrdiff_t>(end));
+  out.start = begin < line.columns.size() ? line.columns[begin] : line.start;
+  return out;
+}
+
+void append(SourceLine& to, std::string_view text, SourcePos at) {
+  to.text += text;
+  to.columns.insert(to.columns.end(), text.size(), at);
+}
+
+size_t skip_spaces(const std::string& text, size_t k) {
+  while (k < text.size() && is_space(text[k])) ++k;
+  return k;
+}
+
+}  // namespace
+
+void Preprocessor::run(const std::string& name, const std::string& text, bool single_line) {
+  const int32_t source = hooks_.add_source(name);
+  current_ = name;
+  const std::string clean = strip_comments(text, source, single_line);
+  const size_t open_conditions = conditions_.size();
+  int32_t number = 1;
+  for (size_t start = 0; start <= clean.size();) {
+    size_t stop = clean.find('\n', start);
+    if (stop == std::string::npos) stop = clean.size();
+    SourceLine line = make_line(std::string_view(clean).substr(start, stop - start), {source, single_line ? 0 : number, 1});
+    const size_t hash = skip_spaces(line.text, 0);
+    // A line continues on the next one after a trailing backslash, as in cpp; cpfg files also
+    // end continued lines with two backslashes, read as one continuation.
+    while (!line.text.empty() && line.text.back() == '\\' && stop < clean.size()) {
+      for (size_t b = line.text.size(); b > 0 && line.text[b - 1] == '\\'; --b) line.text[b - 1] = ' ';
+      start = stop + 1;
+      stop = clean.find('\n', start);
+      if (stop == std::string::npos) stop = clean.size();
+      ++number;
+      const SourceLine more = make_line(std::string_view(clean).substr(start, stop - start), {source, number, 1});
+      line.text += more.text;
+      line.columns.insert(line.columns.end(), more.columns.begin(), more.columns.end());
+    }
+    const bool active = std::all_of(conditions_.begin(), conditions_.end(), [](auto c) { return c.first; });
+    if (hash < line.text.size() && line.text[hash] == '#' && (hash + 1 >= line.text.size() || !std::ispunct(static_cast<unsigned char>(line.text[hash + 1])))) {
+      size_t word = skip_spaces(line.text, hash + 1), end = word;
+      while (end < line.text.size() && in_name(line.text[end])) ++end;
+      const std::string directive_name = line.text.substr(word, end - word);
+      const bool conditional = directive_name == "ifdef" || directive_name == "ifndef" || directive_name == "else" ||
+                               directive_name == "endif" || directive_name == "if" || directive_name == "elif";
+      if (conditional || active) {
+        if (directive_name.empty() || (word > hash + 1 && !conditional && directive_name != "define" && directive_name != "include"))
+          ;  // '#' alone or '# text': a comment line (cpp's null directive)
+        else
+          directive(directive_name, line, hash);
+      }
+    } else if (active) {
+      hooks_.line(expand(line, 0));
+    }
+    if (stop == clean.size()) break;
+    start = stop + 1;
+    ++number;
+  }
+  if (conditions_.size() != open_conditions)
+    fail({source, single_line ? 0 : number, 1}, "#ifdef or #ifndef is never closed (expected #endif)");
+}
+
+void Preprocessor::directive(const std::string& name, const SourceLine& line, size_t hash) {
+  const SourcePos at = line.columns[hash];
+  size_t k = skip_spaces(line.text, line.text.find(name, hash + 1) + name.size());
+  if (name == "define") return define(line, k);
+  if (name == "ifdef" || name == "ifndef") {
+    size_t end = k;
+    while (end < line.text.size() && in_name(line.text[end])) ++end;
+    if (end == k) fail(line.columns[std::min(k, line.columns.size() - 1)], "expected a name after '#" + name + "'");
+    const std::string macro = line.text.substr(k, end - k);
+    const bool defined = find(macro) != nullptr || hooks_.is_number(macro);
+    conditions_.push_back({defined == (name == "ifdef"), false});
+    return;
+  }
+  if (name == "else" || name == "endif") {
+    if (conditions_.empty()) fail(at, "'#" + name + "' without #ifdef or #ifndef");
+    if (name == "endif") return conditions_.pop_back();
+    if (conditions_.back().second) fail(at, "a second '#else' for one #ifdef");
+    conditions_.back() = {!conditions_.back().first, true};
+    return;
+  }
+  if (name == "include") {
+    const size_t open = k;
+    const char close = open < line.text.size() && line.text[open] == '<' ? '>' : '"';
+    const size_t end = open < line.text.size() ? line.text.find(close, open + 1) : std::string::npos;
+    if (open >= line.text.size() || (line.text[open] != '"' && line.text[open] != '<') || end == std::string::npos)
+      fail(at, "expected a file name in quotes after '#include'");
+    if (++include_depth_ > kMaxIncludes) fail(at, "#include nested more than 16 deep");
+    const auto [file, text] = hooks_.include(line.text.substr(open + 1, end - open - 1), current_, at);
+    const std::string outer = current_;
+    run(file, text, false);
+    current_ = outer;
+    --include_depth_;
+    return;
+  }
+  fail(at, "unsupported preprocessor directive '#" + name + "' (supported: #define, #include, #ifdef, #ifndef, #else, #endif; '# ' starts a comment)");
+}
+
+void Preprocessor::define(const SourceLine& line, size_t k) {
+  const SourcePos after = k < line.columns.size() ? line.columns[k] : SourcePos{line.start.source, line.start.line, static_cast<int32_t>(line.text.size()) + 1};
+  size_t end = k;
+  if (k < line.text.size() && starts_name(line.text[k]))
+    while (end < line.text.size() && in_name(line.text[end])) ++end;
+  if (end == k) fail(after, "expected a name after '#define'");
+  Macro macro;
+  macro.name = line.text.substr(k, end - k);
+  k = end;
+  if (k < line.text.size() && line.text[k] == '(') {
+    macro.function_like = true;
+    for (;;) {
+      k = skip_spaces(line.text, k + 1);
+      size_t stop = k;
+      while (stop < line.text.size() && in_name(line.text[stop])) ++stop;
+      if (stop > k) macro.parameters.push_back(line.text.substr(k, stop - k));
+      k = skip_spaces(line.text, stop);
+      if (k < line.text.size() && line.text[k] == ')') break;
+      if (k >= line.text.size() || line.text[k] != ',')
+        fail(line.columns[std::min(k, line.columns.size() - 1)], "expected ',' or ')' in the parameters of macro '" + macro.name + "'");
+    }
+    ++k;
+  }
+  k = skip_spaces(line.text, k);
+  size_t body_end = line.text.size();
+  while (body_end > k && is_space(line.text[body_end - 1])) --body_end;
+  if (k == body_end)
+    fail({after.source, after.line, line.columns.empty() ? 1 : line.columns.back().column + 1},
+         "expected a value after '#define " + macro.name + "'");
+  for (const Macro& m : macros_)
+    if (m.name == macro.name) fail(after, "'" + macro.name + "' is already defined");
+  macro.body = expand(slice(line, k, body_end), 0);
+  if (!macro.function_like && hooks_.define_number(macro.name, macro.body, after)) return;
+  macros_.push_back(std::move(macro));
+}
+
+const Preprocessor::Macro* Preprocessor::find(const std::string& name) const {
+  for (const Macro& m : macros_)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+SourceLine Preprocessor::expand(const SourceLine& line, int depth) const {
+  if (macros_.empty()) return line;
+  if (depth > kMaxExpansion) fail(line.start, "macros expand more than 32 levels deep");
+  SourceLine out;
+  out.start = line.start;
+  const std::string& t = line.text;
+  for (size_t k = 0; k < t.size();) {
+    if (!starts_name(t[k]) || (k > 0 && in_name(t[k - 1]))) {
+      out.text += t[k];
+      out.columns.push_back(line.columns[k]);
+      ++k;
+      continue;
+    }
+    size_t end = k;
+    while (end < t.size() && in_name(t[end])) ++end;
+    const Macro* macro = find(t.substr(k, end - k));
+    const SourcePos at = line.columns[k];
+    size_t open = skip_spaces(t, end);
+    if (!macro || (macro->function_like && (open >= t.size() || t[open] != '('))) {
+      append(out, std::string_view(t).substr(k, end - k), at);
+      k = end;
+      continue;
+    }
+    SourceLine body = macro->body;
+    if (macro->function_like) {
+      // Arguments: split at commas outside parentheses.
+      std::vector<std::string> args;
+      int nesting = 0;
+      size_t arg_begin = open + 1, j = open + 1;
+      for (; j < t.size(); ++j) {
+        if (t[j] == '(') ++nesting;
+        else if (t[j] == ')' && nesting-- == 0) break;
+        else if (t[j] == ',' && nesting == 0) {
+          args.push_back(t.substr(arg_begin, j - arg_begin));
+          arg_begin = j + 1;
+        }
+      }
+      if (j >= t.size()) fail(at, "expected ')' to close the arguments of macro '" + macro->name + "'");
+      if (j > arg_begin || !args.empty() || !macro->parameters.empty()) args.push_back(t.substr(arg_begin, j - arg_begin));
+      if (args.size() != macro->parameters.size())
+        fail(at, "macro '" + macro->name + "' expects " + std::to_string(macro->parameters.size()) + " arguments, got " +
+                     std::to_string(args.size()));
+      SourceLine substituted;
+      const std::string& b = macro->body.text;
+      for (size_t q = 0; q < b.size();) {
+        if (starts_name(b[q]) && (q == 0 || !in_name(b[q - 1]))) {
+          size_t e = q;
+          while (e < b.size() && in_name(b[e])) ++e;
+          const auto p = std::find(macro->parameters.begin(), macro->parameters.end(), b.substr(q, e - q));
+          if (p != macro->parameters.end()) {
+            append(substituted, args[static_cast<size_t>(p - macro->parameters.begin())], at);
+            q = e;
+            continue;
+          }
+          append(substituted, b.substr(q, e - q), at);
+          q = e;
+          continue;
+        }
+        append(substituted, std::string_view(b).substr(q, 1), at);
+        ++q;
+      }
+      body = substituted;
+      end = j + 1;
+    }
+    std::fill(body.columns.begin(), body.columns.end(), at);
+    // The expansion is expanded again without this macro (cpp's rule against self-reference).
+    Preprocessor inner(*this);
+    inner.macros_.erase(inner.macros_.begin() + (macro - macros_.data()));
+    const SourceLine expanded = inner.expand(body, depth + 1);
+    out.text += expanded.text;
+    out.columns.insert(out.columns.end(), expanded.columns.size(), at);
+    if (out.text.size() > kMaxLineLength) fail(at, "a line grows past 1 MiB when its macros are expanded");
+    k = end;
+  }
+  return out;
+}
+
+}  // namespace treeanim

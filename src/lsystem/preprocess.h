@@ -1,0 +1,62 @@
+#pragma once
+// The part of the C preprocessor that cpfg grammar files rely on (a cpfg .l file is passed
+// through cpp, CPFG manual ch. 2): comments, #define (numbers, text, macros with arguments),
+// #include of a file beside the including one, #ifdef / #ifndef / #else / #endif.
+// text => logical lines whose characters keep their origin (file, line, column).
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lsystem/expression.h"
+
+namespace treeanim {
+
+// One line after preprocessing; a macro's expansion takes the place of its use.
+struct SourceLine {
+  std::string text;
+  std::vector<SourcePos> columns;  // (text size) origin of each character
+  SourcePos start;                 // the line's first column (for an empty line)
+};
+
+struct PreprocessHooks {
+  // file name => source index for SourcePos.
+  std::function<int32_t(const std::string& name)> add_source;
+  // path as written, the including file's name => (name, text) of the included file.
+  std::function<std::pair<std::string, std::string>(const std::string& path, const std::string& from,
+                                                    SourcePos at)> include;
+  // "#define NAME body" with no arguments => true when the grammar keeps it as a number
+  // (overridable by the scene); otherwise the body is expanded as text where NAME is used.
+  std::function<bool(const std::string& name, const SourceLine& body, SourcePos at)> define_number;
+  // name => whether the grammar holds it as a number (for #ifdef).
+  std::function<bool(const std::string& name)> is_number;
+  // Every logical line, in order.
+  std::function<void(const SourceLine& line)> line;
+};
+
+// Reads one text (a file or an inline line). Throws GrammarError.
+class Preprocessor {
+ public:
+  explicit Preprocessor(PreprocessHooks hooks) : hooks_(std::move(hooks)) {}
+  void run(const std::string& name, const std::string& text, bool single_line);
+
+ private:
+  struct Macro {
+    std::string name;
+    std::vector<std::string> parameters;
+    bool function_like = false;
+    SourceLine body;
+  };
+  void directive(const std::string& name, const SourceLine& line, size_t hash);
+  void define(const SourceLine& line, size_t begin);
+  SourceLine expand(const SourceLine& line, int depth) const;
+  const Macro* find(const std::string& name) const;
+
+  PreprocessHooks hooks_;
+  std::vector<Macro> macros_;
+  std::vector<std::pair<bool, bool>> conditions_;  // (#if branch taken, inside #else) per open #if
+  int include_depth_ = 0;
+  std::string current_;  // name of the text being read (includes are found beside it)
+};
+
+}  // namespace treeanim

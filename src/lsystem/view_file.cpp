@@ -1,0 +1,178 @@
+// cpfg view files and funcedit functions (CPFG manual 8.1, 8.1.6).
+#include "lsystem/view_file.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+#include "common/errors.h"
+#include "common/read_text_file.h"
+
+namespace treeanim {
+
+namespace {
+
+constexpr int kSamples = 1024;  // x samples of a function (cpfg samples its own at "samples:")
+
+std::vector<std::string> read_lines(const std::filesystem::path& path, const std::string& what) {
+  std::string text, reason;
+  if (!read_text_file(path, text, reason))
+    throw InputError(path.string() + ": cannot read the " + what + " (" + reason + ")");
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+[[noreturn]] void fail(const std::string& name, size_t line, const std::string& message) {
+  throw InputError(name + ":" + std::to_string(line + 1) + ":1: " + message);
+}
+
+// "key: rest" with the key in lower case; false when the line has no ':'.
+bool split_key(const std::string& line, std::string* key, std::string* rest) {
+  const size_t colon = line.find(':');
+  if (colon == std::string::npos) return false;
+  *key = line.substr(0, colon);
+  std::transform(key->begin(), key->end(), key->begin(), [](unsigned char c) { return std::tolower(c); });
+  while (!key->empty() && std::isspace(static_cast<unsigned char>(key->back()))) key->pop_back();
+  while (!key->empty() && std::isspace(static_cast<unsigned char>(key->front()))) key->erase(key->begin());
+  *rest = line.substr(colon + 1);
+  return true;
+}
+
+// Numbers of `text`, separated by spaces or commas.
+std::vector<double> numbers(const std::string& text) {
+  std::string spaced = text;
+  std::replace(spaced.begin(), spaced.end(), ',', ' ');
+  std::istringstream in(spaced);
+  std::vector<double> out;
+  for (double v; in >> v;) out.push_back(v);
+  return out;
+}
+
+double number(const std::string& name, size_t line, const std::string& text, const char* key) {
+  const std::vector<double> v = numbers(text);
+  if (v.empty() || !std::isfinite(v[0])) fail(name, line, std::string("expected a number after '") + key + ":'");
+  return v[0];
+}
+
+// Clamped uniform cubic B-spline through control points, sampled densely, then y read at
+// equally spaced x (the curve's x is taken as increasing, as funcedit keeps it).
+std::vector<double> sample_spline(const std::vector<Eigen::Vector2d>& control) {
+  const int n = static_cast<int>(control.size());
+  const int degree = std::min(3, n - 1);
+  std::vector<double> knots;
+  for (int i = 0; i <= degree; ++i) knots.push_back(0.0);
+  for (int i = 1; i < n - degree; ++i) knots.push_back(static_cast<double>(i) / (n - degree));
+  for (int i = 0; i <= degree; ++i) knots.push_back(1.0);
+  std::vector<Eigen::Vector2d> curve;
+  constexpr int kCurve = 4096;
+  for (int s = 0; s <= kCurve; ++s) {
+    const double u = std::min(static_cast<double>(s) / kCurve, 1.0 - 1e-12);
+    int span = degree;
+    while (span < n - 1 && knots[static_cast<size_t>(span + 1)] <= u) ++span;
+    std::vector<Eigen::Vector2d> d(control.begin() + (span - degree), control.begin() + span + 1);
+    for (int r = 1; r <= degree; ++r)  // de Boor
+      for (int j = degree; j >= r; --j) {
+        const int i = span - degree + j;
+        const double denom = knots[static_cast<size_t>(i + degree - r + 1)] - knots[static_cast<size_t>(i)];
+        const double a = denom > 0 ? (u - knots[static_cast<size_t>(i)]) / denom : 0.0;
+        d[static_cast<size_t>(j)] = (1 - a) * d[static_cast<size_t>(j - 1)] + a * d[static_cast<size_t>(j)];
+      }
+    curve.push_back(d[static_cast<size_t>(degree)]);
+  }
+  std::vector<double> out(kSamples);
+  size_t k = 0;
+  for (int s = 0; s < kSamples; ++s) {
+    const double x = static_cast<double>(s) / (kSamples - 1);
+    while (k + 2 < curve.size() && curve[k + 1].x() < x) ++k;
+    const Eigen::Vector2d& a = curve[k];
+    const Eigen::Vector2d& b = curve[k + 1];
+    const double t = b.x() > a.x() ? std::clamp((x - a.x()) / (b.x() - a.x()), 0.0, 1.0) : 0.0;
+    out[static_cast<size_t>(s)] = a.y() + t * (b.y() - a.y());
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<double> parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos) {
+  size_t k = *pos;
+  while (k < lines.size() && lines[k].find_first_not_of(" \t") == std::string::npos) ++k;
+  if (k >= lines.size() || (lines[k].rfind("fver", 0) != 0 && lines[k].rfind("range:", 0) != 0))
+    fail(name, k, "expected a funcedit function starting with 'fver 1 1' (or 'range:' in the older format)");
+  if (lines[k].rfind("fver", 0) == 0) ++k;
+  std::string key, rest;
+  for (; k < lines.size(); ++k) {
+    if (!split_key(lines[k], &key, &rest)) fail(name, k, "expected 'points: n' in the function");
+    if (key == "points") break;
+  }
+  if (k >= lines.size()) fail(name, k, "expected 'points: n' in the function");
+  const double count = number(name, k, rest, "points");
+  if (count < 2 || count > 10000 || count != std::floor(count)) fail(name, k, "expected 2 ... 10000 points");
+  std::vector<Eigen::Vector2d> control;
+  for (int i = 0; i < static_cast<int>(count); ++i) {
+    ++k;
+    const std::vector<double> xy = k < lines.size() ? numbers(lines[k]) : std::vector<double>{};
+    if (xy.size() < 2 || !std::isfinite(xy[0]) || !std::isfinite(xy[1])) fail(name, k, "expected a point 'x y'");
+    control.emplace_back(xy[0], xy[1]);
+  }
+  *pos = k + 1;
+  return sample_spline(control);
+}
+
+ViewSettings read_view_file(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const std::vector<std::string> lines = read_lines(path, "view file");
+  ViewSettings view;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::string key, rest;
+    if (!split_key(lines[i], &key, &rest)) continue;
+    if (key == "angle increment") view.angle = number(name, i, rest, "angle increment");
+    else if (key == "angle factor") {
+      const double n = number(name, i, rest, "angle factor");
+      if (n == 0) fail(name, i, "expected a non-zero 'angle factor:'");
+      view.angle = 360.0 / n;
+    } else if (key == "initial line width") {
+      if (rest.find('p') == std::string::npos) view.initial_width = number(name, i, rest, key.c_str());
+    } else if (key == "line width increment") view.width_increment = number(name, i, rest, key.c_str());
+    else if (key == "tropism") {
+      const size_t t = rest.find("T:"), e = rest.find("E:");
+      if (t != std::string::npos) {
+        const std::vector<double> v = numbers(rest.substr(t + 2, e == std::string::npos ? std::string::npos : e - t - 2));
+        if (v.size() != 3 || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0) fail(name, i, "expected 'T: x,y,z' (non-zero) after 'tropism:'");
+        view.tropism = Eigen::Vector3d(v[0], v[1], v[2]);
+      }
+      if (e != std::string::npos) view.tropism_elasticity = number(name, i, rest.substr(e + 2), "E");
+    } else if (key == "surface") {
+      std::istringstream in(rest);
+      std::string id;
+      in >> id;
+      if (id.size() != 1) fail(name, i, "expected a one-letter surface id after 'surface:'");
+      view.surfaces.push_back(id[0]);
+    } else if (key == "function" || key == "function set") {
+      std::istringstream in(rest);
+      std::string file;
+      in >> file;
+      const std::filesystem::path target = path.parent_path() / file;
+      const std::vector<std::string> flines = read_lines(target, "function file");
+      size_t pos = 0;
+      size_t items = 1;
+      if (key == "function set") {
+        std::string k2, r2;
+        if (flines.size() < 2 || !split_key(flines[1], &k2, &r2) || k2 != "items")
+          fail(target.string(), 1, "expected 'items: n' after 'funcgalleryver'");
+        items = static_cast<size_t>(std::max(0.0, number(target.string(), 1, r2, "items")));
+        pos = 2;
+      }
+      for (size_t f = 0; f < items; ++f) view.functions.push_back(parse_function(target.string(), flines, &pos));
+    }
+  }
+  return view;
+}
+
+}  // namespace treeanim
