@@ -38,12 +38,10 @@ inline bool parse_arguments(int argc, char** argv, const char* usage, long long&
   return true;
 }
 
-// Scene => its grown and validated tree model.
+// Scene => its grown tree model (build_tree_model validates it).
 inline TreeModel scene_model(const Scene& scene) {
   GrowthStats growth;
-  TreeModel model = build_tree_model(grow_skeleton(scene.lsystem, &growth), scene.tree);
-  validate_tree_model(model);
-  return model;
+  return build_tree_model(grow_skeleton(scene.lsystem, &growth), scene.tree);
 }
 
 }  // namespace treeanim::bench

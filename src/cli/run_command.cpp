@@ -16,10 +16,6 @@ namespace treeanim {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 // Solver state (double) => the float frame the sinks write.
 FrameData make_frame(const SimState& state, long long frame, bool with_velocities) {
   FrameData data;

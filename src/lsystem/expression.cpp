@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <numbers>
 
-#include "common/scene_reader.h"
+#include "common/did_you_mean.h"
 
 namespace treeanim {
 

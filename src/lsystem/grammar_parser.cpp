@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "common/errors.h"
-#include "common/scene_reader.h"
+#include "common/did_you_mean.h"
 #include "lsystem/grammar.h"
 
 namespace treeanim {
