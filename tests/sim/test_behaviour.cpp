@@ -7,37 +7,16 @@
 #include <cstdio>
 #include <cstring>
 
-#include "lsystem/lsystem.h"
 #include "sim/simulator.h"
 #include "sim/stiffness.h"
+#include "grown_tree.h"
 #include "sim_test_models.h"
-#include "tree/build_tree_model.h"
 
 namespace treeanim {
 namespace {
 
-// The Table-1 monopodial grammar grown `iterations` seasons with `leaves` per node.
-TreeModel grown_tree(int iterations, int leaves, int segments_per_cluster) {
-  LsystemOptions lsystem;
-  lsystem.grammar = std::filesystem::path(TREEANIM_SOURCE_DIR) / "grammars/table1-monopodial.lsys";
-  lsystem.iterations = iterations;
-  lsystem.tropism_elasticity = 0.01;
-  lsystem.defines = {{"K", 4}, {"NP", leaves}, {"LT", 1}};
-  GrowthStats stats;
-  const Skeleton skeleton = grow_skeleton(lsystem, &stats);
-  TreeOptions tree;
-  tree.trunk_radius = 0.1;
-  tree.cluster.segments_per_cluster = segments_per_cluster;
-  TreeModel model = build_tree_model(skeleton, tree);
-  return model;
-}
-
-WindOptions gust_then_calm(double speed, double blow_until, double calm_from) {
-  WindOptions wind;
-  wind.keys = {{0, speed, {1, 0, 0.2}, speed * 0.3}, {blow_until, speed, {1, 0, 0.2}, speed * 0.3},
-               {calm_from, 0, {1, 0, 0.2}, 0}};
-  return wind;
-}
+using testing::grown_tree;
+using testing::gust_then_calm;
 
 double max_displacement(const SimState& state, const TreeModel& model) {
   return (state.positions - model.rest_positions).colwise().norm().maxCoeff();
