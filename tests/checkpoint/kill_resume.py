@@ -103,6 +103,12 @@ def main():
         if done.returncode != 0:
             raise Failed("reference bake: exit %d: %s" % (done.returncode, done.stderr))
 
+        # The job's first launch passes --resume too: nothing to resume, it bakes from the start.
+        fresh = os.path.join(work, "fresh")
+        done = run(treeanim, fresh, "--resume", "--frames", "0:5")
+        if done.returncode != 0 or "no usable checkpoint" not in done.stderr:
+            raise Failed("--resume without checkpoints: exit %d: %s" % (done.returncode, done.stderr))
+
         first_kill = kill_after_checkpoint(treeanim, out, 100, "--threads", "2")
         second_kill = kill_after_checkpoint(treeanim, out, 200, "--threads", "1", "--resume")
         done = run(treeanim, out, "--checkpoint-every", str(EVERY), "--resume")
