@@ -43,12 +43,21 @@ int main(int argc, char** argv) {
   run_app->add_option("--set", run.overrides,
                       "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
                       "JSON or a plain string; repeatable");
+  run_app->add_option("--checkpoint-every", run.checkpoint_every,
+                      "Write the complete simulation state every N frames (docs/checkpoint.md)")
+      ->check(CLI::Range(1LL, 1'000'000'000LL));
+  run_app->add_option("--checkpoint-dir", run.checkpoint_dir,
+                      "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)");
+  run_app->add_flag("--resume", run.resume,
+                    "Continue from the newest usable checkpoint and complete every output; without "
+                    "one, bake from the start");
   CLI::Option* quiet_flag = run_app->add_flag("-q,--quiet", quiet, "No progress or summary");
   run_app->add_flag("-v,--verbose", verbose, "Stage timings and details")->excludes(quiet_flag);
   run_app->footer(
       "Examples:\n"
       "  treeanim run configs/demo.json\n"
       "  treeanim run configs/demo.json -o out/ --frames 0:47 --threads 2\n"
+      "  treeanim run configs/demo.json -o out/ --checkpoint-every 24 --resume\n"
       "  treeanim run scene.json --set lsystem.iterations=6 --set time.substeps=8 --quiet");
 
   std::filesystem::path validate_scene;

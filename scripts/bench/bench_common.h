@@ -7,16 +7,14 @@
 #include <functional>
 #include <string>
 
+#include "cli/progress.h"
 #include "lsystem/lsystem.h"
 #include "scene/scene.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim::bench {
 
-// start => wall seconds since.
-inline double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using treeanim::seconds_since;  // cli/progress.h
 
 // argv = NAME SCENE [options], `usage` its options => false (after a message) when the scene
 // is missing or an option is unknown. "--frames N" sets `frames`; `option(arg, i)` takes
@@ -38,12 +36,10 @@ inline bool parse_arguments(int argc, char** argv, const char* usage, long long&
   return true;
 }
 
-// Scene => its grown and validated tree model.
+// Scene => its grown tree model (build_tree_model validates it).
 inline TreeModel scene_model(const Scene& scene) {
   GrowthStats growth;
-  TreeModel model = build_tree_model(grow_skeleton(scene.lsystem, &growth), scene.tree);
-  validate_tree_model(model);
-  return model;
+  return build_tree_model(grow_skeleton(scene.lsystem, &growth), scene.tree);
 }
 
 }  // namespace treeanim::bench

@@ -16,10 +16,14 @@ struct RunRequest {
   std::optional<std::string> frames;          // "START:END", inclusive, frames to write
   int threads = 0;                            // 0 = OpenMP default
   std::vector<std::string> overrides;         // --set PATH=VALUE
+  long long checkpoint_every = 0;             // frames between checkpoints; 0 = none
+  std::filesystem::path checkpoint_dir;       // "" = out_dir/checkpoints
+  bool resume = false;                        // start from the newest usable checkpoint
   Verbosity verbosity = Verbosity::kNormal;
 };
 
-// Bakes the scene: simulate and write every output. Returns 0, or 130/143 on a signal.
+// Bakes the scene: simulate and write every output, with checkpoints and resume
+// (docs/checkpoint.md). Returns 0, or 130/143 on a signal.
 int run_command(const RunRequest& request);
 // Loads, derives and builds the model without simulating; prints counts.
 int validate_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides);

@@ -3,15 +3,12 @@
 #include <chrono>
 #include <limits>
 
+#include "cli/progress.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Json to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
@@ -24,7 +21,6 @@ PreparedTree prepare_tree(const Scene& scene) {
   tree.grow_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
   tree.model = build_tree_model(tree.skeleton, scene.tree);
-  validate_tree_model(tree.model);
   tree.model_seconds = seconds_since(start);
   return tree;
 }

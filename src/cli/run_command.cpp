@@ -3,7 +3,9 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 
+#include "cli/bake_start.h"
 #include "cli/commands.h"
 #include "cli/prepare_tree.h"
 #include "cli/signals.h"
@@ -15,10 +17,6 @@
 namespace treeanim {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Solver state (double) => the float frame the sinks write.
 FrameData make_frame(const SimState& state, long long frame, bool with_velocities) {
@@ -60,12 +58,14 @@ int run_command(const RunRequest& request) {
   install_interrupt_handlers();
   const auto wall_start = std::chrono::steady_clock::now();
   const bool verbose = request.verbosity == Verbosity::kVerbose;
+  std::FILE* log = request.verbosity == Verbosity::kQuiet ? nullptr : stderr;
 
   const Scene scene = load_scene(request.scene, request.overrides);
   const long long first = scene.time.start;
   const long long last = first + scene.time.frames - 1;
-  // --frames only chooses what is written: the simulation always starts at time.start, so
-  // frame k of a split bake is bit-identical to frame k of the whole bake.
+  // --frames only chooses what is written: the simulation starts at time.start (or at a
+  // checkpoint of this bake), so frame k of a split bake is bit-identical to frame k of the
+  // whole bake.
   const auto [write_first, write_last] =
       request.frames ? parse_frame_range(*request.frames, first, last) : std::pair{first, last};
   if (request.threads > 0) omp_set_num_threads(request.threads);
@@ -88,22 +88,63 @@ int run_command(const RunRequest& request) {
 
   const double frame_dt = 1.0 / scene.time.fps;
   Simulator simulator(tree.model, scene.hsm, scene.wind, frame_dt, scene.time.substeps);
-  SimState state = simulator.initial_state(static_cast<double>(first) * frame_dt);
+  BakePlan plan;
+  plan.first = first;
+  plan.write_first = write_first;
+  plan.write_last = write_last;
+  plan.frame_dt = frame_dt;
+  plan.resume = request.resume;
+  plan.use_checkpoints = request.resume || request.frames.has_value();
+  plan.checkpoint_dir = !request.checkpoint_dir.empty() ? request.checkpoint_dir
+                        : request.out_dir.empty()       ? std::filesystem::path("checkpoints")
+                                                        : request.out_dir / "checkpoints";
+  plan.key = {scene_hash(info.scene_json, info.generator), info.generator, scene.hsm.precision == Precision::kFloat};
+  plan.journal = {plan.key.scene_hash, write_first, tree.model.vertex_count(), tree.model.leaf_count(),
+                  outputs.wants_velocities()};
+  BakeStart start = find_bake_start(plan, simulator, log);
+  SimState& state = start.state;
+  if (!start.checkpoint.empty() && log)
+    std::fprintf(log, "treeanim: resuming at frame %lld from %s\n", start.frame, start.checkpoint.c_str());
+  std::optional<FrameJournal> journal;  // this bake's, when it writes checkpoints
+  if (request.checkpoint_every > 0) {
+    remove_foreign_checkpoints(plan, start.frame, state, log);
+    if (start.journal) {
+      journal = std::move(start.journal);
+      journal->truncate(start.frame - write_first);  // the frames before the checkpoint's
+    } else {
+      journal = FrameJournal::create(journal_path(plan.checkpoint_dir, write_first), plan.journal);
+    }
+  }
   outputs.begin();
+  // The frames written before the checkpoint are not in it: the journal gives them back.
+  for (long long k = write_first; k < start.frame && k <= write_last; ++k) {
+    FrameJournal& source = journal ? *journal : *start.journal;
+    outputs.push(source.read(k - write_first));
+  }
 
-  Progress progress(write_last - first + 1, request.verbosity, stderr);
+  Progress progress(write_last - start.frame + 1, request.verbosity, stderr);
   const auto sim_start = std::chrono::steady_clock::now();
-  for (long long frame = first; frame <= write_last; ++frame) {
-    if (frame > first) simulator.advance_frame(state, frame);
+  for (long long frame = start.frame; frame <= write_last; ++frame) {
+    if (frame > start.frame) simulator.advance_frame(state, frame);
     if (const int signal_number = pending_signal()) {
       outputs.abort();
       progress.finish();
-      std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept\n",
-                   signal_number == SIGINT ? "SIGINT" : "SIGTERM", frame);
+      std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept%s\n",
+                   signal_number == SIGINT ? "SIGINT" : "SIGTERM", frame,
+                   journal ? " (--resume continues from the last checkpoint)" : "");
       return signal_number == SIGINT ? kExitSigint : kExitSigterm;
     }
-    if (frame >= write_first) outputs.push(make_frame(state, frame, outputs.wants_velocities()));
-    progress.update(frame - first + 1);
+    if (frame >= write_first) {
+      FrameData data = make_frame(state, frame, outputs.wants_velocities());
+      if (journal) journal->append(data);
+      outputs.push(std::move(data));
+    }
+    // The journal reaches the disk before the checkpoint that names its frames as written.
+    if (journal && frame > start.frame && (frame - first) % request.checkpoint_every == 0) {
+      journal->sync();
+      write_checkpoint(checkpoint_path(plan.checkpoint_dir, frame), state, frame, plan.key);
+    }
+    progress.update(frame - start.frame + 1);
   }
   outputs.finish();
   progress.finish();
@@ -112,7 +153,7 @@ int run_command(const RunRequest& request) {
     std::printf("baked %lld frames: %zu vertices, %zu clusters, %lld substeps in %.2f s "
                 "(simulation + writing %.2f s)\n",
                 write_last - write_first + 1, tree.model.vertex_count(),
-                tree.model.cluster_count(), (write_last - first) * scene.time.substeps,
+                tree.model.cluster_count(), (write_last - start.frame) * scene.time.substeps,
                 seconds_since(wall_start), seconds_since(sim_start));
     for (const auto& path : outputs.final_paths()) std::printf("  wrote %s\n", path.string().c_str());
     for (const auto& [path, line] : outputs.reports()) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());

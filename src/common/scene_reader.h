@@ -113,9 +113,5 @@ class SceneReader {
 std::string describe_json(const Json& value);
 // JSON-pointer escaping of one reference token ("~" => "~0", "/" => "~1").
 std::string escape_pointer_token(const std::string& token);
-// Levenshtein edit distance, for did-you-mean suggestions.
-size_t edit_distance(const std::string& a, const std::string& b);
-// The closest candidate to `word`, or "" when none is close enough to suggest.
-std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
 
 }  // namespace treeanim

@@ -6,12 +6,12 @@
 
 #include <array>
 #include <cmath>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/hdf5_support.h"
 #include "io/obj_format.h"
 #include "io/staged_files.h"
 
@@ -20,67 +20,6 @@ namespace treeanim {
 namespace fs = std::filesystem;
 
 namespace {
-
-// The Debian HDF5 library is not built thread-safe; sinks run on their own threads, so every
-// HDF5 call of every HDF5 sink holds this lock.
-std::mutex hdf5_mutex;
-
-// Takes the lock and turns HDF5's own error printing off (failures become OutputError).
-std::unique_lock<std::mutex> hdf5_lock() {
-  std::unique_lock lock(hdf5_mutex);
-  // HDF5 1.10.8's exit handler crashes (SIGSEGV in H5F__close_cb) closing a file whose
-  // H5Fclose failed, e.g. after EFBIG or ENOSPC. Sinks never leave a file open otherwise, so
-  // the handler has nothing to do; it must be declined before the library's first call.
-  static const bool no_exit_handler = H5dont_atexit() >= 0;
-  (void)no_exit_handler;
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  return lock;
-}
-
-// The innermost message of HDF5's error stack; of a failed system call only its errno text
-// ("... error message = 'File too large', buf = ..." => "File too large").
-std::string hdf5_error_text() {
-  std::string text;
-  auto walk = [](unsigned, const H5E_error2_t* error, void* data) -> herr_t {
-    auto* out = static_cast<std::string*>(data);
-    if (out->empty() && error->desc) *out = error->desc;
-    return 0;
-  };
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk, &text);
-  H5Eclear2(H5E_DEFAULT);
-  const std::string marker = "error message = '";
-  const size_t start = text.find(marker);
-  if (start != std::string::npos) {
-    const size_t end = text.find('\'', start + marker.size());
-    text = text.substr(start + marker.size(), end == std::string::npos ? std::string::npos : end - start - marker.size());
-  }
-  return text;
-}
-
-// Owns one HDF5 identifier and closes it with the matching H5?close.
-class Handle {
- public:
-  Handle() = default;
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  Handle(Handle&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
-  Handle& operator=(Handle&& other) noexcept {
-    std::swap(id_, other.id_);
-    std::swap(close_, other.close_);
-    return *this;
-  }
-  ~Handle() { reset(); }
-  hid_t get() const { return id_; }
-  // Closes now; returns false when HDF5 reports a failure (a flush that did not reach disk).
-  bool reset() {
-    const bool ok = id_ < 0 || close_(id_) >= 0;
-    id_ = -1;
-    return ok;
-  }
-
- private:
-  hid_t id_ = -1;
-  herr_t (*close_)(hid_t) = nullptr;
-};
 
 class Hdf5Sink final : public FrameSink {
  public:

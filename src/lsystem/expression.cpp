@@ -9,7 +9,7 @@
 #include <iterator>
 #include <numbers>
 
-#include "common/scene_reader.h"
+#include "common/did_you_mean.h"
 
 namespace treeanim {
 

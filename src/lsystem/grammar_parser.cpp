@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "common/errors.h"
+#include "common/did_you_mean.h"
 #include "common/read_text_file.h"
-#include "common/scene_reader.h"
 #include "lsystem/grammar.h"
 #include "lsystem/preprocess.h"
 

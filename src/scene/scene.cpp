@@ -3,6 +3,7 @@
 #include "common/errors.h"
 #include "common/json_text.h"
 #include "common/read_text_file.h"
+#include "scene/sim_sections.h"
 
 namespace treeanim {
 
@@ -96,7 +97,7 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   scene.seed = static_cast<uint64_t>(root.integer("seed", 1, 0, (1LL << 53)));
   scene.lsystem = read_lsystem_options(root.object("lsystem"), scene.seed);
   scene.tree = read_tree_options(root.object("tree"));
-  scene.hsm = read_sim_options(root.object("hsm"));
+  scene.hsm = read_hsm_options(root.object("hsm"));
   scene.wind = read_wind_options(root.object("wind"), scene.seed);
   scene.time = read_time_options(root.object("time"));
   for (SceneObject element : root.array_of_objects("outputs"))

@@ -28,7 +28,7 @@ struct Scene {
   uint64_t seed = 1;           // /seed, the default of every per-purpose seed
   LsystemOptions lsystem;
   TreeOptions tree;
-  SimOptions hsm;
+  HsmOptions hsm;
   WindOptions wind;
   TimeOptions time;
   std::vector<OutputOptions> outputs;

@@ -1,13 +1,11 @@
 #pragma once
-// Scene sections /hsm and /wind (docs/scene.md). Owned by sim/.
+// Options of the sim stage: the scene sections /hsm and /wind (docs/scene.md), read and
+// validated by scene/ (src/scene/sim_sections.h); the engine never sees the JSON.
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
-#include <string>
 #include <vector>
-
-#include "common/scene_reader.h"
 
 namespace treeanim {
 
@@ -23,8 +21,8 @@ enum class Precision : uint8_t {
   kFloat,   // half the memory traffic; ~1e-7 relative round-off, far below the step's error
 };
 
-struct SimOptions {
-  // Filled from /hsm by read_sim_options.
+struct HsmOptions {
+  // The scene's /hsm section.
   bool global_matching = true;           // paper Eq. 8 on/off
   StiffnessMode stiffness = StiffnessMode::kPhysical;
   double alpha = 0.5;                    // per-step local rate (kPerStep), [0, 1]
@@ -54,7 +52,7 @@ struct WindKey {
 };
 
 struct WindOptions {
-  // Filled from /wind by read_wind_options (keys or a CSV file, turbulence, drag).
+  // The scene's /wind section (keys or a CSV file, turbulence, drag).
   std::optional<std::filesystem::path> file;  // the CSV the keys came from, if any
   std::vector<WindKey> keys;                  // strictly increasing times; empty = calm
   double air_density = 1.225;                 // kg/m^3
@@ -67,15 +65,5 @@ struct WindOptions {
   double gust_frequency = 0.2;                // Hz, typical gust rate
   uint64_t seed = 1;                          // turbulence and gusts
 };
-
-// /hsm section => solver options.
-SimOptions read_sim_options(SceneObject section);
-// /wind section => wind options. scene_seed is the top-level /seed (turbulence default).
-// A wind CSV is read here, so its errors (file:line) surface with the other input errors.
-WindOptions read_wind_options(SceneObject section, uint64_t scene_seed);
-
-// CSV text (header "time,speed,dx,dy,dz[,gust]") => keys. `name` prefixes errors
-// ("name:line: ..."). Throws InputError.
-std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name);
 
 }  // namespace treeanim

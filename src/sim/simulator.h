@@ -11,7 +11,7 @@ namespace treeanim {
 class Simulator {
  public:
   // model: read-only tree (must outlive the simulator); frame_dt: 1/fps; substeps per frame.
-  Simulator(const TreeModel& model, const SimOptions& options, const WindOptions& wind,
+  Simulator(const TreeModel& model, const HsmOptions& options, const WindOptions& wind,
             double frame_dt, int substeps);
   ~Simulator();
   Simulator(const Simulator&) = delete;

@@ -46,7 +46,7 @@ std::vector<uint32_t> parents_first(const TreeModel& model) {
 }
 
 // Physical mode: segment (local) and limb frequencies of every cluster (docs/solver.md).
-void physical_frequencies(const TreeModel& model, const SimOptions& options, StepRates& rates) {
+void physical_frequencies(const TreeModel& model, const HsmOptions& options, StepRates& rates) {
   const size_t C = model.cluster_count();
   const double E = options.youngs_modulus;
   // Each vertex's mass is shared among its clusters, so subtree sums count it once.
@@ -103,7 +103,7 @@ double global_frequency(double rate, double h) { return std::acos(1 - std::clamp
 
 double local_frequency(double rate, double h) { return std::asin(std::sqrt(std::clamp(rate, 0.0, 1.0))) / h; }
 
-StepRates compute_step_rates(const TreeModel& model, const SimOptions& options, double h) {
+StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, double h) {
   const size_t C = model.cluster_count(), V = model.vertex_count();
   StepRates rates;
   rates.cluster_alpha.assign(C, 0);

@@ -29,6 +29,6 @@ double global_frequency(double rate, double h);
 double local_frequency(double rate, double h);
 
 // Model (geometry, masses) + options + step h => every per-step rate of the solver.
-StepRates compute_step_rates(const TreeModel& model, const SimOptions& options, double h);
+StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, double h);
 
 }  // namespace treeanim

@@ -88,14 +88,6 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
   }
   for (double& m : model.vertex_mass) m = std::max(m, kMinVertexMass);
   anchor(rings, leaves, uint32_t(options.ring_sides), model);
-  model.vertex_inv_mass.resize(V);
-  for (size_t v = 0; v < V; ++v) model.vertex_inv_mass[v] = model.vertex_anchored[v] ? 0.0 : 1.0 / model.vertex_mass[v];
-  model.cluster_mass.assign(C, 0.0);
-  for (size_t c = 0; c < C; ++c)
-    for (uint32_t i = model.cluster_offsets[c]; i < model.cluster_offsets[c + 1]; ++i) {
-      const uint32_t v = model.cluster_members[i];
-      if (!model.vertex_anchored[v]) model.cluster_mass[c] += model.vertex_mass[v];
-    }
 }
 
 TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options) {

@@ -82,13 +82,12 @@ LeafMeshes build_leaf_meshes(const Skeleton& skeleton, const TreeOptions& option
                              const LeafTemplate& shape, const MeshCounts& counts, TreeModel& model);
 
 // topology + rings + leaves => every cluster array of the model (CSR both ways, parents,
-// kinds, lengths, radii; cluster_mass is left for assign_masses).
+// kinds, lengths, radii).
 void build_clusters(const Skeleton& skeleton, const SegmentTopology& topology,
                     const TreeOptions& options, const BranchRings& rings,
                     const LeafMeshes& leaves, TreeModel& model);
 
-// Eq. 9 volumes and leaf areas => vertex_mass, vertex_inv_mass, vertex_anchored,
-// vertex_drag_area and cluster_mass.
+// Eq. 9 volumes and leaf areas => vertex_mass, vertex_anchored and vertex_drag_area.
 void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
                    const BranchRings& rings, const LeafMeshes& leaves, TreeModel& model);
 

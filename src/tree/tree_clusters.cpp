@@ -18,6 +18,7 @@ void group_segments(const Skeleton& skeleton, const SegmentTopology& topology,
   const uint32_t target = uint32_t(options.cluster.target_vertices);
   std::vector<uint32_t> segments, members;  // (C) per branch cluster so far
   std::vector<double> weighted_radius;      // (C) sum of length * mean radius (m^2)
+  std::vector<int32_t> first_segment;       // (C) the segment that started the cluster
   model.segment_cluster.resize(S);
   for (size_t s = 0; s < S; ++s) {
     const int32_t p = skeleton.segment_parent[s];
@@ -38,7 +39,7 @@ void group_segments(const Skeleton& skeleton, const SegmentTopology& topology,
       segments.push_back(0);
       members.push_back(sides);  // the base ring
       weighted_radius.push_back(0);
-      model.cluster_first_segment.push_back(int32_t(s));
+      first_segment.push_back(int32_t(s));
       model.cluster_parent.push_back(p >= 0 ? int32_t(model.segment_cluster[p]) : -1);
       model.cluster_length.push_back(0);
     }
@@ -52,7 +53,7 @@ void group_segments(const Skeleton& skeleton, const SegmentTopology& topology,
   const size_t B = segments.size();
   model.cluster_radius.resize(B);
   for (size_t c = 0; c < B; ++c) {
-    const int32_t s = model.cluster_first_segment[c];
+    const int32_t s = first_segment[c];
     model.cluster_radius[c] = model.cluster_length[c] > 0
                                   ? weighted_radius[c] / model.cluster_length[c]
                                   : model.segment_radius_base[s];
@@ -71,7 +72,6 @@ void add_leaf_clusters(const Skeleton& skeleton, const LeafMeshes& leaves, TreeM
     model.leaf_cluster[l] = uint32_t(model.cluster_kind.size());
     model.cluster_kind.push_back(kClusterLeaf);
     model.cluster_leaf.push_back(int32_t(l));
-    model.cluster_first_segment.push_back(-1);
     model.cluster_parent.push_back(s >= 0 ? int32_t(model.segment_cluster[s]) : -1);
     model.cluster_length.push_back(leaves.length[l]);
     model.cluster_radius.push_back(0);

@@ -20,7 +20,6 @@ struct TreeModel {
 
   // --- masses and forces ---
   std::vector<double> vertex_mass;                // (V) kg (shared vertices sum their shares)
-  std::vector<double> vertex_inv_mass;            // (V) 1/kg; 0 for anchored vertices
   std::vector<uint8_t> vertex_anchored;           // (V) 1 = fixed to the ground
   std::vector<double> vertex_drag_area;           // (V) m^2, the vertex's share of projected branch/leaf area
 
@@ -28,10 +27,8 @@ struct TreeModel {
   std::vector<uint32_t> cluster_offsets;          // (C+1) into cluster_members
   std::vector<uint32_t> cluster_members;          // (M) vertex ids, ascending within a cluster
   std::vector<uint8_t> cluster_kind;              // (C) ClusterKind
-  std::vector<int32_t> cluster_first_segment;     // (C) first segment merged into a branch cluster; -1 for leaves
   std::vector<int32_t> cluster_leaf;              // (C) leaf index of a leaf cluster; -1 for branches
   std::vector<int32_t> cluster_parent;            // (C) cluster this one hangs from; -1 for the root
-  std::vector<double> cluster_mass;               // (C) kg, sum of member vertex masses (anchors excluded)
   std::vector<double> cluster_length;             // (C) m, axis length (leaf: leaf length)
   std::vector<double> cluster_radius;             // (C) m, mean branch radius (leaf: 0)
 

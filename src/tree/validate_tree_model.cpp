@@ -49,7 +49,6 @@ void check_mesh(const TreeModel& m) {
 void check_masses(const TreeModel& m) {
   const size_t V = m.vertex_count();
   expect_size("vertex_mass", m.vertex_mass.size(), V);
-  expect_size("vertex_inv_mass", m.vertex_inv_mass.size(), V);
   expect_size("vertex_anchored", m.vertex_anchored.size(), V);
   expect_size("vertex_drag_area", m.vertex_drag_area.size(), V);
   expect_range("vertex_anchored", m.vertex_anchored, 0, 2);
@@ -58,8 +57,6 @@ void check_masses(const TreeModel& m) {
       fail("vertex_mass[" + std::to_string(v) + "] is not a positive finite number");
     if (!(std::isfinite(m.vertex_drag_area[v]) && m.vertex_drag_area[v] >= 0))
       fail("vertex_drag_area[" + std::to_string(v) + "] is not a finite number >= 0");
-    if ((m.vertex_inv_mass[v] == 0) != bool(m.vertex_anchored[v]))
-      fail("vertex_inv_mass[" + std::to_string(v) + "] disagrees with vertex_anchored");
   }
 }
 
@@ -72,13 +69,10 @@ void check_clusters(const TreeModel& m) {
       if (m.cluster_members[i] <= m.cluster_members[i - 1])
         fail("cluster_members of cluster " + std::to_string(c) + " not strictly ascending at " + std::to_string(i));
   expect_range("cluster_kind", m.cluster_kind, 0, 2);
-  expect_size("cluster_first_segment", m.cluster_first_segment.size(), C);
   expect_size("cluster_leaf", m.cluster_leaf.size(), C);
   expect_size("cluster_parent", m.cluster_parent.size(), C);
-  expect_size("cluster_mass", m.cluster_mass.size(), C);
   expect_size("cluster_length", m.cluster_length.size(), C);
   expect_size("cluster_radius", m.cluster_radius.size(), C);
-  expect_range("cluster_first_segment", m.cluster_first_segment, -1, (long long)m.segment_count());
   expect_range("cluster_leaf", m.cluster_leaf, -1, (long long)m.leaf_count());
   for (size_t c = 0; c < C; ++c)
     if (m.cluster_parent[c] < -1 || m.cluster_parent[c] >= (long long)c)

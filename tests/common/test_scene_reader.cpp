@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
+#include "common/did_you_mean.h"
 #include "common/scene_reader.h"
 
 namespace treeanim {

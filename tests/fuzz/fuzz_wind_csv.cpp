@@ -6,7 +6,7 @@
 #include <string>
 
 #include "common/errors.h"
-#include "sim/sim_options.h"
+#include "scene/sim_sections.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace treeanim;

@@ -33,16 +33,13 @@ inline TreeModel small_model() {
   m.vertex_segment = {0, 0, 0, 0, -1, -1};
   m.vertex_leaf = {-1, -1, -1, 0, 0, 0};
   m.vertex_mass = {0.5, 0.5, 0.25, 0.3, 0.01, 0.01};
-  m.vertex_inv_mass = {0, 0, 4, 1 / 0.3, 100, 100};
   m.vertex_anchored = {1, 1, 0, 0, 0, 0};
   m.vertex_drag_area = {0, 0, 0.01, 0.01, 0.002, 0.002};
   m.cluster_offsets = {0, 4, 7};
   m.cluster_members = {0, 1, 2, 3, 3, 4, 5};
   m.cluster_kind = {kClusterBranch, kClusterLeaf};
-  m.cluster_first_segment = {0, -1};
   m.cluster_leaf = {-1, 0};
   m.cluster_parent = {-1, 0};
-  m.cluster_mass = {0.55, 0.32};
   m.cluster_length = {1.0, 0.3};
   m.cluster_radius = {0.05, 0.0};
   m.vertex_cluster_offsets = {0, 1, 2, 3, 5, 6, 7};

@@ -111,18 +111,13 @@ TreeModel ModelBuilder::finish() {
   m.cluster_parent = parent;
   m.cluster_length = length;
   m.cluster_radius = radius;
-  m.cluster_first_segment.assign(C, -1);
   m.cluster_leaf.assign(C, -1);
   for (size_t l = 0; l < leaf_cluster.size(); ++l) m.cluster_leaf[leaf_cluster[l]] = static_cast<int32_t>(l);
-  m.vertex_inv_mass.assign(V, 0);
-  for (size_t v = 0; v < V; ++v) m.vertex_inv_mass[v] = anchored[v] || m.vertex_mass[v] <= 0 ? 0 : 1 / m.vertex_mass[v];
-  m.cluster_mass.assign(C, 0);
   std::vector<std::vector<uint32_t>> slots(V);
   for (size_t c = 0; c < C; ++c)
     for (uint32_t s = m.cluster_offsets[c]; s < m.cluster_offsets[c + 1]; ++s) {
       const uint32_t v = m.cluster_members[s];
       slots[v].push_back(s);
-      if (!anchored[v]) m.cluster_mass[c] += m.vertex_mass[v];
     }
   m.vertex_cluster_offsets.push_back(0);
   for (size_t v = 0; v < V; ++v) {

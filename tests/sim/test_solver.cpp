@@ -18,8 +18,8 @@ namespace {
 using testing::ModelBuilder;
 using testing::small_tree;
 
-SimOptions per_step(double alpha, double k_d, bool global) {
-  SimOptions o;
+HsmOptions per_step(double alpha, double k_d, bool global) {
+  HsmOptions o;
   o.stiffness = StiffnessMode::kPerStep;
   o.alpha = alpha;
   o.leaf_alpha = alpha;
@@ -39,8 +39,8 @@ WindOptions steady_wind(double speed, const Eigen::Vector3d& direction, double g
 }
 
 // Physical defaults with sleeping off, so that every step really runs.
-SimOptions awake() {
-  SimOptions options;
+HsmOptions awake() {
+  HsmOptions options;
   options.sleep = false;
   return options;
 }
@@ -62,7 +62,7 @@ TEST(Solver, RigidlyMovedRestPoseIsItsOwnGoal) {
   // moved rest pose, so nothing moves and the extracted rotation is the applied one.
   TreeModel model = small_tree(2, Eigen::Vector3d(5000, 20, -3000));
   std::fill(model.vertex_anchored.begin(), model.vertex_anchored.end(), 0);
-  SimOptions options = per_step(0.7, 0, false);
+  HsmOptions options = per_step(0.7, 0, false);
   options.rotation_iterations = 100;  // a cold start 0.8 rad away; the bake warm-starts
   Simulator sim(model, options, calm(), 1.0 / 24, 1);
   SimState state = sim.initial_state(0);
@@ -210,7 +210,7 @@ TEST(Solver, TreeAtRestStaysAtRestFor100kSteps) {
   // float rest offset is rounded, and the tree must not creep from it).
   const TreeModel model = small_tree(2, Eigen::Vector3d(1000, 0, -2000));
   for (Precision precision : {Precision::kDouble, Precision::kFloat}) {
-    SimOptions options = awake();
+    HsmOptions options = awake();
     options.precision = precision;
     Simulator sim(model, options, calm(), 1.0 / 24, 100);
     SimState state = sim.initial_state(0);
@@ -225,7 +225,7 @@ TEST(Solver, TreeAtRestStaysAtRestFor100kSteps) {
 
 TEST(Solver, NonFiniteValueNamesFrameSubstepAndCluster) {
   const TreeModel model = small_tree();
-  SimOptions options = awake();
+  HsmOptions options = awake();
   Simulator sim(model, options, calm(), 1.0 / 24, 3);
   SimState state = sim.initial_state(0);
   state.positions(1, 40) = std::numeric_limits<double>::quiet_NaN();
@@ -244,7 +244,7 @@ TEST(Solver, ExtremeWindAndLargeStepStayFinite) {
   WindOptions wind;
   wind.keys = {{0, 60, {1, 0, 0}, 20}, {4, 60, {1, 0, 0}, 20}, {5, 0, {1, 0, 0}, 0}};
   for (double fps : {4.0, 24.0}) {
-    SimOptions options;
+    HsmOptions options;
     options.sleep = false;
     Simulator sim(model, options, wind, 1.0 / fps, 1);
     SimState state = sim.initial_state(0);
@@ -295,36 +295,38 @@ TEST(Solver, DegenerateClustersStayFinite) {
   b.mass.push_back(0);
   const TreeModel model = b.finish();
   const WindOptions wind = steady_wind(30, Eigen::Vector3d{0, 0, 1}, 10);
-  SimOptions options = awake();
+  HsmOptions options = awake();
   Simulator sim(model, options, wind, 1.0 / 24, 2);
   SimState state = sim.initial_state(0);
   for (int f = 1; f <= 48; ++f) ASSERT_NO_THROW(sim.advance_frame(state, f));
   EXPECT_TRUE(state.positions.allFinite());
 }
 
-// The last step of a frame predicts the next frame's first step for the state it wrote
-// (SimState::prediction_stamp). A copy taken mid-bake and resumed by another simulator, and a
-// state edited by hand with the stamp reset, must be predicted from their positions instead.
+// The last step of a frame predicts the next frame's first step and keeps that prediction in
+// the state (SimState::predicted). A copy taken mid-bake and resumed by another simulator
+// continues with the same bits; a state edited by hand with `predicted` reset is predicted
+// from its positions.
 TEST(Solver, ResumedAndEditedStatesArePredictedFromTheirPositions) {
   const TreeModel model = small_tree(3);
   const WindOptions wind = steady_wind(12, Eigen::Vector3d{1, 0, 0.2}, 3);
-  const SimOptions options = awake();
+  const HsmOptions options = awake();
   Simulator whole(model, options, wind, 1.0 / 24, 4);
   SimState state = whole.initial_state(0);
   advance(whole, state, 1, 24);
   SimState checkpoint = state;
   advance(whole, state, 25, 48);
-  // Resumed elsewhere: the same motion (not the same bits: u is recomputed as x - x0).
+  // Resumed elsewhere: the same bits (the state holds the prediction it was written with).
   Simulator resumed(model, options, wind, 1.0 / 24, 4);
   advance(resumed, checkpoint, 25, 48);
-  EXPECT_LT((checkpoint.positions - state.positions).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ((checkpoint.positions - state.positions).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((checkpoint.velocities - state.velocities).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_GT((state.positions - model.rest_positions).cwiseAbs().maxCoeff(), 1e-3);  // it moved
 
   // Edited by hand: a simulator that carried a prediction and a fresh one agree exactly.
   SimState edited = state;
   edited.positions = model.rest_positions;
   edited.velocities.setZero();
-  edited.prediction_stamp = 0;
+  edited.predicted = false;
   SimState fresh_copy = edited;
   whole.advance_frame(edited, 49);
   Simulator fresh(model, options, wind, 1.0 / 24, 4);

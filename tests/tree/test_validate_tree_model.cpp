@@ -37,8 +37,6 @@ TEST(ValidateTreeModel, CatchesCorruptedIndices) {
             "tree model: vertex_memberships of vertex 8 not in ascending cluster order");
   EXPECT_EQ(error_after([](TreeModel& m) { m.vertex_cluster_offsets.pop_back(); }),
             "tree model: vertex_cluster_offsets has 70 entries, expected 71");
-  EXPECT_EQ(error_after([](TreeModel& m) { m.vertex_inv_mass[0] = 1; }),
-            "tree model: vertex_inv_mass[0] disagrees with vertex_anchored");
 }
 
 TEST(ValidateTreeModel, AnEmptySkeletonIsAnInputError) {

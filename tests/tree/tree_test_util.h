@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lsystem/skeleton.h"
+#include "tree/tree_model.h"
 
 namespace treeanim::test {
 
@@ -76,6 +77,14 @@ inline Skeleton small_tree() {
   b.leaf(t1, {0, 1.5, 0}, h, left, 2.0);
   b.leaf(l1, b.sk.segment_end[l1], Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(-1, 0, 0));
   return b.sk;
+}
+
+// Cluster c => the mass of its members that are not anchored (kg).
+inline double free_cluster_mass(const TreeModel& model, size_t c) {
+  double mass = 0;
+  for (uint32_t s = model.cluster_offsets[c]; s < model.cluster_offsets[c + 1]; ++s)
+    if (!model.vertex_anchored[model.cluster_members[s]]) mass += model.vertex_mass[model.cluster_members[s]];
+  return mass;
 }
 
 }  // namespace treeanim::test

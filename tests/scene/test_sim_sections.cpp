@@ -1,18 +1,18 @@
-// /hsm and /wind readers, the wind CSV and the wind field.
+// /hsm and /wind readers (scene/sim_sections.h), the wind CSV and the wind field.
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "common/errors.h"
-#include "sim/sim_options.h"
+#include "scene/sim_sections.h"
 #include "sim/wind.h"
 
 namespace treeanim {
 namespace {
 
-SimOptions read_hsm(Json document) {
+HsmOptions read_hsm(Json document) {
   SceneReader reader(document, "/scenes", "s.json");
-  SimOptions o = read_sim_options(reader.root().object("hsm"));
+  HsmOptions o = read_hsm_options(reader.root().object("hsm"));
   reader.check_unknown_keys();
   return o;
 }
@@ -33,10 +33,10 @@ std::string error_of(auto&& f) {
   return "no error";
 }
 
-TEST(SimOptions, DefaultsAreFilledIn) {
+TEST(HsmOptions, DefaultsAreFilledIn) {
   Json document = Json::object();
   SceneReader reader(document, "/scenes", "s.json");
-  const SimOptions o = read_sim_options(reader.root().object("hsm"));
+  const HsmOptions o = read_hsm_options(reader.root().object("hsm"));
   EXPECT_EQ(o.stiffness, StiffnessMode::kPhysical);
   EXPECT_TRUE(o.global_matching);
   EXPECT_TRUE(o.sleep);
@@ -47,7 +47,7 @@ TEST(SimOptions, DefaultsAreFilledIn) {
   EXPECT_EQ(document["hsm"]["precision"], "double");
 }
 
-TEST(SimOptions, ReadsPrecision) {
+TEST(HsmOptions, ReadsPrecision) {
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "float"}})")).precision, Precision::kFloat);
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "double"}})")).precision, Precision::kDouble);
   const std::string error = error_of([] { read_hsm(Json::parse(R"({"hsm": {"precision": "half"}})")); });
@@ -55,8 +55,8 @@ TEST(SimOptions, ReadsPrecision) {
   EXPECT_NE(error.find("\"float\""), std::string::npos) << error;
 }
 
-TEST(SimOptions, ReadsPerStepStiffness) {
-  const SimOptions o = read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 0.3, "k_d": 0.05,
+TEST(HsmOptions, ReadsPerStepStiffness) {
+  const HsmOptions o = read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 0.3, "k_d": 0.05,
                                                        "global_matching": false, "sleep": false}})"));
   EXPECT_EQ(o.stiffness, StiffnessMode::kPerStep);
   EXPECT_EQ(o.alpha, 0.3);
@@ -65,7 +65,7 @@ TEST(SimOptions, ReadsPerStepStiffness) {
   EXPECT_FALSE(o.sleep);
 }
 
-TEST(SimOptions, RejectsOutOfRangeAndUnknownKeys) {
+TEST(HsmOptions, RejectsOutOfRangeAndUnknownKeys) {
   EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"alpha": 1.5}})")); }),
             "s.json: /hsm/alpha: expected a number in [0, 1], got 1.5");
   EXPECT_NE(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stifness": "physical"}})")); }).find("did you mean /hsm/stiffness"),

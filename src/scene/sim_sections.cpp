@@ -1,4 +1,4 @@
-#include "sim/sim_options.h"
+#include "scene/sim_sections.h"
 
 #include <cmath>
 #include <limits>
@@ -65,8 +65,8 @@ std::string order_error(const std::vector<WindKey>& keys, size_t i) {
 
 }  // namespace
 
-SimOptions read_sim_options(SceneObject section) {
-  SimOptions o;
+HsmOptions read_hsm_options(SceneObject section) {
+  HsmOptions o;
   o.global_matching = section.boolean("global_matching", o.global_matching);
   o.stiffness = section.choice("stiffness", "physical", {"physical", "per_step"}) == "physical"
                     ? StiffnessMode::kPhysical

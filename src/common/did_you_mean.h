@@ -1,0 +1,14 @@
+#pragma once
+// Did-you-mean suggestions for unknown names (scene keys, choices, grammar symbols).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace treeanim {
+
+// Levenshtein edit distance.
+size_t edit_distance(const std::string& a, const std::string& b);
+// The closest candidate to `word`, or "" when none is close enough to suggest.
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace treeanim

@@ -1,0 +1,180 @@
+// The per-vertex pass, in displacements from rest (u = x - x0): the correction of the step
+// just matched (Eq. 7: each vertex takes the mean of its clusters' corrections), fused with
+// the prediction of the next step (prediction.h), so a vertex is loaded once per substep
+// (docs/solver.md, "One step" 4 and 1).
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+#include "common/errors.h"
+#include "sim/prediction.h"
+#include "sim/solver_step.h"
+
+namespace treeanim {
+
+namespace {
+
+// Vertex v => the mean of its clusters' corrections, summed in membership order (never the
+// sum: Eq. 7 with overlaps). A released membership's row holds 0.
+template <typename Real>
+inline Eigen::Matrix<Real, 1, 3> mean_correction(const TreeModel& tree, const Attachment<Real>& attachment,
+                                                 const StepScratch<Real>& scratch, uint32_t v) {
+  Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
+  for (uint32_t s = tree.vertex_cluster_offsets[v]; s < tree.vertex_cluster_offsets[v + 1]; ++s)
+    pull += scratch.member_correction.row(tree.vertex_memberships[s]);
+  return pull * attachment.vertex_inv_count[v];
+}
+
+// Shared vertices in [first, last) => their mean correction in their pull row, read by the
+// direct vertex pass.
+template <typename Real>
+void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          StepScratch<Real>& scratch, size_t first, size_t last) {
+  const auto from = std::lower_bound(model.shared_vertices.begin(), model.shared_vertices.end(), first);
+  const auto to = std::lower_bound(from, model.shared_vertices.end(), last);
+  for (auto it = from; it != to; ++it)
+    scratch.member_correction.row(attachment.vertex_pull_row[*it]) = mean_correction(model.tree, attachment, scratch, *it);
+}
+
+// Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
+// asleep) and block.pull, each vertex's mean correction; kFromState: 0, after loading
+// u = x - x0 and v from the state (anchors included: they hold where they are).
+template <typename Real>
+void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                  const StepScratch<Real>& scratch, VertexPass pass, bool any_asleep, size_t begin, int n,
+                  VertexBlock<Real>& block) {
+  const TreeModel& tree = model.tree;
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  for (int k = 0; k < n; ++k) {
+    const size_t v = begin + k;
+    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
+                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+    block.moving[k] = still ? 0 : 1;
+    block.drag[k] = still ? Real(0) : model.vertex_drag[v];
+    block.damping[k] = still ? Real(1) : model.vertex_damping[v];
+    block.global[k] = still ? Real(0) : attachment.vertex_global[v];
+    block.flying[k] = still ? 0 : attachment.vertex_flying[v];
+    Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
+    if (pass == VertexPass::kFromState) {
+      prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
+      prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
+    } else if (!still) {
+      pull = mean_correction(tree, attachment, scratch, static_cast<uint32_t>(v)).transpose();
+    }
+    for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
+  }
+}
+
+}  // namespace
+
+// kLastStep also writes positions and velocities to the state.
+template <typename Real>
+bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                         StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
+  using Inputs = VertexInputs<Real>;
+  const TreeModel& tree = model.tree;
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
+                                      [](uint8_t a) { return a != 0; });
+  uint32_t bad = kNone, runaway = kNone;
+#pragma omp parallel if (model.parallel) reduction(min : bad, runaway)
+  {
+    const auto [first, last] =
+        balanced_range(tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    // Without sleeping islands every free vertex moves and reads its mean correction from
+    // one row (anchors: the zero row, with factors that keep them still); otherwise, and when
+    // a frame starts from the state, each block is gathered lane by lane.
+    const bool direct = pass != VertexPass::kFromState && !any_asleep;
+    if (direct) average_shared_pulls(model, attachment, scratch, first, last);
+    const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
+                                  scratch.member_correction.col(2).data()};
+    VertexBlock<Real> block;
+    for (size_t begin = first; begin < last; begin += kVertexBlock) {
+      const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
+      Inputs in;
+      if (direct) {
+        in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
+              model.vertex_drag.data() + begin, model.vertex_damping.data() + begin,
+              attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin};
+        std::fill(block.moving, block.moving + n, uint8_t(1));
+      } else {
+        gather_block(model, attachment, state, scratch, pass, any_asleep, begin, n, block);
+        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
+              block.global, block.flying};
+      }
+      const bool end = pass == VertexPass::kLastStep;
+      const bool detach = model.detach_enabled;
+      const bool flagged =
+          end ? (detach ? predict_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                        : predict_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block))
+              : (detach ? predict_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                        : predict_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block));
+      if (end) {
+        // (3 x V) columns: x, y, z of a vertex are adjacent. A still lane keeps its value.
+        double* positions = state.positions.data() + 3 * begin;
+        double* velocities = state.velocities.data() + 3 * begin;
+        const double* rest = tree.rest_positions.data() + 3 * begin;
+#pragma omp simd
+        for (int k = 0; k < n; ++k)
+          for (int i = 0; i < 3; ++i) {
+            const bool moving = block.moving[k] != 0;
+            positions[3 * k + i] = moving ? rest[3 * k + i] + double(block.end_offset[i][k]) : positions[3 * k + i];
+            velocities[3 * k + i] = moving ? double(block.end_velocity[i][k]) : velocities[3 * k + i];
+          }
+      }
+      if (flagged) {  // rare: find the first vertex at fault, as the scalar tests would
+        for (int k = 0; k < n; ++k) {
+          if (!block.moving[k]) continue;
+          const uint32_t v = static_cast<uint32_t>(begin + k);
+          if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite() ||
+              (end && !(state.positions.col(v).allFinite() && state.velocities.col(v).allFinite())))
+            bad = std::min(bad, v);
+          const double moved2 = end ? Eigen::Matrix<Real, 3, 1>(block.end_offset[0][k], block.end_offset[1][k],
+                                                                block.end_offset[2][k])
+                                          .template cast<double>()
+                                          .squaredNorm()
+                                    : 0.0;
+          if (!attachment.vertex_flying[v] && moved2 > model.runaway_distance2) runaway = std::min(runaway, v);
+        }
+      }
+    }
+  }
+  // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
+  auto where = [&](uint32_t v) {
+    return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+           std::to_string(attachment.vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
+  };
+  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
+  if (runaway != kNone) {
+    char distances[96];
+    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m)",
+                  (state.positions.col(runaway) - tree.rest_positions.col(runaway)).norm(),
+                  std::sqrt(model.runaway_distance2) / 2);
+    throw SimulationError(where(runaway) + distances +
+                          ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+  }
+  return any_asleep;
+}
+
+template <typename Real>
+void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                        StepScratch<Real>& scratch, long long frame) {
+  set_air_time(model.wind, state.time, scratch.air);
+#pragma omp parallel for schedule(static) if (model.parallel)
+  for (size_t c = 0; c < model.C; ++c)
+    if (cluster_awake(model, attachment, state, c)) sample_cluster_air(model, attachment, state, scratch, c);
+  correct_and_predict(model, attachment, state, scratch, VertexPass::kFromState, frame, 0);
+}
+
+template bool correct_and_predict(const SolverModel<float>&, const Attachment<float>&, SimState&, StepScratch<float>&,
+                                  VertexPass, long long, int);
+template bool correct_and_predict(const SolverModel<double>&, const Attachment<double>&, SimState&,
+                                  StepScratch<double>&, VertexPass, long long, int);
+template void predict_from_state(const SolverModel<float>&, const Attachment<float>&, SimState&, StepScratch<float>&,
+                                 long long);
+template void predict_from_state(const SolverModel<double>&, const Attachment<double>&, SimState&,
+                                 StepScratch<double>&, long long);
+
+}  // namespace treeanim

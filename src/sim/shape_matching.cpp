@@ -1,0 +1,142 @@
+// Shape matching of every awake cluster on the predicted positions (docs/solver.md, "One
+// step" 2 and "Local shape matching").
+#include "sim/shape_matching.h"
+
+#include <omp.h>
+
+#include <string>
+
+#include "common/errors.h"
+#include "sim/rotation.h"
+#include "sim/solver_step.h"
+
+namespace treeanim {
+
+template <typename Real>
+bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
+                 const Eigen::Vector3d* pinned_point, int max_iterations, Eigen::Quaterniond& rotation,
+                 Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
+  const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+  // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
+  // numbers wherever the tree stands and however far it travelled. With the rest terms
+  // precomputed, one pass over the displacements sums the centre shift
+  // t - t0 = sum (w / sum w) u_p and sum s u_p q^T, s = (w / sum w) k with the cluster's
+  // match scale k. About the match point o, displaced by w (the centre shift, or the pin):
+  // A_pq = sum s (d - o - w)(q - o)^T = sum s u_p q^T - k shift o^T + sum s (q - o)(q - o)^T
+  //        - w (sum s (q - o))^T,
+  // the third term precomputed. About the centre, sum s q is 0 but for the round-off of the
+  // stored q; the shift leaves that residue out, so at the rest pose (u_p = 0) the shift is
+  // exactly 0 and A_pq is the exactly symmetric rest moment: no goal pulls a resting tree.
+  // One weight per member serves both sums; they run in Real, with the round-off of the
+  // values they sum. q is read here and again by write_corrections, while it is in cache.
+  Real a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
+  Real sx = 0, sy = 0, sz = 0;
+  for (uint32_t s = begin; s < end; ++s) {
+    const uint32_t v = tree.cluster_members[s];
+    const Real x = predicted_offset(v, 0), y = predicted_offset(v, 1), z = predicted_offset(v, 2);
+    const Real share = a.member_centre_weight[s];
+    const Real wx = share * a.member_offset(s, 0), wy = share * a.member_offset(s, 1), wz = share * a.member_offset(s, 2);
+    sx += share * x, sy += share * y, sz += share * z;
+    a00 += x * wx, a01 += x * wy, a02 += x * wz;
+    a10 += y * wx, a11 += y * wy, a12 += y * wz;
+    a20 += z * wx, a21 += z * wy, a22 += z * wz;
+  }
+  const Eigen::Vector3d centre_shift(sx, sy, sz);
+  const Eigen::Vector3d point = a.cluster_match_point.col(c);
+  const Eigen::Vector3d point_shift = pinned_point ? *pinned_point : centre_shift;
+  Eigen::Matrix3d A;
+  A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
+  A -= centre_shift * point.transpose();  // 0 about the centre
+  A *= a.cluster_match_scale[c];
+  A += Eigen::Map<const Eigen::Matrix3d>(&a.cluster_rest_moment(0, c));
+  A -= point_shift * a.cluster_offset_sum.col(c).transpose();
+  extract_rotation(A, rotation, max_iterations);
+  R = rotation.toRotationMatrix();
+  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
+  shift = point_shift - (R * point - point);
+  return R.allFinite() && shift.allFinite();
+}
+
+template <typename Real>
+void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a, const Rows3<Real>& predicted_offset,
+                       size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift, Rows3<Real>& corrections) {
+  const TreeModel& tree = model.tree;
+  const Real alpha = static_cast<Real>(model.cluster_alpha[c]);
+  const uint32_t* members = tree.cluster_members.data();
+  const uint8_t* active = a.member_active.data();
+  const Real *qx = a.member_offset.col(0).data(), *qy = a.member_offset.col(1).data(), *qz = a.member_offset.col(2).data();
+  const Real *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
+             *uz = predicted_offset.col(2).data();
+  Real *cx = corrections.col(0).data(), *cy = corrections.col(1).data(), *cz = corrections.col(2).data();
+  const Eigen::Matrix<Real, 3, 3> r = R.template cast<Real>();
+  const Eigen::Matrix<Real, 3, 1> t = shift.template cast<Real>();
+  const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
+  const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
+#pragma omp simd
+  for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+    const uint32_t v = members[s];
+    const Real x = qx[s], y = qy[s], z = qz[s];
+    const Real weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
+    cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
+    cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
+    cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
+  }
+}
+
+template <typename Real>
+bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                   StepScratch<Real>& scratch, size_t c, const Eigen::Vector3d* pinned_point) {
+  const Rows3<Real>& predicted_offset = state.prediction<Real>().offset;
+  Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
+  Eigen::Matrix3d R;
+  Eigen::Vector3d shift;
+  const bool finite = fit_cluster(model.tree, attachment, predicted_offset, c, pinned_point,
+                                  model.options.rotation_iterations, rotation, R, shift);
+  state.cluster_rotations.col(c) = rotation.coeffs();
+  state.cluster_shift.col(c) = shift;
+  Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
+  if (finite) write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
+  return finite;
+}
+
+// Branches and free leaves first, then the attached leaves, whose translation is pinned to
+// their branch's goal for the shared vertex (hierarchical: a 1 g leaf cannot drag its branch,
+// nor drift off it in a gale). Sampling the next step's air here, per cluster, saves a
+// parallel region per step.
+template <typename Real>
+void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                    StepScratch<Real>& scratch, long long frame, int substep) {
+  uint32_t bad = kNone;
+#pragma omp parallel if (model.parallel) reduction(min : bad)
+  {
+    const auto [first, last] = balanced_range(model.tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    for (size_t c = first; c < last; ++c) {
+      if (!cluster_awake(model, attachment, state, c)) continue;
+      if (attachment.cluster_pin_slot[c] == kNone && !match_cluster(model, attachment, state, scratch, c, nullptr))
+        bad = std::min(bad, static_cast<uint32_t>(c));
+      sample_cluster_air(model, attachment, state, scratch, c);
+    }
+    if (!model.pinned_leaf_clusters.empty()) {
+#pragma omp barrier
+      match_attached_leaves(model, attachment, state, scratch, bad);
+    }
+  }
+  if (bad != kNone)
+    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                          std::to_string(bad) + ": the shape match produced a non-finite rotation or centre");
+}
+
+#define TREEANIM_SHAPE_MATCHING(Real)                                                                              \
+  template bool fit_cluster(const TreeModel&, const Attachment<Real>&, const Rows3<Real>&, size_t,                 \
+                            const Eigen::Vector3d*, int, Eigen::Quaterniond&, Eigen::Matrix3d&, Eigen::Vector3d&); \
+  template void write_corrections(const SolverModel<Real>&, const Attachment<Real>&, const Rows3<Real>&, size_t,   \
+                                  const Eigen::Matrix3d&, const Eigen::Vector3d&, Rows3<Real>&);                   \
+  template bool match_cluster(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,    \
+                              size_t, const Eigen::Vector3d*);                                                     \
+  template void match_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,   \
+                               long long, int);
+TREEANIM_SHAPE_MATCHING(float)
+TREEANIM_SHAPE_MATCHING(double)
+#undef TREEANIM_SHAPE_MATCHING
+
+}  // namespace treeanim

@@ -1,0 +1,228 @@
+// Precompute (libigl's split of a solver into precompute + solve): TreeModel + options =>
+// SolverModel, whose Attachment has every leaf attached; and the per-step scratch.
+#include <numeric>
+
+#include "common/errors.h"
+#include "sim/solver_model.h"
+#include "sim/stiffness.h"
+
+namespace treeanim {
+
+namespace {
+
+// Union-find root with path halving.
+uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+
+// Model CSR => per-membership cluster ids, and per vertex its counts, correction row and
+// air cluster (the rest data comes from rebuild_cluster_rest, once the pins are known).
+template <typename Real>
+void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
+  const TreeModel& tree = m.tree;
+  m.member_cluster.resize(m.M);
+  for (size_t c = 0; c < m.C; ++c)
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s)
+      m.member_cluster[s] = static_cast<uint32_t>(c);
+  a.member_offset.setZero(m.M, 3);
+  a.member_centre_weight.assign(m.M, 0);
+  a.member_active.assign(m.M, 1);
+  a.member_in_fit.assign(m.M, 1);
+  a.cluster_rest_centre.setZero(3, m.C);
+  a.cluster_match_point.setZero(3, m.C);
+  a.cluster_match_scale.assign(m.C, 0);
+  a.cluster_offset_sum.setZero(3, m.C);
+  a.cluster_rest_moment.setZero(9, m.C);
+  a.vertex_inv_count.assign(m.V, 0);
+  a.vertex_air_cluster.assign(m.V, 0);
+  a.vertex_pull_row.assign(m.V, static_cast<uint32_t>(m.M));
+  for (size_t v = 0; v < m.V; ++v) {
+    const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+    a.vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
+    a.vertex_air_cluster[v] = end > begin ? m.member_cluster[tree.vertex_memberships[begin]] : 0;
+    if (tree.vertex_anchored[v] || end == begin) continue;
+    a.vertex_pull_row[v] = tree.vertex_memberships[begin];
+    if (end - begin > 1) m.shared_vertices.push_back(static_cast<uint32_t>(v));
+  }
+}
+
+// Leaves => the membership slots that pin each attached leaf to its branch (attached_leaves.cpp).
+// A leaf whose shared vertex is in no other cluster is matched like a branch. The shared
+// vertex, where it is the leaf's own, does not count in its branch's fit: it carries leaf
+// mass and leaf drag, and a leaf does not load its branch (docs/solver.md, "Leaves").
+template <typename Real>
+void precompute_pins(SolverModel<Real>& m, Attachment<Real>& a) {
+  const TreeModel& tree = m.tree;
+  a.cluster_pin_slot.assign(m.C, kNone);
+  m.cluster_pin_own_slot.assign(m.C, kNone);
+  for (size_t l = 0; l < m.L; ++l) {
+    const uint32_t c = tree.leaf_cluster[l], shared = tree.leaf_attachment_vertex[l];
+    uint32_t own = kNone, pin = kNone;
+    for (uint32_t s = tree.vertex_cluster_offsets[shared]; s < tree.vertex_cluster_offsets[shared + 1]; ++s) {
+      const uint32_t slot = tree.vertex_memberships[s];
+      if (m.member_cluster[slot] == c) own = slot;
+      else if (pin == kNone && tree.cluster_kind[m.member_cluster[slot]] == kClusterBranch) pin = slot;
+    }
+    if (own == kNone || pin == kNone) continue;
+    a.cluster_pin_slot[c] = pin;
+    m.cluster_pin_own_slot[c] = own;
+    m.pinned_leaf_clusters.push_back(c);
+    if (tree.vertex_leaf[shared] == static_cast<int32_t>(l)) a.member_in_fit[pin] = 0;
+  }
+}
+
+// Drag areas and coefficients => per-vertex drag constants.
+template <typename Real>
+void precompute_drag(SolverModel<Real>& m, const WindOptions& w) {
+  const TreeModel& tree = m.tree;
+  m.vertex_drag.assign(m.V, 0);
+  for (size_t v = 0; v < m.V; ++v) {
+    const double mass = tree.vertex_mass[v];
+    if (tree.vertex_anchored[v] || !(mass > 0)) continue;
+    const double cd = tree.vertex_leaf[v] >= 0 ? w.leaf_drag_coefficient : w.branch_drag_coefficient;
+    m.vertex_drag[v] = static_cast<Real>(0.5 * w.air_density * cd * tree.vertex_drag_area[v] / mass);
+  }
+}
+
+// Clusters sharing a non-anchored vertex => one island (anchors hold, they do not couple).
+template <typename Real>
+void precompute_islands(SolverModel<Real>& m) {
+  const TreeModel& tree = m.tree;
+  const size_t V = m.V, C = m.C;
+  std::vector<uint32_t> parent(C);
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (size_t v = 0; v < V; ++v) {
+    if (tree.vertex_anchored[v]) continue;
+    const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+    for (uint32_t s = begin + 1; s < end; ++s) {
+      const uint32_t a = find_root(parent, m.member_cluster[tree.vertex_memberships[begin]]);
+      const uint32_t b = find_root(parent, m.member_cluster[tree.vertex_memberships[s]]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<uint32_t> id_of_root(C, kNone);
+  m.cluster_island.resize(C);
+  m.I = 0;
+  for (size_t c = 0; c < C; ++c) {
+    const uint32_t r = find_root(parent, static_cast<uint32_t>(c));
+    if (id_of_root[r] == kNone) id_of_root[r] = static_cast<uint32_t>(m.I++);
+    m.cluster_island[c] = id_of_root[r];
+  }
+  m.vertex_island.assign(V, kNone);
+  m.island_vertex_offsets.assign(m.I + 1, 0);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t begin = tree.vertex_cluster_offsets[v];
+    if (tree.vertex_anchored[v] || begin == tree.vertex_cluster_offsets[v + 1]) continue;
+    m.vertex_island[v] = m.cluster_island[m.member_cluster[tree.vertex_memberships[begin]]];
+    ++m.island_vertex_offsets[m.vertex_island[v] + 1];
+  }
+  for (size_t i = 0; i < m.I; ++i) m.island_vertex_offsets[i + 1] += m.island_vertex_offsets[i];
+  m.island_vertices.resize(m.island_vertex_offsets[m.I]);
+  std::vector<uint32_t> fill(m.island_vertex_offsets.begin(), m.island_vertex_offsets.end() - 1);
+  for (size_t v = 0; v < V; ++v)
+    if (m.vertex_island[v] != kNone) m.island_vertices[fill[m.vertex_island[v]]++] = static_cast<uint32_t>(v);
+}
+
+}  // namespace
+
+template <typename Real>
+SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const WindOptions& w, double dt, int n)
+    : tree(t), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n), V(t.vertex_count()), C(t.cluster_count()),
+      M(t.membership_count()), L(t.leaf_count()), I(0), detach_enabled(o.leaf_detach_force > 0 && t.leaf_count() > 0),
+      parallel(t.membership_count() >= 4096) {
+  if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
+  const double size = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
+  const bool anchored = std::any_of(t.vertex_anchored.begin(), t.vertex_anchored.end(), [](auto a) { return a != 0; });
+  runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
+  Attachment<Real>& a = all_attached;
+  precompute_members(*this, a);
+  precompute_pins(*this, a);
+  for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(*this, a, static_cast<uint32_t>(c));
+  const StepRates rates = compute_step_rates(tree, options, h);
+  cluster_alpha = rates.cluster_alpha;
+  a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
+  vertex_damping.assign(rates.vertex_damping.begin(), rates.vertex_damping.end());
+  precompute_drag(*this, w);
+  precompute_islands(*this);
+  a.cluster_flying.assign(C, 0);
+  a.vertex_flying.assign(V, 0);
+  a.leaf_attached.assign(L, 1);
+  // Spatial turbulence phases at the rest centres: the tree moves little against the
+  // length scale of the eddies, so they are evaluated once (flying leaves use their centre).
+  const int N = wind.mode_count();
+  cluster_turbulence_sin.resize(C * N);
+  cluster_turbulence_cos.resize(C * N);
+  for (size_t c = 0; c < C; ++c)
+    wind.spatial_phases(a.cluster_rest_centre.col(c), &cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N]);
+}
+
+// Weights are vertex masses; a cluster without mass (all members anchored or massless)
+// falls back to equal weights, so its shape is still defined.
+template <typename Real>
+void rebuild_cluster_rest(const SolverModel<Real>& model, Attachment<Real>& a, uint32_t c) {
+  const TreeModel& tree = model.tree;
+  const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+  double total = 0;
+  for (uint32_t s = begin; s < end; ++s)
+    if (a.member_in_fit[s]) total += tree.vertex_mass[tree.cluster_members[s]];
+  const bool uniform = !(total > 0);
+  auto weight = [&](uint32_t s) {
+    return !a.member_in_fit[s] ? 0.0 : uniform ? 1.0 : tree.vertex_mass[tree.cluster_members[s]];
+  };
+  if (uniform) total = 0;
+  if (uniform)
+    for (uint32_t s = begin; s < end; ++s) total += weight(s);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (uint32_t s = begin; s < end; ++s)
+    centre += (weight(s) / total) * tree.rest_positions.col(tree.cluster_members[s]);
+  a.cluster_rest_centre.col(c) = centre;
+  for (uint32_t s = begin; s < end; ++s) {
+    const Eigen::Vector3d exact = a.member_active[s]
+                                      ? Eigen::Vector3d(tree.rest_positions.col(tree.cluster_members[s]) - centre)
+                                      : Eigen::Vector3d::Zero();
+    a.member_offset.row(s) = exact.transpose().template cast<Real>();
+    a.member_centre_weight[s] = static_cast<Real>(total > 0 ? weight(s) / total : 0.0);
+  }
+  const Eigen::Vector3d point =
+      a.cluster_pin_slot[c] == kNone
+          ? Eigen::Vector3d::Zero()
+          : Eigen::Vector3d(a.member_offset.row(model.cluster_pin_own_slot[c]).transpose().template cast<double>());
+  a.cluster_match_point.col(c) = point;
+  // The sums below are taken over the stored (Real) q and weights, the values the step reads.
+  double spread = 0;  // sum (w / sum w) |q - o|^2, m^2
+  Eigen::Vector3d offset_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+  for (uint32_t s = begin; s < end; ++s) {
+    const double share = a.member_centre_weight[s];
+    const Eigen::Vector3d q = a.member_offset.row(s).transpose().template cast<double>() - point;
+    spread += share * q.squaredNorm();
+    offset_sum += share * q;
+    // Each entry as w (q_i q_j): exactly symmetric, so R = I exactly at the rest pose.
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) moment(i, j) += share * (q[i] * q[j]);
+  }
+  // A single-point cluster has no shape: its A_pq is 0 and the rotation keeps its warm start.
+  const double scale = spread > 0 ? 1.0 / spread : 0.0;
+  a.cluster_match_scale[c] = scale;
+  moment *= scale;
+  a.cluster_offset_sum.col(c) = scale * offset_sum;
+  Eigen::Map<Eigen::Matrix3d>(&a.cluster_rest_moment(0, c)) = moment;
+}
+
+template <typename Real>
+StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
+  member_correction.setZero(m.M + 1, 3);
+  cluster_air.setZero(m.C, 3);
+  cluster_rotation_matrix.setZero(9, m.C);
+  island_fell_asleep.assign(m.I, 0);
+}
+
+template struct SolverModel<float>;
+template struct SolverModel<double>;
+template struct StepScratch<float>;
+template struct StepScratch<double>;
+template void rebuild_cluster_rest(const SolverModel<float>&, Attachment<float>&, uint32_t);
+template void rebuild_cluster_rest(const SolverModel<double>&, Attachment<double>&, uint32_t);
+
+}  // namespace treeanim

@@ -1,0 +1,155 @@
+#pragma once
+// The solver's data by lifetime (docs/design.md, "The solver's data"): SolverModel, built
+// once from the TreeModel and the options and read-only afterwards; Attachment, the rest data
+// that the attached leaves decide (a function of the model and SimState::leaf_attached);
+// StepScratch, per-step buffers (Box2D's b2StepContext). The state is SimState. Every type
+// is a template on `Real`, what the step state is stored in (docs/solver.md, "Precision").
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "sim/sim_options.h"
+#include "sim/sim_state.h"
+#include "sim/wind.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr int kMaxModes = 64;  // the scene reader caps wind.turbulence_modes here
+
+// Arrays of 3-vectors that the step reads or writes are (n x 3): a column per axis
+// (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
+template <typename Real>
+using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;
+
+// What the leaves' attachment decides: the clusters' rest data for the members they keep,
+// and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
+// detachment.cpp changes it when a leaf detaches, and rebuilds it from the model for a state
+// whose leaf_attached differs (a checkpoint): the result depends on the set of detached
+// leaves alone, never on the order in which they detached.
+template <typename Real>
+struct Attachment {
+  std::vector<uint8_t> leaf_attached;      // (L) the flags this was built for
+  // --- per membership (M), in cluster_members order ---
+  std::vector<uint8_t> member_active;      // (M) 0 once the membership was released (detached leaf)
+  // (M) 1 where the member's mass counts in its cluster's fit: active, and not an attached
+  // leaf's shared vertex in its branch (docs/solver.md, "Leaves")
+  std::vector<uint8_t> member_in_fit;
+  Rows3<Real> member_offset;               // (M x 3) m, rest offset q = x0 - t0 from the cluster's rest centre
+  // (M) w / sum(w): mass share in the cluster's centre; times cluster_match_scale, the weight
+  // of the member in A_pq
+  std::vector<Real> member_centre_weight;
+  // --- per cluster (C) ---
+  Eigen::Matrix3Xd cluster_rest_centre;    // (3 x C) m, mass-weighted rest centre t0
+  // (3 x C) m, rest position minus t0 of the point the fit rotates about, o: 0 (the centre)
+  // but for an attached leaf, which turns about its shared vertex
+  Eigen::Matrix3Xd cluster_match_point;
+  // (C) 1/m^2, 1 / sum((w / sum w) |q - o|^2): A_pq = sum s d (q - o)^T with s = (w / sum w)
+  // times it is of order 1 for any cluster size
+  std::vector<double> cluster_match_scale;
+  Eigen::Matrix3Xd cluster_offset_sum;     // (3 x C) 1/m, sum of s (q - o) over the members (o = 0: round-off only)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s (q - o)(q - o)^T, column-major: A_pq at rest
+  std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
+  std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
+  // --- per vertex (V) ---
+  std::vector<Real> vertex_global;         // (V) global rate per step (0: off, anchored, flying)
+  std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
+  std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
+  // (V) row of StepScratch::member_correction that holds the vertex's mean correction: its
+  // first active membership (M: anchored), so that a released row is never written
+  std::vector<uint32_t> vertex_pull_row;
+  std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
+};
+
+// Everything the step needs that never changes during a bake.
+template <typename Real>
+struct SolverModel {
+  const TreeModel& tree;                   // must outlive the solver
+  HsmOptions options;
+  WindField wind;
+  double frame_dt;                         // s
+  int substeps;
+  double h;                                // s, one substep
+  // m^2: (2 x the largest extent of the rest mesh)^2. An attached vertex of an anchored tree
+  // farther than that from rest means the tree came apart (docs/solver.md, "Runaway").
+  // Infinite without anchors (a free body may travel) and for a single-point model.
+  double runaway_distance2;
+  size_t V, C, M, L, I;
+  bool detach_enabled;                     // leaf_detach_force > 0 and the tree has leaves
+  // Threads only pay off above a few thousand memberships; below, the fork/join costs more
+  // than the work (results are identical either way).
+  bool parallel;
+
+  std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
+  std::vector<double> cluster_alpha;       // (C) local rate per step
+  std::vector<uint32_t> cluster_island;    // (C) island id
+  std::vector<uint32_t> cluster_pin_own_slot;  // (C) leaf pinned to a branch: membership of the shared vertex in the leaf
+  std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
+  std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
+  std::vector<Real> vertex_damping;        // (V) velocity factor per step
+  std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
+  std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
+  // --- islands (I): clusters connected through shared non-anchored vertices ---
+  std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
+  std::vector<uint32_t> island_vertices;        // non-anchored vertices, ascending per island
+
+  Attachment<Real> all_attached;           // the rest data of the bake's start
+
+  SolverModel(const TreeModel& tree, const HsmOptions& options, const WindOptions& wind, double frame_dt,
+              int substeps);
+};
+
+// The wind terms shared by every cluster at one time (set_air_time).
+struct AirSample {
+  Eigen::Vector3d base = Eigen::Vector3d::Zero();  // m/s, mean wind + gust
+  double scale = 0;                                // m/s, turbulence amplitude
+  double sin_b[kMaxModes] = {}, cos_b[kMaxModes] = {};  // temporal phases of the modes
+};
+
+// Per-step buffers: written before they are read within a step (no allocation in the step).
+template <typename Real>
+struct StepScratch {
+  // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
+  // anchor). Before the vertex prediction, a shared vertex's pull row takes its mean correction.
+  Rows3<Real> member_correction;
+  Rows3<Real> cluster_air;                 // (C x 3) m/s, air velocity at the cluster for the step being predicted
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of this step's fit, column-major
+  std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
+  AirSample air;                           // the wind at the time being sampled
+
+  explicit StepScratch(const SolverModel<Real>& model);
+};
+
+// CSR offsets (n+1) + this thread's index and the thread count => the contiguous range of
+// rows [begin, end) holding an equal share of the entries. Balances clusters of very
+// different sizes (trunk rings, 4-vertex leaves); results never depend on the split.
+inline std::pair<size_t, size_t> balanced_range(const std::vector<uint32_t>& offsets, int thread, int threads) {
+  const size_t n = offsets.size() - 1;
+  const double total = offsets.back();
+  auto row_at = [&](int t) {
+    if (t == 0) return size_t(0);
+    if (t == threads) return n;
+    const double target = total * t / threads;
+    return size_t(std::lower_bound(offsets.begin(), offsets.end(), target) - offsets.begin());
+  };
+  return {std::min(row_at(thread), n), std::min(row_at(thread + 1), n)};
+}
+
+// Cluster c, attachment, state => whether the cluster steps (a flying leaf always does).
+template <typename Real>
+inline bool cluster_awake(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                          size_t c) {
+  return attachment.cluster_flying[c] || !state.island_asleep[model.cluster_island[c]];
+}
+
+// Active members of cluster c => its rest centre, rest offsets and normalised weights, and
+// the rest moment about its match point (an attached leaf's shared vertex, else the centre).
+template <typename Real>
+void rebuild_cluster_rest(const SolverModel<Real>& model, Attachment<Real>& attachment, uint32_t c);
+
+}  // namespace treeanim
