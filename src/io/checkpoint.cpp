@@ -64,7 +64,8 @@ class CheckpointFile {
              const void* data) const {
     Handle space(check(H5Screate_simple(int(dims.size()), dims.data(), nullptr), std::string("make a space for ") + name),
                  H5Sclose);
-    Handle dataset(check(H5Dcreate2(group, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+    Handle dataset(check(H5Dcreate2(group, name, file_type, space.get(), H5P_DEFAULT,
+                                    untimed_creation(H5P_DATASET_CREATE).get(), H5P_DEFAULT),
                          std::string("create /state/") + name),
                    H5Dclose);
     hsize_t total = 1;
@@ -200,7 +201,8 @@ void write_checkpoint(const fs::path& path, const SimState& state, long long fra
   try {
     const auto lock = hdf5_lock();
     const CheckpointFile file(path, false);
-    Handle handle(file.check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "create the file"),
+    Handle handle(file.check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, untimed_creation(H5P_FILE_CREATE).get(),
+                                       H5P_DEFAULT), "create the file"),
                   H5Fclose);
     const hid_t root = handle.get();
     const int64_t frame_index = frame;
@@ -213,7 +215,8 @@ void write_checkpoint(const fs::path& path, const SimState& state, long long fra
     file.attribute(root, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &state.time);
     file.string_attribute(root, "precision", key.float_precision ? "float" : "double");
     file.attribute(root, "predicted", H5T_STD_U8LE, H5T_NATIVE_UINT8, &predicted);
-    Handle group(file.check(H5Gcreate2(root, "/state", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "create /state"), H5Gclose);
+    Handle group(file.check(H5Gcreate2(root, "/state", H5P_DEFAULT, untimed_creation(H5P_GROUP_CREATE).get(), H5P_DEFAULT),
+                            "create /state"), H5Gclose);
     const hid_t g = group.get();
     const hsize_t V = state.positions.cols(), C = state.cluster_rotations.cols();
     file.array(g, "positions", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {V, 3}, state.positions.data());

@@ -35,7 +35,7 @@ class Hdf5Sink final : public FrameSink {
     const auto lock = hdf5_lock();
     rest_ = rest_positions_f32(model_);
     const fs::path temporary = staged_.stage(path_);
-    file_ = Handle(check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+    file_ = Handle(check(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, untimed_creation(H5P_FILE_CREATE).get(), H5P_DEFAULT),
                          "create the file"), H5Fclose);
     write_root_attributes();
     write_string_dataset(file_.get(), "scene", info_.scene_json);
@@ -134,7 +134,8 @@ class Hdf5Sink final : public FrameSink {
   void write_string_dataset(hid_t group, const char* name, const std::string& value) const {
     const Handle type = string_type();
     Handle space(check(H5Screate(H5S_SCALAR), "make a scalar space"), H5Sclose);
-    Handle dataset(check(H5Dcreate2(group, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+    Handle dataset(check(H5Dcreate2(group, name, type.get(), space.get(), H5P_DEFAULT,
+                                    untimed_creation(H5P_DATASET_CREATE).get(), H5P_DEFAULT),
                          std::string("create /") + name), H5Dclose);
     const char* text = value.c_str();
     check_status(H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &text),
@@ -142,7 +143,7 @@ class Hdf5Sink final : public FrameSink {
   }
 
   Handle create_group(const char* name) const {
-    return Handle(check(H5Gcreate2(file_.get(), name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+    return Handle(check(H5Gcreate2(file_.get(), name, H5P_DEFAULT, untimed_creation(H5P_GROUP_CREATE).get(), H5P_DEFAULT),
                         std::string("create group ") + name), H5Gclose);
   }
 
@@ -151,7 +152,8 @@ class Hdf5Sink final : public FrameSink {
                    std::vector<hsize_t> dims, const void* data) const {
     Handle space(check(H5Screate_simple(int(dims.size()), dims.data(), nullptr), "make a space for " + name),
                  H5Sclose);
-    Handle dataset(check(H5Dcreate2(group, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
+    Handle dataset(check(H5Dcreate2(group, name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                                    untimed_creation(H5P_DATASET_CREATE).get(),
                                     H5P_DEFAULT), "create " + name), H5Dclose);
     hsize_t total = 1;
     for (hsize_t d : dims) total *= d;
@@ -213,7 +215,7 @@ class Hdf5Sink final : public FrameSink {
     }
     Handle space(check(H5Screate_simple(int(dims.size()), dims.data(), max_dims.data()), "make a frame space"),
                  H5Sclose);
-    Handle properties(check(H5Pcreate(H5P_DATASET_CREATE), "make dataset properties"), H5Pclose);
+    Handle properties = untimed_creation(H5P_DATASET_CREATE);
     check_status(H5Pset_chunk(properties.get(), int(chunk.size()), chunk.data()), std::string("chunk ") + name);
     if (level > 0) {
       check_status(H5Pset_shuffle(properties.get()), "enable shuffle");

@@ -1,5 +1,7 @@
 #include "io/hdf5_support.h"
 
+#include <stdexcept>
+
 namespace treeanim {
 
 namespace {
@@ -36,6 +38,13 @@ std::string hdf5_error_text() {
     text = text.substr(start + marker.size(), end == std::string::npos ? std::string::npos : end - start - marker.size());
   }
   return text;
+}
+
+Handle untimed_creation(hid_t property_class) {
+  Handle properties(H5Pcreate(property_class), H5Pclose);
+  if (properties.get() < 0 || H5Pset_obj_track_times(properties.get(), false) < 0)
+    throw std::runtime_error("HDF5 could not make creation properties (" + hdf5_error_text() + ")");
+  return properties;
 }
 
 }  // namespace treeanim

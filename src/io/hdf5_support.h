@@ -42,4 +42,9 @@ class Handle {
   herr_t (*close_)(hid_t) = nullptr;
 };
 
+// Creation properties of `property_class` (H5P_FILE_CREATE, H5P_GROUP_CREATE, H5P_DATASET_CREATE)
+// without object times: HDF5 stamps every object with the clock by default, and then the same
+// bake would not write the same bytes twice. Throws std::runtime_error when HDF5 refuses.
+Handle untimed_creation(hid_t property_class);
+
 }  // namespace treeanim
