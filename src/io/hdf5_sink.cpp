@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/errors.h"
@@ -24,9 +25,7 @@ namespace {
 class Hdf5Sink final : public FrameSink {
  public:
   Hdf5Sink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
-      : options_(options), path_(std::move(path)), model_(model), info_(info),
-        // int16 when the solver's bound on displacements fits in it at this step, else int32.
-        quantized_int16_(options.quantize > 0 && std::round(info.displacement_bound / options.quantize) <= 32767) {}
+      : options_(options), path_(std::move(path)), model_(model), info_(info) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
@@ -50,7 +49,7 @@ class Hdf5Sink final : public FrameSink {
     const hsize_t n = model_.vertex_count();
     append(time_.get(), {}, H5T_NATIVE_DOUBLE, &frame.time);
     if (options_.quantize > 0) {
-      quantize(frame);
+      if (!quantize(frame) && quantized_int16_) widen_quantized();
       append(positions_.get(), {n, 3}, H5T_NATIVE_INT32, quantized_.data());
     } else {
       append(positions_.get(), {n, 3}, H5T_NATIVE_FLOAT, frame.positions.data());
@@ -233,10 +232,7 @@ class Hdf5Sink final : public FrameSink {
     // Times are tiny: 1024 per chunk keeps the chunk index small for long bakes.
     time_ = create_frame_dataset(g, "time", H5T_IEEE_F64LE, {}, 1024, 0);
     if (options_.quantize > 0) {
-      // Integers are only worth storing shuffled and deflated (level 4 unless one is given).
-      positions_ = create_frame_dataset(g, "displacement_quantized", quantized_int16_ ? H5T_STD_I16LE : H5T_STD_I32LE,
-                                        {n, 3}, 1, level > 0 ? level : 4);
-      write_attribute("step", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &options_.quantize, positions_.get());
+      positions_ = create_quantized_dataset(g, "displacement_quantized", H5T_STD_I16LE);
     } else {
       positions_ = create_frame_dataset(g, "positions", H5T_IEEE_F32LE, {n, 3}, 1, level);
     }
@@ -249,34 +245,84 @@ class Hdf5Sink final : public FrameSink {
 
   // Grows `dataset` [k, frame_shape...] by one frame and writes `data` (one frame) there.
   void append(hid_t dataset, const std::vector<hsize_t>& frame_shape, hid_t memory_type, const void* data) const {
-    std::vector<hsize_t> start(frame_shape.size() + 1, 0), count{1}, dims{frames_written_ + 1};
-    start[0] = frames_written_;
-    count.insert(count.end(), frame_shape.begin(), frame_shape.end());
+    write_frame(dataset, frames_written_, frame_shape, memory_type, data);
+  }
+
+  // Writes frame `index` of `dataset` [k, frame_shape...], growing it to index + 1 frames.
+  void write_frame(hid_t dataset, hsize_t index, const std::vector<hsize_t>& frame_shape, hid_t memory_type,
+                   const void* data) const {
+    std::vector<hsize_t> dims{index + 1};
     dims.insert(dims.end(), frame_shape.begin(), frame_shape.end());
     check_status(H5Dset_extent(dataset, dims.data()), "extend a frame dataset");
+    const auto [file_space, memory_space] = frame_spaces(dataset, index, frame_shape);
+    check_status(H5Dwrite(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT, data),
+                 "write frame " + std::to_string(index));
+  }
+
+  void read_frame(hid_t dataset, hsize_t index, const std::vector<hsize_t>& frame_shape, hid_t memory_type,
+                  void* data) const {
+    const auto [file_space, memory_space] = frame_spaces(dataset, index, frame_shape);
+    check_status(H5Dread(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT, data),
+                 "read frame " + std::to_string(index));
+  }
+
+  // The file space of `dataset` with frame `index` selected, and a memory space of one frame.
+  std::pair<Handle, Handle> frame_spaces(hid_t dataset, hsize_t index, const std::vector<hsize_t>& frame_shape) const {
+    std::vector<hsize_t> start(frame_shape.size() + 1, 0), count{1};
+    start[0] = index;
+    count.insert(count.end(), frame_shape.begin(), frame_shape.end());
     Handle file_space(check(H5Dget_space(dataset), "get a frame space"), H5Sclose);
     check_status(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
                  "select a frame");
     Handle memory_space(check(H5Screate_simple(int(count.size()), count.data(), nullptr), "make a frame space"),
                         H5Sclose);
-    check_status(H5Dwrite(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT, data),
-                 "write frame " + std::to_string(start[0]));
+    return {std::move(file_space), std::move(memory_space)};
   }
 
-  // frame => quantized_: (position - rest) / step rounded to the nearest integer. A value beyond
-  // the stored type fails the bake rather than being clipped (a file never lies).
-  void quantize(const FrameData& frame) {
-    const double limit = quantized_int16_ ? 32767.0 : 2147483647.0;
+  // Integers are only worth storing shuffled and deflated (level 4 unless one is given).
+  Handle create_quantized_dataset(hid_t group, const char* name, hid_t file_type) const {
+    Handle dataset = create_frame_dataset(group, name, file_type, {model_.vertex_count(), 3}, 1,
+                                          options_.compression > 0 ? options_.compression : 4);
+    write_attribute("step", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &options_.quantize, dataset.get());
+    return dataset;
+  }
+
+  // frame => quantized_: (position - rest) / step rounded to the nearest integer; returns false
+  // when a value does not fit in int16. A value beyond int32 fails the bake rather than being
+  // clipped (a file never lies).
+  bool quantize(const FrameData& frame) {
     quantized_.resize(rest_.size());
+    bool fits_int16 = true;
     for (size_t i = 0; i < rest_.size(); ++i) {
       const double q = std::nearbyint((double(frame.positions[i]) - double(rest_[i])) / options_.quantize);
-      if (!(std::fabs(q) <= limit))
+      if (!(std::fabs(q) <= 2147483647.0))
         throw OutputError(path_.string() + ": frame " + std::to_string(frame.frame) + " moves vertex " +
                           std::to_string(i / 3) + " " + std::to_string(double(frame.positions[i]) - rest_[i]) +
-                          " m from rest, beyond what quantize = " + std::to_string(options_.quantize) + " m holds in " +
-                          (quantized_int16_ ? "int16" : "int32") + "; raise quantize or leave it out");
+                          " m from rest, beyond what quantize = " + std::to_string(options_.quantize) +
+                          " m holds in int32; raise quantize or leave it out");
+      fits_int16 = fits_int16 && std::fabs(q) <= 32767.0;
       quantized_[i] = static_cast<int32_t>(q);
     }
+    return fits_int16;
+  }
+
+  // The first frame past int16: the frames so far move to an int32 dataset of the same name.
+  // Their int16 copy stays in the file as unused space (HDF5 does not give it back), once.
+  void widen_quantized() {
+    Handle group(check(H5Gopen2(file_.get(), "/frames", H5P_DEFAULT), "open /frames"), H5Gclose);
+    Handle wide = create_quantized_dataset(group.get(), "displacement_quantized_int32", H5T_STD_I32LE);
+    std::vector<int32_t> frame(rest_.size());
+    const hsize_t n = model_.vertex_count();
+    for (hsize_t k = 0; k < frames_written_; ++k) {
+      read_frame(positions_.get(), k, {n, 3}, H5T_NATIVE_INT32, frame.data());
+      write_frame(wide.get(), k, {n, 3}, H5T_NATIVE_INT32, frame.data());
+    }
+    if (!positions_.reset()) fail("close the int16 displacements");
+    check_status(H5Ldelete(group.get(), "displacement_quantized", H5P_DEFAULT), "remove the int16 displacements");
+    check_status(H5Lmove(group.get(), "displacement_quantized_int32", group.get(), "displacement_quantized", H5P_DEFAULT,
+                         H5P_DEFAULT), "rename the int32 displacements");
+    positions_ = std::move(wide);
+    quantized_int16_ = false;
   }
 
   bool close_datasets() {
@@ -291,7 +337,7 @@ class Hdf5Sink final : public FrameSink {
   fs::path path_;
   const TreeModel& model_;
   BakeInfo info_;
-  bool quantized_int16_;           // the quantized displacements are stored as int16 (else int32)
+  bool quantized_int16_ = true;    // the quantized displacements are stored as int16 (else int32)
   std::vector<float> rest_;        // (V*3) m, float32 rest pose as stored in /mesh
   std::vector<int32_t> quantized_; // (V*3) scratch: one frame's quantized displacements
   // positions_ is /frames/positions, or /frames/displacement_quantized when quantized.

@@ -4,7 +4,6 @@
 // beside its target and renames it when complete; abort() removes every temporary.
 #include <cstdint>
 #include <filesystem>
-#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -24,9 +23,6 @@ struct BakeInfo {
   long long frame_count = 0;   // frames the bake will hand to push()
   int substeps = 1;
   uint64_t seed = 0;
-  // m: no written vertex is farther from its rest position (the solver's runaway guard);
-  // infinity when nothing bounds it (leaves that detach fly on).
-  double displacement_bound = std::numeric_limits<double>::infinity();
 };
 
 // One simulated frame, converted to float for output.

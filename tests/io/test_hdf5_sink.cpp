@@ -3,7 +3,6 @@
 #include <hdf5.h>
 
 #include <cmath>
-#include <limits>
 
 #include "common/errors.h"
 #include "io/vertex_normals.h"
@@ -217,39 +216,40 @@ TEST_F(Hdf5Sink, CompressionVelocitiesAndFrameStep) {
 }
 
 // "quantize": format_version 2, /frames/displacement_quantized instead of /frames/positions,
-// int16 when the bake's displacement bound fits at the step, and rest + step * q within half a
-// step of every pushed position; "normals": /frames/normals exactly as OutputSet computed them.
+// int16 while every value fits and int32 from the first frame that does not (the frames before
+// it moved over), and rest + step * q within half a step of every pushed position; "normals":
+// /frames/normals exactly as OutputSet computed them.
 TEST_F(Hdf5Sink, QuantizedDisplacementsAndNormals) {
-  const TreeModel m = small_model();
-  for (const double bound : {1.0, std::numeric_limits<double>::infinity()}) {
-    SCOPED_TRACE(bound);
+  const TreeModel m = test::small_model();
+  // The frames move up to 13 mm x frame x 3/7: at 1 mm every frame fits int16; at 1 um frame 6
+  // (33,400 steps) does not.
+  for (const double step : {1e-3, 1e-6}) {
+    SCOPED_TRACE(step);
     OutputOptions o = test::output("hdf5", "bake.h5");
-    o.quantize = 1e-3;
+    o.quantize = step;
     o.normals = true;
-    BakeInfo info = small_info(4, 0);
-    info.displacement_bound = bound;  // 1 m / 1 mm = 1000 steps: int16
-    test::bake({o}, dir_, m, info);
+    test::bake({o}, dir_, m, small_info(8, 0));
 
     const hid_t file = H5Fopen((dir_ / "bake.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     ASSERT_GE(file, 0);
     EXPECT_EQ(read_attribute<int32_t>(file, "format_version", H5T_NATIVE_INT32), 2);
     EXPECT_EQ(H5Lexists(file, "/frames/positions", H5P_DEFAULT), 0);
+    EXPECT_EQ(H5Lexists(file, "/frames/displacement_quantized_int32", H5P_DEFAULT), 0);
     const Dataset d = describe(file, "/frames/displacement_quantized");
-    expect_type(d, H5T_INTEGER, std::isinf(bound) ? 4 : 2, H5T_SGN_2);
-    EXPECT_EQ(d.dims, (std::vector<hsize_t>{4, 6, 3}));
+    expect_type(d, H5T_INTEGER, step == 1e-3 ? 2 : 4, H5T_SGN_2);
+    EXPECT_EQ(d.dims, (std::vector<hsize_t>{8, 6, 3}));
     EXPECT_EQ(d.chunk, (std::vector<hsize_t>{1, 6, 3}));
     EXPECT_EQ(d.filters, (std::vector<H5Z_filter_t>{H5Z_FILTER_SHUFFLE, H5Z_FILTER_DEFLATE}));
     const hid_t set = H5Dopen2(file, "/frames/displacement_quantized", H5P_DEFAULT);
-    const double step = read_attribute<double>(set, "step", H5T_NATIVE_DOUBLE);
+    EXPECT_EQ(read_attribute<double>(set, "step", H5T_NATIVE_DOUBLE), step);
     H5Dclose(set);
-    EXPECT_EQ(step, 1e-3);
     const auto rest = read_all<float>(file, "/mesh/rest_positions", H5T_NATIVE_FLOAT);
     const auto q = read_all<int32_t>(file, "/frames/displacement_quantized", H5T_NATIVE_INT32);
     const auto normals = read_all<float>(file, "/frames/normals", H5T_NATIVE_FLOAT);
-    ASSERT_EQ(q.size(), 4u * 18u);
-    ASSERT_EQ(normals.size(), 4u * 18u);
+    ASSERT_EQ(q.size(), 8u * 18u);
+    ASSERT_EQ(normals.size(), 8u * 18u);
     std::vector<float> expected_normals;
-    for (size_t k = 0; k < 4; ++k) {
+    for (size_t k = 0; k < 8; ++k) {
       const FrameData frame = small_frame(m, long(k));
       for (size_t i = 0; i < 18; ++i)
         EXPECT_LE(std::fabs(double(rest[i]) + step * q[18 * k + i] - double(frame.positions[i])), 0.5 * step) << i;
@@ -262,19 +262,23 @@ TEST_F(Hdf5Sink, QuantizedDisplacementsAndNormals) {
   }
 }
 
-// A displacement beyond the stored integer type fails the bake (exit 4), never clipped.
+// A displacement beyond int32 fails the bake (exit 4) and leaves nothing, never clipped.
 TEST_F(Hdf5Sink, QuantizedOverflowFailsTheBake) {
   const TreeModel m = small_model();
   OutputOptions o = test::output("hdf5", "bake.h5");
-  o.quantize = 1e-7;  // the frames move up to 28 mm: 280,000 steps, past int16
-  BakeInfo info = small_info(6, 0);
-  info.displacement_bound = 1e-3;  // a bound that does not hold: int16 is chosen
+  o.quantize = 1e-9;
   try {
-    test::bake({o}, dir_, m, info);
+    OutputSet set({o}, dir_, m, small_info(2, 0));
+    set.begin();
+    set.push(small_frame(m, 0));
+    FrameData far = small_frame(m, 1);
+    far.positions[6] += 10.0f;  // 10 m: 1e10 steps of 1 nm
+    set.push(far);
+    set.finish();
     FAIL() << "no error";
   } catch (const OutputError& e) {
-    EXPECT_NE(std::string(e.what()).find("beyond what quantize = 0.000000 m holds in int16"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("frame 1 moves vertex 2 "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("holds in int32; raise quantize"), std::string::npos) << e.what();
   }
   EXPECT_EQ(entries(), std::vector<std::string>{});
 }
