@@ -26,8 +26,10 @@ set(io_options_outputs "[{\"format\":\"hdf5\",\"path\":\"plain.h5\",\"normals\":
 {\"format\":\"glb\",\"path\":\"normals.glb\",\"normals\":true},{\"format\":\"mdd\",\"path\":\"tree.mdd\"},\
 {\"format\":\"vat\",\"path\":\"vat/tree\"},{\"format\":\"vat\",\"path\":\"vat_half/tree\",\"precision\":\"half\",\"texture_width\":100},\
 {\"format\":\"skinned_glb\",\"path\":\"skinned.glb\"},{\"format\":\"skinned_glb\",\"path\":\"skinned4.glb\",\"max_joints\":4}]")
+# And a seamless loop of the same tree (tests/clients/scenes/loop.json).
+set(io_loop_dir ${io_bake_dir}/loop)
 add_test(NAME io_clients_bake
-         COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}'"
+         COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}' && exec '$<TARGET_FILE:treeanim>' run '${io_clients}/scenes/loop.json' -o '${io_loop_dir}' --quiet"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(io_clients_bake PROPERTIES LABELS "io;clients" FIXTURES_SETUP io_bake TIMEOUT 120)
 
@@ -41,6 +43,11 @@ io_client_test(io_clients_h5py "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_h
 io_client_test(io_clients_bake_options "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_bake_options.py
                ${io_options_dir}/plain.h5 --quantized ${io_options_dir}/quantized.h5 --mdd ${io_options_dir}/tree.mdd
                --obj ${io_options_dir}/obj/tree --glb ${io_options_dir}/normals.glb)
+
+# The loop: one period at its own times, a seam within twice the median frame step, the GLB's
+# closing key, the VAT's flag.
+io_client_test(io_clients_loop "${TREEANIM_SYSTEM_PYTHON}" ${io_clients}/check_loop.py
+               ${io_loop_dir}/loop.h5 ${io_loop_dir}/loop.glb ${io_loop_dir}/vat/loop.json)
 
 # Golden bake: positions, velocities and every other number within 1e-5 (m, m/s, kg), strings
 # and attributes exact. scripts/update-golden regenerates tests/golden/*.h5 on purpose.
@@ -56,7 +63,7 @@ io_client_test(io_clients_gltf_validator "${TREEANIM_NODE}" ${io_clients}/node/v
                ${io_bake_dir}/small_tree.glb ${io_bake_dir}/gltf/small_tree.0000.glb
                ${io_bake_dir}/gltf/small_tree.0006.glb ${io_options_dir}/normals.glb
                ${io_options_dir}/gltf/tree.0006.glb ${io_options_dir}/vat/tree.glb ${io_options_dir}/skinned.glb
-               ${io_options_dir}/skinned4.glb)
+               ${io_options_dir}/skinned4.glb ${io_loop_dir}/loop.glb ${io_loop_dir}/skinned.glb)
 
 find_program(TREEANIM_BLENDER blender)
 io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --python

@@ -7,6 +7,7 @@
 
 #include "cli/bake_start.h"
 #include "cli/commands.h"
+#include "cli/loop_bake.h"
 #include "cli/prepare_tree.h"
 #include "cli/signals.h"
 #include "common/errors.h"
@@ -84,6 +85,9 @@ int run_command(const RunRequest& request) {
   info.frame_count = write_last - write_first + 1;
   info.substeps = scene.time.substeps;
   info.seed = scene.seed;
+  // Only a bake of the whole loop closes it; --frames writes a part of it.
+  info.loop = scene.time.loop && write_first == first && write_last == last;
+  info.loop_end_time = double(last + 1) / scene.time.fps;
   OutputSet outputs(scene.outputs, request.out_dir, tree.model, info);
 
   const double frame_dt = 1.0 / scene.time.fps;
@@ -103,6 +107,11 @@ int run_command(const RunRequest& request) {
                   outputs.wants_velocities()};
   BakeStart start = find_bake_start(plan, simulator, log);
   SimState& state = start.state;
+  // A loop starts from the tree's periodic motion: whole periods run first (not on a resume,
+  // whose checkpoint lies past them).
+  LoopWarmup warmup;
+  if (scene.time.loop && start.checkpoint.empty()) warmup = warm_up_loop(simulator, state, first, scene.time.frames, log);
+  SeamMeter seam;
   if (!start.checkpoint.empty() && log)
     std::fprintf(log, "treeanim: resuming at frame %lld from %s\n", start.frame, start.checkpoint.c_str());
   std::optional<FrameJournal> journal;  // this bake's, when it writes checkpoints
@@ -119,7 +128,9 @@ int run_command(const RunRequest& request) {
   // The frames written before the checkpoint are not in it: the journal gives them back.
   for (long long k = write_first; k < start.frame && k <= write_last; ++k) {
     FrameJournal& source = journal ? *journal : *start.journal;
-    outputs.push(source.read(k - write_first));
+    FrameData data = source.read(k - write_first);
+    seam.add(data.positions);
+    outputs.push(std::move(data));
   }
 
   Progress progress(write_last - start.frame + 1, request.verbosity, stderr);
@@ -136,6 +147,8 @@ int run_command(const RunRequest& request) {
     }
     if (frame >= write_first) {
       FrameData data = make_frame(state, frame, outputs.wants_velocities());
+      if (scene.time.loop) data.time = double(frame) * frame_dt;  // the warm-up ran periods ahead
+      seam.add(data.positions);
       if (journal) journal->append(data);
       outputs.push(std::move(data));
     }
@@ -157,6 +170,11 @@ int run_command(const RunRequest& request) {
                 seconds_since(wall_start), seconds_since(sim_start));
     for (const auto& path : outputs.final_paths()) std::printf("  wrote %s\n", path.string().c_str());
     for (const auto& [path, line] : outputs.reports()) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
+    if (info.loop)
+      std::printf("  loop: %d warm-up period%s%s; seam %.3g m, %.2f x the median frame step (%.3g m)\n",
+                  warmup.periods, warmup.periods == 1 ? "" : "s",
+                  warmup.converged || !start.checkpoint.empty() ? "" : " (the motion did not repeat: baked as it stands)",
+                  seam.seam(), seam.median_step() > 0 ? seam.seam() / seam.median_step() : 0.0, seam.median_step());
   }
   return 0;
 }

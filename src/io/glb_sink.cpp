@@ -51,9 +51,17 @@ struct Bounds {
 
 // Everything the JSON chunk says, so it can be rendered with placeholders (to reserve room)
 // and for real (in finish()).
+// What an animated GLB carries besides positions.
+struct GlbLayout {
+  bool normals = false;  // NORMAL on the mesh and on every target
+  bool loop = false;     // a closing key brings the first frame back at the loop's end
+  // Animation keys for f frames: one per frame, and the closing one of a loop.
+  uint64_t keys(uint64_t f) const { return f + (loop && f > 0 ? 1 : 0); }
+};
+
 struct GlbContent {
   size_t vertices = 0, triangles = 0, frames = 0;
-  bool normals = false;                   // NORMAL on the mesh and on every target
+  GlbLayout layout;
   std::string generator;
   std::optional<Bounds> rest;             // nullopt: render the longest placeholder numbers
   std::vector<Bounds> targets;            // (frames) displacement bounds
@@ -72,14 +80,15 @@ nlohmann::json bounds_json(const std::array<float, 3>& values, bool placeholder)
 // Bytes of one vertex attribute per vertex set that a frame's target holds: 1, or 2 with normals.
 uint64_t target_sets(bool normals) { return normals ? 2 : 1; }
 
-uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames, bool normals) {
-  const uint64_t n = vertices, f = frames, sets = target_sets(normals);
-  return 12 * uint64_t(triangles) + 12 * n * sets + 8 * n + 12 * n * sets * f + 4 * f + 4 * f * f;
+uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames, const GlbLayout& layout) {
+  const uint64_t n = vertices, f = frames, sets = target_sets(layout.normals), keys = layout.keys(f);
+  return 12 * uint64_t(triangles) + 12 * n * sets + 8 * n + 12 * n * sets * f + 4 * keys + 4 * f * keys;
 }
 
 std::string render_json(const GlbContent& c) {
   using nlohmann::json;
-  const uint64_t n = c.vertices, f = c.frames, t = c.triangles, sets = target_sets(c.normals);
+  const uint64_t n = c.vertices, f = c.frames, t = c.triangles, sets = target_sets(c.layout.normals);
+  const uint64_t keys = c.layout.keys(f);
   const uint64_t indices_bytes = 12 * t, rest_bytes = 12 * n * sets, uv_bytes = 8 * n;
   const uint64_t frame_bytes = 12 * n * sets, targets_bytes = frame_bytes * f;
   const uint64_t targets_offset = indices_bytes + rest_bytes + uv_bytes;
@@ -101,7 +110,7 @@ std::string render_json(const GlbContent& c) {
       {{"bufferView", 2}, {"componentType", kFloat}, {"count", n}, {"type", "VEC2"}},
   });
   json primitive = {{"attributes", {{"POSITION", 1}, {"TEXCOORD_0", 2}}}, {"indices", 0}, {"mode", 4}};
-  if (c.normals) {
+  if (c.layout.normals) {
     primitive["attributes"]["NORMAL"] = accessors.size();
     accessors.push_back({{"bufferView", 1}, {"byteOffset", 12 * n}, {"componentType", kFloat}, {"count", n},
                          {"type", "VEC3"}});
@@ -118,8 +127,8 @@ std::string render_json(const GlbContent& c) {
     // Several target accessors share one view: glTF then requires its byteStride.
     views.push_back({{"buffer", 0}, {"byteOffset", targets_offset}, {"byteLength", targets_bytes},
                      {"byteStride", 12}, {"target", kArrayBuffer}});
-    views.push_back({{"buffer", 0}, {"byteOffset", times_offset}, {"byteLength", 4 * f}});
-    views.push_back({{"buffer", 0}, {"byteOffset", times_offset + 4 * f}, {"byteLength", 4 * f * f}});
+    views.push_back({{"buffer", 0}, {"byteOffset", times_offset}, {"byteLength", 4 * keys}});
+    views.push_back({{"buffer", 0}, {"byteOffset", times_offset + 4 * keys}, {"byteLength", 4 * f * keys}});
     json targets = json::array();
     for (uint64_t k = 0; k < f; ++k) {
       const Bounds bounds = c.placeholder ? Bounds{} : c.targets[k];
@@ -127,7 +136,7 @@ std::string render_json(const GlbContent& c) {
       accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k}, {"componentType", kFloat},
                            {"count", n}, {"type", "VEC3"}, {"min", bounds_json(bounds.min, c.placeholder)},
                            {"max", bounds_json(bounds.max, c.placeholder)}});
-      if (c.normals) {  // glTF asks bounds of POSITION only
+      if (c.layout.normals) {  // glTF asks bounds of POSITION only
         targets.back()["NORMAL"] = accessors.size();
         accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k + 12 * n}, {"componentType", kFloat},
                              {"count", n}, {"type", "VEC3"}});
@@ -135,10 +144,10 @@ std::string render_json(const GlbContent& c) {
     }
     const size_t times_accessor = accessors.size();
     const double longest = -1.7976931348623157e308;
-    accessors.push_back({{"bufferView", 4}, {"componentType", kFloat}, {"count", f}, {"type", "SCALAR"},
+    accessors.push_back({{"bufferView", 4}, {"componentType", kFloat}, {"count", keys}, {"type", "SCALAR"},
                          {"min", json::array({c.placeholder ? longest : double(c.time_min)})},
                          {"max", json::array({c.placeholder ? longest : double(c.time_max)})}});
-    accessors.push_back({{"bufferView", 5}, {"componentType", kFloat}, {"count", f * f}, {"type", "SCALAR"}});
+    accessors.push_back({{"bufferView", 5}, {"componentType", kFloat}, {"count", f * keys}, {"type", "SCALAR"}});
     primitive["targets"] = targets;
     mesh["weights"] = json(std::vector<double>(f, 0.0));
     mesh["extras"] = {{"targetNames", c.target_names}};
@@ -151,7 +160,7 @@ std::string render_json(const GlbContent& c) {
   }
   mesh["primitives"] = json::array({primitive});
   document["meshes"] = json::array({mesh});
-  document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f, c.normals)}}});
+  document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f, c.layout)}}});
   document["bufferViews"] = views;
   document["accessors"] = accessors;
   std::string text = document.dump();
@@ -170,10 +179,10 @@ std::vector<std::string> target_names(const FrameSelection& selection) {
 }
 
 // The JSON with every number at its longest, for `frames` frames named as in `names`.
-GlbContent placeholder_content(const TreeModel& model, const std::string& generator, bool normals, size_t frames,
-                               std::vector<std::string> names) {
+GlbContent placeholder_content(const TreeModel& model, const std::string& generator, const GlbLayout& layout,
+                               size_t frames, std::vector<std::string> names) {
   GlbContent content;
-  content.normals = normals;
+  content.layout = layout;
   content.vertices = model.vertex_count();
   content.triangles = model.triangle_count();
   content.frames = frames;
@@ -188,8 +197,8 @@ GlbContent placeholder_content(const TreeModel& model, const std::string& genera
 // each further frame adds, plus room for the few totals whose digits grow with the frame count.
 class GlbSizeBound {
  public:
-  GlbSizeBound(const TreeModel& model, const std::string& generator, bool normals)
-      : vertices_(model.vertex_count()), triangles_(model.triangle_count()), normals_(normals) {
+  GlbSizeBound(const TreeModel& model, const std::string& generator, const GlbLayout& layout)
+      : vertices_(model.vertex_count()), triangles_(model.triangle_count()), layout_(layout) {
     using nlohmann::json;
     constexpr uint64_t kMax = std::numeric_limits<uint64_t>::max();
     constexpr double kLongest = -1.7976931348623157e308;
@@ -197,19 +206,19 @@ class GlbSizeBound {
     const json accessor = {{"bufferView", 3}, {"byteOffset", kMax}, {"componentType", kFloat}, {"count", kMax},
                            {"type", "VEC3"}, {"min", longest3}, {"max", longest3}};
     json target = {{"POSITION", kMax}};
-    if (normals) target["NORMAL"] = kMax;
+    if (layout.normals) target["NORMAL"] = kMax;
     const json name = "frame_-9223372036854775808";
-    per_frame_json_ = target_sets(normals) * (accessor.dump().size() + 1) + target.dump().size() + name.dump().size() +
-                      json(0.0).dump().size() + 3;
-    no_frame_json_ = render_json(placeholder_content(model, generator, normals, 0, {})).size();
-    one_frame_json_ = render_json(placeholder_content(model, generator, normals, 1, {name.get<std::string>()})).size();
+    per_frame_json_ = target_sets(layout.normals) * (accessor.dump().size() + 1) + target.dump().size() +
+                      name.dump().size() + json(0.0).dump().size() + 3;
+    no_frame_json_ = render_json(placeholder_content(model, generator, layout, 0, {})).size();
+    one_frame_json_ = render_json(placeholder_content(model, generator, layout, 1, {name.get<std::string>()})).size();
   }
 
   uint64_t bytes(uint64_t frames) const {
     // Totals that grow with the frame count: view and buffer lengths and offsets, counts.
     constexpr uint64_t kGrowingDigits = 16 * 20;
     const uint64_t json = frames == 0 ? no_frame_json_ : one_frame_json_ + (frames - 1) * per_frame_json_ + kGrowingDigits;
-    return glb_bytes(json + 3, bin_bytes(vertices_, triangles_, frames, normals_));
+    return glb_bytes(json + 3, bin_bytes(vertices_, triangles_, frames, layout_));
   }
 
   // The largest frame count (written frames) whose GLB fits in `limit` bytes.
@@ -227,7 +236,7 @@ class GlbSizeBound {
 
  private:
   size_t vertices_, triangles_;
-  bool normals_;
+  GlbLayout layout_;
   uint64_t per_frame_json_ = 0, no_frame_json_ = 0, one_frame_json_ = 0;
 };
 
@@ -236,7 +245,9 @@ class GlbSink final : public FrameSink {
   GlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : path_(std::move(path)), model_(model),
         selection_{info.frame_start, info.frame_count, options.frame_step},
-        content_(placeholder_content(model, info.generator, options.normals, size_t(selection_.written()),
+        loop_end_time_(info.loop_end_time),
+        content_(placeholder_content(model, info.generator, GlbLayout{options.normals, info.loop},
+                                     size_t(selection_.written()),
                                      target_names(selection_))) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
@@ -249,7 +260,7 @@ class GlbSink final : public FrameSink {
     file_->write(std::string(12 + 8 + reserved_json_ + 8, '\0'));  // header and JSON, filled by finish()
     for (uint32_t index : model_.triangles) file_->write_u32_le(index);
     file_->write_f32_le(rest_.data(), rest_.size());
-    if (content_.normals) {
+    if (content_.layout.normals) {
       rest_normals_ = rest_normals(model_);
       file_->write_f32_le(rest_normals_.data(), rest_normals_.size());
     }
@@ -272,7 +283,7 @@ class GlbSink final : public FrameSink {
       bounds.add(&displacement_[i]);
     }
     file_->write_f32_le(displacement_.data(), displacement_.size());
-    if (content_.normals) {
+    if (content_.layout.normals) {
       for (size_t i = 0; i < rest_normals_.size(); ++i) displacement_[i] = frame.normals[i] - rest_normals_[i];
       file_->write_f32_le(displacement_.data(), displacement_.size());
     }
@@ -285,11 +296,13 @@ class GlbSink final : public FrameSink {
     if (times_.size() != f)
       throw OutputError(path_.string() + ": the animated GLB was laid out for " + std::to_string(f) +
                         " frames but the bake delivered " + std::to_string(times_.size()));
-    file_->write_f32_le(times_.data(), f);
+    const size_t keys = content_.layout.keys(f);
+    if (keys > f) times_.push_back(float(loop_end_time_));  // the loop's closing key
+    file_->write_f32_le(times_.data(), keys);
     std::vector<float> weights(f);
-    for (size_t k = 0; k < f; ++k) {  // key k: target k fully on, all others off
+    for (size_t k = 0; k < keys; ++k) {  // key k: target k fully on, all others off; the closing key: target 0
       std::fill(weights.begin(), weights.end(), 0.0f);
-      weights[k] = 1.0f;
+      weights[k % f] = 1.0f;
       file_->write_f32_le(weights.data(), f);
     }
     if (f > 0) {
@@ -302,7 +315,7 @@ class GlbSink final : public FrameSink {
     file_->seek(0);
     file_->write_u32_le(kGlbMagic);
     file_->write_u32_le(2);
-    const uint64_t bin = bin_bytes(content_.vertices, content_.triangles, f, content_.normals);
+    const uint64_t bin = bin_bytes(content_.vertices, content_.triangles, f, content_.layout);
     file_->write_u32_le(uint32_t(GlbSizeBound::glb_bytes(reserved_json_, bin)));
     file_->write_u32_le(uint32_t(reserved_json_));
     file_->write_u32_le(kChunkJson);
@@ -322,6 +335,7 @@ class GlbSink final : public FrameSink {
   fs::path path_;
   const TreeModel& model_;
   FrameSelection selection_;
+  double loop_end_time_;  // s, the closing key's time when the bake is a loop
   GlbContent content_;
   size_t reserved_json_ = 0;           // bytes of the JSON chunk
   std::vector<float> rest_;            // (N*3) m, float rest pose the displacements are taken from
@@ -335,13 +349,13 @@ class GlbSink final : public FrameSink {
 
 uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step, bool normals) {
   const FrameSelection selection{info.frame_start, info.frame_count, frame_step};
-  return GlbSizeBound(model, info.generator, normals).bytes(uint64_t(selection.written()));
+  return GlbSizeBound(model, info.generator, GlbLayout{normals, info.loop}).bytes(uint64_t(selection.written()));
 }
 
 std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
   const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
-  const GlbSizeBound bound(model, info.generator, options.normals);
+  const GlbSizeBound bound(model, info.generator, GlbLayout{options.normals, info.loop});
   const uint64_t bytes = bound.bytes(uint64_t(selection.written()));
   if (bytes > kGlbMaxBytes) {
     const uint64_t fits = bound.frames_within(kGlbMaxBytes);  // written frames

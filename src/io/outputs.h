@@ -23,6 +23,10 @@ struct BakeInfo {
   long long frame_count = 0;   // frames the bake will hand to push()
   int substeps = 1;
   uint64_t seed = 0;
+  // A seamless loop of the whole bake (time.loop): the first frame comes again at
+  // loop_end_time (s), so animations add a closing key there.
+  bool loop = false;
+  double loop_end_time = 0;
 };
 
 // One simulated frame, converted to float for output.

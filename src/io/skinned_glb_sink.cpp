@@ -234,16 +234,28 @@ class SkinnedGlbSink final : public FrameSink {
     if (frames > 0) {
       tinygltf::Animation animation;
       animation.name = "wind";
-      const int input = add.floats(times_, TINYGLTF_TYPE_SCALAR, 1);
-      add.bound(input, times_, 1);
+      // A loop closes with the first frame's keys again at the loop's end.
+      std::vector<float> times = times_;
+      if (info_.loop) times.push_back(float(info_.loop_end_time));
+      const int input = add.floats(times, TINYGLTF_TYPE_SCALAR, 1);
+      add.bound(input, times, 1);
       std::vector<float> keys;
       for (size_t j = 0; j < joints; ++j) {
         for (const auto& [path, width] : {std::pair{"translation", 3}, std::pair{"rotation", 4}}) {
           const std::vector<float>& all = width == 3 ? translations_ : rotations_;
           keys.clear();
-          for (size_t f = 0; f < frames; ++f)
+          for (size_t k = 0; k < times.size(); ++k) {
+            const size_t f = k % frames;
             keys.insert(keys.end(), all.begin() + long((f * joints + j) * size_t(width)),
                         all.begin() + long((f * joints + j + 1) * size_t(width)));
+          }
+          if (width == 4 && times.size() > frames) {  // the closing rotation the short way, as every key
+            float* closing = keys.data() + 4 * frames;
+            float dot = 0;
+            for (int c = 0; c < 4; ++c) dot += closing[c] * closing[c - 4];
+            if (dot < 0)
+              for (int c = 0; c < 4; ++c) closing[c] = -closing[c];
+          }
           tinygltf::AnimationSampler sampler;
           sampler.input = input;
           sampler.output = add.floats(keys, width == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4, width);

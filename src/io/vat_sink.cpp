@@ -239,7 +239,7 @@ class VatSink final : public FrameSink {
         {"rows_per_frame", layout_.rows_per_frame},
         {"bounds_min", frames_ ? std::vector<double>(low_.begin(), low_.end()) : std::vector<double>(3, 0.0)},
         {"bounds_max", frames_ ? std::vector<double>(high_.begin(), high_.end()) : std::vector<double>(3, 0.0)},
-        {"loop", false},
+        {"loop", info_.loop},
         {"precision", half_ ? "half" : "float"},
         {"positions", fs::path(stem_ + ".positions.exr").filename().string()},
         {"normals", fs::path(stem_ + ".normals.exr").filename().string()},

@@ -1,7 +1,11 @@
 #include "scene/scene.h"
 
+#include <cmath>
+#include <sstream>
+
 #include "common/errors.h"
 #include "common/json_text.h"
+#include "sim/wind.h"
 #include "common/read_text_file.h"
 #include "scene/sim_sections.h"
 
@@ -21,7 +25,41 @@ TimeOptions read_time_options(SceneObject section) {
   time.frames = section.integer("frames", time.frames, 1, 10'000'000);
   time.start = section.integer("start", time.start, -1'000'000'000, 1'000'000'000);
   time.substeps = static_cast<int>(section.integer("substeps", time.substeps, 1, 10'000));
+  time.loop = section.boolean("loop", time.loop);
   return time;
+}
+
+std::string vector_text(const Eigen::Vector3d& v) {
+  std::ostringstream out;
+  out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return out.str();
+}
+
+// time.loop => the wind made periodic over the bake (docs/scene.md "time"), or InputError
+// naming what keeps the scene from looping.
+void prepare_loop(SceneObject time_section, Scene& scene) {
+  const TimeOptions& time = scene.time;
+  if (time.frames < 2) time_section.fail("loop", "a loop needs at least 2 frames, got " + std::to_string(time.frames));
+  if (scene.hsm.leaf_detach_force > 0)
+    time_section.fail("loop", "leaves that detach never come back, so the bake cannot repeat; set "
+                              "/hsm/leaf_detach_force to 0 or leave the loop out");
+  const double start = double(time.start) / time.fps, period = double(time.frames) / time.fps;
+  const WindField wind(scene.wind);
+  const Eigen::Vector3d first = wind.mean(start), last = wind.mean(start + period);
+  const double first_gust = wind.gust_amplitude(start), last_gust = wind.gust_amplitude(start + period);
+  const double tolerance = 1e-9 * std::max(1.0, first.norm() + first_gust);
+  if ((first - last).norm() > tolerance || std::fabs(first_gust - last_gust) > tolerance) {
+    std::ostringstream message;
+    message << "the wind cannot be made periodic over the loop (" << period << " s): at its end (t = "
+            << start + period << " s) it is " << vector_text(last) << " m/s with gusts of " << last_gust
+            << " m/s, at its start (t = " << start << " s) " << vector_text(first) << " m/s with gusts of "
+            << first_gust << " m/s; give the wind " << (scene.wind.file ? "file" : "keys")
+            << " the same value at both ends (a key at t = " << start + period << " equal to the wind at t = "
+            << start << ")";
+    time_section.fail("loop", message.str());
+  }
+  scene.wind.loop_start = start;
+  scene.wind.loop_period = period;
 }
 
 }  // namespace
@@ -100,6 +138,7 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   scene.hsm = read_hsm_options(root.object("hsm"));
   scene.wind = read_wind_options(root.object("wind"), scene.seed);
   scene.time = read_time_options(root.object("time"));
+  if (scene.time.loop) prepare_loop(root.object("time"), scene);
   for (SceneObject element : root.array_of_objects("outputs"))
     scene.outputs.push_back(read_output_options(element));
   reader.check_unknown_keys();

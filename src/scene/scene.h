@@ -20,6 +20,7 @@ struct TimeOptions {
   long long frames = 120;   // frames simulated (and written)
   long long start = 0;      // index of the first frame; frame k is at time k / fps
   int substeps = 16;        // solver steps per frame (<= 1% error with the default hsm, docs/benchmarks.md)
+  bool loop = false;        // a seamless loop: periodic wind, warm-up, one period baked
 };
 
 struct Scene {

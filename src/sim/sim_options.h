@@ -64,6 +64,10 @@ struct WindOptions {
   int turbulence_modes = 8;                   // sinusoidal modes summed
   double gust_frequency = 0.2;                // Hz, typical gust rate
   uint64_t seed = 1;                          // turbulence and gusts
+  // A seamless loop (time.loop): > 0 makes the wind periodic with this period (s) from
+  // loop_start (s); the keys must give the same wind at both ends (checked by scene/).
+  double loop_period = 0;
+  double loop_start = 0;
 };
 
 }  // namespace treeanim

@@ -33,7 +33,8 @@ size_t interval_of(const std::vector<double>& times, double t) {
 
 }  // namespace
 
-WindField::WindField(const WindOptions& options) : intensity(options.turbulence_intensity) {
+WindField::WindField(const WindOptions& options)
+    : intensity(options.turbulence_intensity), loop_period(options.loop_period), loop_start(options.loop_start) {
   for (const WindKey& k : options.keys) {
     key_time.push_back(k.time);
     key_wind.push_back(k.speed * k.direction);
@@ -72,9 +73,44 @@ WindField::WindField(const WindOptions& options) : intensity(options.turbulence_
     gust_omega[j] = 2 * std::numbers::pi * options.gust_frequency * ratios[j];
     gust_phase[j] = 2 * std::numbers::pi * uniform01(rng);
   }
+  if (loop_period > 0) make_periodic();
+}
+
+void WindField::make_periodic() {
+  loop_advection = key_advection_at(loop_start + loop_period) - key_advection_at(loop_start);
+  // A rate of c cycles per period, c >= 1 a whole number: sin(w t) then repeats with the loop.
+  auto whole_cycles = [&](double omega) {
+    const double cycles = std::max(1.0, std::round(omega * loop_period / (2 * std::numbers::pi)));
+    return 2 * std::numbers::pi * cycles / loop_period;
+  };
+  for (double& omega : gust_omega) omega = whole_cycles(omega);
+  const double drift = loop_advection.norm();
+  for (int m = 0; m < mode_count(); ++m) {
+    mode_omega[m] = whole_cycles(mode_omega[m]);
+    if (drift == 0) continue;
+    // The frozen field drifts by loop_advection per period: k . drift must be whole cycles too.
+    // Only the wave vector's component along the drift changes; the amplitude is kept normal
+    // to it, so the field stays divergence-free.
+    const Eigen::Vector3d along = loop_advection / drift;
+    Eigen::Vector3d k = mode_wave.col(m);
+    const double cycles = std::round(k.dot(loop_advection) / (2 * std::numbers::pi));
+    k += (2 * std::numbers::pi * cycles / drift - k.dot(along)) * along;
+    if (k.norm() < 1e-12) k = mode_wave.col(m).cross(along);  // a mode with no drift component left
+    const double scale = mode_amplitude.col(m).norm();
+    Eigen::Vector3d a = mode_amplitude.col(m) - mode_amplitude.col(m).dot(k.normalized()) * k.normalized();
+    if (a.norm() < 1e-9) a = k.unitOrthogonal();
+    mode_wave.col(m) = k;
+    mode_amplitude.col(m) = a.normalized() * scale;
+  }
+}
+
+double WindField::key_time_of(double t) const {
+  if (!(loop_period > 0)) return t;
+  return loop_start + (t - loop_start) - loop_period * std::floor((t - loop_start) / loop_period);
 }
 
 Eigen::Vector3d WindField::mean(double t) const {
+  t = key_time_of(t);
   if (key_time.empty()) return Eigen::Vector3d::Zero();
   if (t <= key_time.front()) return key_wind.front();
   if (t >= key_time.back()) return key_wind.back();
@@ -84,6 +120,7 @@ Eigen::Vector3d WindField::mean(double t) const {
 }
 
 double WindField::gust_amplitude(double t) const {
+  t = key_time_of(t);
   if (key_time.empty()) return 0;
   if (t <= key_time.front()) return key_gust.front();
   if (t >= key_time.back()) return key_gust.back();
@@ -109,11 +146,19 @@ Eigen::Vector3d WindField::base(double t) const {
 bool WindField::calm(double t) const { return mean(t).squaredNorm() == 0; }
 
 Eigen::Vector3d WindField::advection(double t) const {
+  if (!(loop_period > 0)) return key_advection_at(t);
+  // Whole periods drift by loop_advection each; the rest of the way within the first period.
+  const double periods = std::floor((t - loop_start) / loop_period);
+  return periods * loop_advection + key_advection_at(key_time_of(t)) - key_advection_at(loop_start);
+}
+
+Eigen::Vector3d WindField::key_advection_at(double t) const {
   if (key_time.empty()) return Eigen::Vector3d::Zero();
   if (t <= key_time.front()) return (t - key_time.front()) * key_wind.front();
   if (t >= key_time.back()) return key_advection.back() + (t - key_time.back()) * key_wind.back();
   const size_t k = interval_of(key_time, t);
-  return key_advection[k] + 0.5 * (t - key_time[k]) * (key_wind[k] + mean(t));
+  const double s = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
+  return key_advection[k] + 0.5 * (t - key_time[k]) * (key_wind[k] + ((1 - s) * key_wind[k] + s * key_wind[k + 1]));
 }
 
 void WindField::spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const {

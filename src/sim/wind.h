@@ -3,6 +3,8 @@
 // keys (piecewise linear, held before the first and after the last key), gusts along it, and
 // a frozen-turbulence field of sinusoidal modes advected with the mean wind. Deterministic:
 // everything is a function of (seed, position, time), never of the step or thread count.
+// With options.loop_period > 0 the whole field is periodic (docs/solver.md "Wind"): the keys
+// repeat, and every rate and wave number is rounded to whole cycles per period.
 #include <Eigen/Core>
 #include <vector>
 
@@ -21,6 +23,8 @@ class WindField {
   Eigen::Vector3d base(double t) const;
   // t => true when the air is still everywhere (no mean wind, no gust, hence no turbulence).
   bool calm(double t) const;
+  // t => amplitude of the gusts along the mean wind (m/s), interpolated between keys.
+  double gust_amplitude(double t) const;
   // x (m) => the spatial phase terms sin/cos(k_m . x + phi_m) of every mode, into (modes) arrays.
   void spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const;
   // t => the temporal phase terms sin/cos(-k_m . D(t) + w_m t) (D: advection of the frozen
@@ -31,9 +35,14 @@ class WindField {
                              const double* cos_b, double scale) const;
 
  private:
-  double gust_amplitude(double t) const;
   double gust_signal(double t) const;
   Eigen::Vector3d advection(double t) const;
+  // t => the time of the keys it reads: t itself, or t wrapped into the loop's first period.
+  double key_time_of(double t) const;
+  // Integral of the keys' mean wind from the first key to t (no wrapping).
+  Eigen::Vector3d key_advection_at(double t) const;
+  // Rounds rates and wave numbers to whole cycles per loop period (constructor, loops only).
+  void make_periodic();
 
   std::vector<double> key_time;          // (K) s
   std::vector<Eigen::Vector3d> key_wind; // (K) m/s, speed * direction
@@ -46,6 +55,9 @@ class WindField {
   std::vector<double> mode_omega;        // (N) rad/s, evolution of the frozen field in place
   double gust_omega[3];                  // rad/s, three incommensurate gust rates
   double gust_phase[3];                  // rad
+  double loop_period = 0;                // s; > 0: the field repeats with this period
+  double loop_start = 0;                 // s, start of the first period
+  Eigen::Vector3d loop_advection = Eigen::Vector3d::Zero();  // m, advection over one period
 };
 
 }  // namespace treeanim
