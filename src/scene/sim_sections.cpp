@@ -80,6 +80,7 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
   o.max_frequency = section.number("max_frequency", o.max_frequency, Range::positive());
   o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, Range::positive());
+  o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::non_negative());
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
   o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::non_negative());
   o.gravity = section.vector3("gravity", o.gravity);

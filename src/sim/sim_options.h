@@ -32,6 +32,7 @@ struct HsmOptions {
   double global_scale = 1.0;             // multiplies the limb stiffness of the global term (kPhysical)
   double max_frequency = 30;             // rad/s, highest frequency the solver resolves (kPhysical)
   double max_limb_frequency = 8;         // rad/s, highest limb (global) frequency (kPhysical)
+  double min_limb_frequency = 1.25;      // rad/s, lowest limb (global) frequency (kPhysical)
   double damping_ratio = 0.1;            // structural damping ratio of the limb mode
   double leaf_detach_force = 0;          // N; 0 = leaves never detach
   Eigen::Vector3d gravity{0, -9.81, 0};  // m/s^2, acts on detached leaves only

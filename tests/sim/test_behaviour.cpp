@@ -103,6 +103,26 @@ TEST(Behaviour, ThickBranchesAreStifferAndHeavier) {
   EXPECT_GT(checked, 10u);
 }
 
+TEST(Behaviour, LimbFrequencyHasAFloor) {
+  // Wood of 1 MPa gives every limb a frequency far below the sway band of trees; the floor
+  // (min_limb_frequency) holds each moving vertex's global rate at that frequency's.
+  const TreeModel model = grown_tree(6, 0, 2);
+  const double h = 1.0 / 96;
+  HsmOptions soft;
+  soft.youngs_modulus = 1e6;
+  const double floor_rate = global_rate(soft.min_limb_frequency, h);
+  const std::vector<double> held = compute_step_rates(model, soft, h).vertex_global;
+  soft.min_limb_frequency = 0;
+  const std::vector<double> free = compute_step_rates(model, soft, h).vertex_global;
+  size_t below = 0;
+  for (size_t v = 0; v < model.vertex_count(); ++v) {
+    if (model.vertex_anchored[v]) continue;
+    EXPECT_GE(held[v], floor_rate * (1 - 1e-12)) << "vertex " << v;
+    below += free[v] < floor_rate;
+  }
+  EXPECT_GT(below, model.vertex_count() / 2);
+}
+
 TEST(Behaviour, DetachedLeavesFallAndNeverComeBack) {
   const TreeModel model = testing::small_tree(6);
   HsmOptions options;
