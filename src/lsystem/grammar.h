@@ -48,6 +48,7 @@ struct Rule {
   Expr after;        // block run when the condition holds, before the successor (cpfg)
   Expr probability;  // absent: deterministic
   SourcePos pos;     // the rule's first character
+  bool cpfg_parts = false;  // a strict predecessor of several modules or a block: one test for the deriver
   bool has_context() const { return left_end > left_begin || right_end > right_begin; }
   // Modules the strict predecessor replaces.
   uint32_t length() const { return 1 + tail_end - tail_begin; }

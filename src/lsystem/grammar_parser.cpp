@@ -662,6 +662,7 @@ class Parser {
     for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m)
       if (set.successor[m].symbol == '%') set.any_cut = true;
     if (rule.has_context()) set.any_context = true;
+    rule.cpfg_parts = rule.length() > 1 || rule.before.present() || rule.after.present();
     set.rules.push_back(rule);
   }
 
