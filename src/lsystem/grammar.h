@@ -108,10 +108,10 @@ struct GrammarText {
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError
 // "name:line:column: message".
-// `functions` are the view file's, for func(id, x). A file's #include is read beside it.
+// `functions` are the view file's, for func(id, x) (id a number or a function's name). A file's #include is read beside it.
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text = std::nullopt,
-                      std::vector<std::vector<double>> functions = {});
+                      std::vector<SampledFunction> functions = {});
 
 }  // namespace treeanim

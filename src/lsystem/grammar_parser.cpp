@@ -804,7 +804,7 @@ std::string Grammar::where(const SourcePos& pos) const {
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text,
-                      std::vector<std::vector<double>> functions) {
+                      std::vector<SampledFunction> functions) {
   Grammar grammar;
   grammar.program.functions = std::move(functions);
   Parser parser(grammar, define_overrides);

@@ -75,19 +75,21 @@ TEST_F(ViewFile, AngleFactorDividesTheCircleAndWidthsInPixelsAreLeftOut) {
 TEST_F(ViewFile, FunctionFilesInBothFormatsAreFoundBesideTheViewFile) {
   write("grow.func", kLinear);
   write("old.func", std::string("range: 0, 1\npoints: 2\n0 1\n1 3\n"));  // the format before "fver"
-  write("pair.fset", std::string("funcgalleryver 1 1\nitems: 2\n") + kLinear + "\n" + kLinear);
+  write("pair.fset", std::string("funcgalleryver 1 1\nitems: 2\n") + kLinear + "\n" + kLinear);  // both named "grow"
   const ViewSettings v = read_view_file(write("plant.v", "function: grow.func 5\nfunction: old.func\n"
                                                          "function set: pair.fset\n"));
   ASSERT_EQ(v.functions.size(), 4u);
-  for (const std::vector<double>& f : v.functions) ASSERT_GE(f.size(), 3u);
-  const std::vector<double>& linear = v.functions[0];
+  for (const SampledFunction& f : v.functions) ASSERT_GE(f.samples.size(), 3u);
+  const std::vector<double>& linear = v.functions[0].samples;
   EXPECT_NEAR(linear.front(), 0.0, 1e-9);
   EXPECT_NEAR(linear[linear.size() / 2], 0.5, 1e-3);
   EXPECT_NEAR(linear.back(), 1.0, 1e-9);
-  EXPECT_NEAR(v.functions[1].front(), 1.0, 1e-9);
-  EXPECT_NEAR(v.functions[1].back(), 3.0, 1e-9);
-  EXPECT_EQ(v.functions[2], linear);
-  EXPECT_EQ(v.functions[3], linear);
+  EXPECT_NEAR(v.functions[1].samples.front(), 1.0, 1e-9);
+  EXPECT_NEAR(v.functions[1].samples.back(), 3.0, 1e-9);
+  EXPECT_EQ(v.functions[2].samples, linear);
+  EXPECT_EQ(v.functions[3].samples, linear);
+  EXPECT_EQ(v.functions[0].name, "grow");
+  EXPECT_EQ(v.functions[1].name, "");
 }
 
 TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
