@@ -680,8 +680,8 @@ Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, con
 namespace {
 
 // The interpreter of expressions and blocks; slots are written only by blocks' stores.
-// Inlined into evaluate and execute: a call between them cost parametric derivation about 1.5 %
-// of its instructions (docs/grammar.md "Speed").
+// Inlined into evaluate and execute: a call between them cost the derivation benchmark 1.5 % of
+// its instructions (docs/grammar.md, "Speed").
 [[gnu::always_inline]] inline double run(const ExprProgram& program, const Expr& expr, double* slots, RandomStream& random,
            double* variables) {
   double stack[kMaxExprStack];
