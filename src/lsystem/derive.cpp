@@ -304,8 +304,9 @@ class Deriver {
     size_t j = index + rule.length();
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
-      if (pattern.symbol == ']') {
+      if (pattern.symbol == ']' || pattern.symbol == '=') {  // '=' (cpfg): to the branch's end, before its ']'
         while (j < n && w.symbols[j] != ']') j = w.symbols[j] == '[' ? static_cast<size_t>(match_[j]) + 1 : j + 1;
+        if (pattern.symbol == '=') continue;
         if (j >= n) return false;
         ++j;
         continue;

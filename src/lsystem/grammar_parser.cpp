@@ -740,9 +740,11 @@ class Parser {
         fail(line, k, std::string("a bracket cannot be in a ") + what +
                           (std::string_view(what) == "left context" ? " (it already skips branches)" : ""));
       PatternModule module{c, 0, static_cast<uint16_t>(formals->size())};
+      const size_t symbol_at = k;
       k = parameters_at(text, k + 1, end);
       module.arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
       if ((c == '[' || c == ']') && module.arity) fail(line, k - 1, "brackets take no parameters");
+      if (c == '=' && brackets && module.arity) fail(line, symbol_at, "'=' (the rest of the branch) takes no parameters");
       set->patterns.push_back(module);
     }
   }

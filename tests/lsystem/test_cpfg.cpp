@@ -77,6 +77,14 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
 }
 
+// '=' in a right context (cpfg's generate.c) skips to the end of the current branch.
+TEST(Cpfg, EqualsInARightContextSkipsTheRestOfTheBranch) {
+  EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [B=]D --> X\n", 1), "X[BC]D");
+  EXPECT_EQ(derive_text("axiom: A[C][BE]F\nA > [=][B=]F --> X\n", 1), "X[C][BE]F");
+  EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [C=]D --> X\n", 1), "A[BC]D");
+  EXPECT_EQ(error_of("axiom: A\nA > B=(x) --> X\n"), "plant.l:2:6: '=' (the rest of the branch) takes no parameters");
+}
+
 // A strict predecessor of several modules (CPFG manual 3.1) replaces them all, with the right
 // context after its last module; in a homomorphism it applies to the derived word.
 TEST(Cpfg, PredecessorOfSeveralModules) {
