@@ -242,17 +242,17 @@ class Deriver {
                double* slots, RandomStream& random) {
     if (rule.arity != params.size()) return false;
     for (size_t p = 0; p < params.size(); ++p) slots[rule.predecessor_slot + p] = params[p];
-    if (rule.tail_end > rule.tail_begin && !match_tail(set, rule, index, slots)) return false;
+    if (rule.cpfg_parts && rule.length() > 1 && !match_tail(set, rule, index, slots)) return false;
     if (rule.left_end > rule.left_begin && !match_left(set, rule, index, slots)) return false;
     if (rule.right_end > rule.right_begin && !match_right(set, rule, index, slots)) return false;
     rule_ = &rule;
-    if (rule.before.present()) {
+    if (rule.cpfg_parts && rule.before.present()) {
       std::fill(slots + rule.predecessor_slot + rule.arity, slots + rule.slot_count, 0.0);  // locals start at 0
       execute(g_.program, rule.before, slots, random, variables_.data());
     }
     if (rule.condition.present() && evaluate(g_.program, rule.condition, slots, random, variables_.data()) == 0.0)
       return false;
-    if (rule.after.present()) execute(g_.program, rule.after, slots, random, variables_.data());
+    if (rule.cpfg_parts && rule.after.present()) execute(g_.program, rule.after, slots, random, variables_.data());
     return true;
   }
 
@@ -304,8 +304,9 @@ class Deriver {
     size_t j = index + rule.length();
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
-      if (pattern.symbol == ']') {
+      if (pattern.symbol == ']' || pattern.symbol == '=') {  // '=' (cpfg): to the branch's end, before its ']'
         while (j < n && w.symbols[j] != ']') j = w.symbols[j] == '[' ? static_cast<size_t>(match_[j]) + 1 : j + 1;
+        if (pattern.symbol == '=') continue;
         if (j >= n) return false;
         ++j;
         continue;

@@ -389,6 +389,12 @@ class Compiler {
           emit_constant(value, start);
           return;
         }
+    // A view-file function's name stands for its number, as in func(BRANCH_ANGLE, x).
+    for (size_t f = 0; f < program_.functions.size(); ++f)
+      if (!name.empty() && program_.functions[f].name == name) {
+        emit_constant(static_cast<double>(f + 1), start);
+        return;
+      }
     fail(start, "unknown name '" + name + "'" + known_names(name));
   }
   // " (expected a formal parameter (l, w) or a #define (r1, r2); did you mean 'r1'?)"
@@ -462,8 +468,8 @@ class Compiler {
                       std::to_string(count));
     emit(function->op, function->op == Op::kFunc ? function_number(first_argument_end, start) : 0, start);
   }
-  // func(id, x): id, the code ending at first_argument_end, must be a constant naming one of
-  // the view file's functions => its index.
+  // func(id, x): id, the code ending at first_argument_end, must be a constant numbering one
+  // of the view file's functions (or its name, parse_name) => its index.
   uint32_t function_number(size_t first_argument_end, size_t start) const {
     const Instruction id = program_.code[first_argument_end - 1];
     const double value = id.op == Op::kConst ? program_.constants[id.arg] : -1.0;
@@ -674,7 +680,9 @@ Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, con
 namespace {
 
 // The interpreter of expressions and blocks; slots are written only by blocks' stores.
-double run(const ExprProgram& program, const Expr& expr, double* slots, RandomStream& random,
+// Inlined into evaluate and execute: a call between them cost the derivation benchmark 1.5 % of
+// its instructions (docs/grammar.md, "Speed").
+[[gnu::always_inline]] inline double run(const ExprProgram& program, const Expr& expr, double* slots, RandomStream& random,
            double* variables) {
   double stack[kMaxExprStack];
   int top = -1;
@@ -724,7 +732,7 @@ double run(const ExprProgram& program, const Expr& expr, double* slots, RandomSt
       case Op::kCeil: stack[top] = std::ceil(b); break;
       case Op::kTrunc: stack[top] = std::trunc(b); break;
       case Op::kSign: stack[top] = b > 0.0 ? 1.0 : (b < 0.0 ? -1.0 : 0.0); break;
-      case Op::kFunc: a = sample_function(program.functions[in.arg], b); --top; break;
+      case Op::kFunc: a = sample_function(program.functions[in.arg].samples, b); --top; break;
       case Op::kRan: stack[top] = random.uniform() * b; break;
       case Op::kNran: a = a + b * random.normal(); --top; break;
       case Op::kBran: {

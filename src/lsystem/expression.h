@@ -89,12 +89,19 @@ struct ArrayDecl {
   std::vector<uint32_t> dims;   // sizes of its dimensions
 };
 
+// A view-file function (funcedit, CPFG manual 8.1.6): its name and y sampled at equally
+// spaced x on [0, 1].
+struct SampledFunction {
+  std::string name;             // its "name:" line; empty in the older format without one
+  std::vector<double> samples;  // (samples) y at x = k / (samples - 1)
+};
+
 // The code of every expression of one grammar.
 struct ExprProgram {
   std::vector<Instruction> code;     // (instructions)
   std::vector<SourcePos> code_pos;   // (instructions) the operator's place, for runtime errors
   std::vector<double> constants;     // (constants)
-  std::vector<std::vector<double>> functions;  // (functions x samples) func(id, x) on [0, 1], equally spaced
+  std::vector<SampledFunction> functions;  // func(id, x): the view file's functions, id 1, 2, ...
   std::vector<ArrayDecl> arrays;     // names the compiler resolves to array elements
   // expr => true when it is one constant (its value in *value).
   bool is_constant(const Expr& expr, double* value) const;

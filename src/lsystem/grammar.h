@@ -48,6 +48,7 @@ struct Rule {
   Expr after;        // block run when the condition holds, before the successor (cpfg)
   Expr probability;  // absent: deterministic
   SourcePos pos;     // the rule's first character
+  bool cpfg_parts = false;  // a strict predecessor of several modules or a block: one test for the deriver
   bool has_context() const { return left_end > left_begin || right_end > right_begin; }
   // Modules the strict predecessor replaces.
   uint32_t length() const { return 1 + tail_end - tail_begin; }
@@ -107,10 +108,10 @@ struct GrammarText {
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError
 // "name:line:column: message".
-// `functions` are the view file's, for func(id, x). A file's #include is read beside it.
+// `functions` are the view file's, for func(id, x) (id a number or a function's name). A file's #include is read beside it.
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text = std::nullopt,
-                      std::vector<std::vector<double>> functions = {});
+                      std::vector<SampledFunction> functions = {});
 
 }  // namespace treeanim

@@ -548,7 +548,7 @@ class Parser {
         open.pop_back();
       }
       SuccessorModule module{c, 0, static_cast<uint32_t>(params->size()), at_column(line, k)};
-      ++k;
+      k = parameters_at(text, k + 1, end);
       if (k < end && text[k] == '(') {
         if (c == '[' || c == ']') fail(line, k, "brackets take no parameters");
         for (;;) {
@@ -583,6 +583,14 @@ class Parser {
     if (next == 'E')
       fail(line, k, "'?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
     return next == 'P' || next == 'H' || next == 'U' || next == 'L';
+  }
+
+  // Past a module symbol at text[k - 1]: the '(' of its parameters when only spaces come
+  // before it (cpfg reads "\ (90)" as "\(90)": '(' is never a module), else k.
+  static size_t parameters_at(std::string_view text, size_t k, size_t end) {
+    size_t p = k;
+    while (p < end && is_space(text[p])) ++p;
+    return p < end && text[p] == '(' ? p : k;
   }
 
   static void check_symbol(std::string_view text, size_t k, const TextOrigin& line, const char* what) {
@@ -654,6 +662,7 @@ class Parser {
     for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m)
       if (set.successor[m].symbol == '%') set.any_cut = true;
     if (rule.has_context()) set.any_context = true;
+    rule.cpfg_parts = rule.length() > 1 || rule.before.present() || rule.after.present();
     set.rules.push_back(rule);
   }
 
@@ -703,7 +712,7 @@ class Parser {
     if (text[begin] == '[' || text[begin] == ']') fail(line, begin, "a bracket cannot be in a predecessor");
     rule->predecessor = text[begin];
     rule->predecessor_slot = static_cast<uint16_t>(formals->size());
-    size_t k = begin + 1;
+    size_t k = parameters_at(text, begin + 1, end);
     rule->arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
     rule->tail_begin = static_cast<uint32_t>(set->patterns.size());
     parse_modules(text, k, end, line, false, set, formals, "predecessor");
@@ -731,9 +740,11 @@ class Parser {
         fail(line, k, std::string("a bracket cannot be in a ") + what +
                           (std::string_view(what) == "left context" ? " (it already skips branches)" : ""));
       PatternModule module{c, 0, static_cast<uint16_t>(formals->size())};
-      ++k;
+      const size_t symbol_at = k;
+      k = parameters_at(text, k + 1, end);
       module.arity = static_cast<uint8_t>(parse_formals(text, &k, end, line, formals));
       if ((c == '[' || c == ']') && module.arity) fail(line, k - 1, "brackets take no parameters");
+      if (c == '=' && brackets && module.arity) fail(line, symbol_at, "'=' (the rest of the branch) takes no parameters");
       set->patterns.push_back(module);
     }
   }
@@ -795,7 +806,7 @@ std::string Grammar::where(const SourcePos& pos) const {
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text,
-                      std::vector<std::vector<double>> functions) {
+                      std::vector<SampledFunction> functions) {
   Grammar grammar;
   grammar.program.functions = std::move(functions);
   Parser parser(grammar, define_overrides);

@@ -111,7 +111,7 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
       line.text += more.text;
       line.columns.insert(line.columns.end(), more.columns.begin(), more.columns.end());
     }
-    const bool active = std::all_of(conditions_.begin(), conditions_.end(), [](auto c) { return c.first; });
+    const bool active = std::all_of(conditions_.begin(), conditions_.end(), [](const Condition& c) { return c.taken; });
     if (hash < line.text.size() && line.text[hash] == '#' && (hash + 1 >= line.text.size() || !std::ispunct(static_cast<unsigned char>(line.text[hash + 1])))) {
       size_t word = skip_spaces(line.text, hash + 1), end = word;
       while (end < line.text.size() && in_name(line.text[end])) ++end;
@@ -132,7 +132,7 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
     ++number;
   }
   if (conditions_.size() != open_conditions)
-    fail({source, single_line ? 0 : number, 1}, "#ifdef or #ifndef is never closed (expected #endif)");
+    fail(conditions_.back().at, "#ifdef or #ifndef is never closed (expected #endif)");
 }
 
 void Preprocessor::directive(const std::string& name, const SourceLine& line, size_t hash) {
@@ -145,14 +145,16 @@ void Preprocessor::directive(const std::string& name, const SourceLine& line, si
     if (end == k) fail(line.columns[std::min(k, line.columns.size() - 1)], "expected a name after '#" + name + "'");
     const std::string macro = line.text.substr(k, end - k);
     const bool defined = find(macro) != nullptr || hooks_.is_number(macro);
-    conditions_.push_back({defined == (name == "ifdef"), false});
+    conditions_.push_back({defined == (name == "ifdef"), false, at});
     return;
   }
   if (name == "else" || name == "endif") {
     if (conditions_.empty()) fail(at, "'#" + name + "' without #ifdef or #ifndef");
     if (name == "endif") return conditions_.pop_back();
-    if (conditions_.back().second) fail(at, "a second '#else' for one #ifdef");
-    conditions_.back() = {!conditions_.back().first, true};
+    Condition& open = conditions_.back();
+    if (open.in_else) fail(at, "a second '#else' for one #ifdef");
+    open.taken = !open.taken;
+    open.in_else = true;
     return;
   }
   if (name == "include") {

@@ -54,7 +54,12 @@ class Preprocessor {
 
   PreprocessHooks hooks_;
   std::vector<Macro> macros_;
-  std::vector<std::pair<bool, bool>> conditions_;  // (#if branch taken, inside #else) per open #if
+  struct Condition {
+    bool taken;    // the lines of this branch are read
+    bool in_else;  // past its #else
+    SourcePos at;  // the #ifdef or #ifndef (where an unclosed one is reported)
+  };
+  std::vector<Condition> conditions_;  // open #ifdef / #ifndef, innermost last
   int include_depth_ = 0;
   std::string current_;  // name of the text being read (includes are found beside it)
 };

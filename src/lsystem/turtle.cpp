@@ -356,12 +356,12 @@ class Turtle {
   // Reserves the skeleton from symbol counts (F/G bound the segments, L ~ { the leaves) and
   // starts widths at settings.initial_width when the word uses '!' (else they stay NaN).
   void reserve_outputs() {
-    const std::vector<char>& symbols = word_.symbols;
-    const auto count = [&](char c) { return static_cast<size_t>(std::count(symbols.begin(), symbols.end(), c)); };
+    std::array<size_t, 256> counts{};  // of every symbol, in one pass over the word
+    for (const char c : word_.symbols) ++counts[static_cast<unsigned char>(c)];
+    const auto count = [&](char c) { return counts[static_cast<unsigned char>(c)]; };
     const size_t segments = count('F') + count('G');
     const size_t leaves = count('L') + count('~') + count('{') + count('@');
-    if (std::find_if(symbols.begin(), symbols.end(), [](char c) { return c == '!' || c == '#'; }) != symbols.end())
-      s_.width = settings_.initial_width;
+    if (count('!') + count('#') > 0) s_.width = settings_.initial_width;
     Skeleton& k = out_;
     k.segment_start.reserve(segments);
     k.segment_end.reserve(segments);

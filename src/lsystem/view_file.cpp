@@ -100,15 +100,17 @@ std::vector<double> sample_spline(const std::vector<Eigen::Vector2d>& control) {
 
 }  // namespace
 
-std::vector<double> parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos) {
+SampledFunction parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos) {
   size_t k = *pos;
   while (k < lines.size() && lines[k].find_first_not_of(" \t") == std::string::npos) ++k;
   if (k >= lines.size() || (lines[k].rfind("fver", 0) != 0 && lines[k].rfind("range:", 0) != 0))
     fail(name, k, "expected a funcedit function starting with 'fver 1 1' (or 'range:' in the older format)");
   if (lines[k].rfind("fver", 0) == 0) ++k;
   std::string key, rest;
+  SampledFunction function;
   for (; k < lines.size(); ++k) {
     if (!split_key(lines[k], &key, &rest)) fail(name, k, "expected 'points: n' in the function");
+    if (key == "name") std::istringstream(rest) >> function.name;
     if (key == "points") break;
   }
   if (k >= lines.size()) fail(name, k, "expected 'points: n' in the function");
@@ -122,7 +124,8 @@ std::vector<double> parse_function(const std::string& name, const std::vector<st
     control.emplace_back(xy[0], xy[1]);
   }
   *pos = k + 1;
-  return sample_spline(control);
+  function.samples = sample_spline(control);
+  return function;
 }
 
 ViewSettings read_view_file(const std::filesystem::path& path) {

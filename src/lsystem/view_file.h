@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "lsystem/expression.h"
+
 namespace treeanim {
 
 struct ViewSettings {
@@ -16,14 +18,15 @@ struct ViewSettings {
   std::optional<Eigen::Vector3d> tropism;     // "tropism: T: x,y,z ..."
   std::optional<double> tropism_elasticity;   // "... E: e" or "initial elasticity: e"
   std::vector<char> surfaces;                 // "surface: id file.s ...": ids drawn by ~id as leaves
-  std::vector<std::vector<double>> functions; // "function: f.func n" / "function set: s.fset", sampled on [0, 1]
+  std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
 };
 
 // path => settings; files it names are found beside it. Throws InputError "file:line:col: message".
 ViewSettings read_view_file(const std::filesystem::path& path);
 
-// The text of a funcedit function ("fver 1 1" format) => its B-spline sampled at n equally
-// spaced x in [0, 1]. `name` and `first_line` place errors. *pos moves past the function.
-std::vector<double> parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos);
+// The text of a funcedit function ("fver 1 1" format, or the older one from "range:") => its
+// "name:" and its B-spline sampled at equally spaced x in [0, 1]. `name` (the file) places
+// errors. *pos moves past the function.
+SampledFunction parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos);
 
 }  // namespace treeanim

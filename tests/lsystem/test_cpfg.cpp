@@ -1,6 +1,8 @@
 // cpfg's notation (docs/grammar.md "cpfg files"): grammars written for these tests in its style.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "common/errors.h"
@@ -30,6 +32,11 @@ TEST(Cpfg, HeadersCommentsMacrosAndRulesOverLines) {
                         "Lsystem: 1\nDerivation length: 2\nAxiom: A(0)\n"
                         "A(n) -->\n  F\n  A(GROW(n))\nhomomorphism: no warnings\nEndlsystem\n", 2),
             "FFA(2)");
+}
+
+// Spaces may come between a module and its parameters, in the axiom, predecessors and successors.
+TEST(Cpfg, SpacesBeforeParameters) {
+  EXPECT_EQ(derive_text("axiom: A (1)\nA (n) --> F (n) \\ (90) [ B] A(n + 1)\n", 1), "F(1)\\(90)[B]A(2)");
 }
 
 TEST(Cpfg, BlocksVariablesAndControlBlocks) {
@@ -68,6 +75,14 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A ?E(1)\n"),
             "plant.l:1:10: '?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
   EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
+}
+
+// '=' in a right context (cpfg's generate.c) skips to the end of the current branch.
+TEST(Cpfg, EqualsInARightContextSkipsTheRestOfTheBranch) {
+  EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [B=]D --> X\n", 1), "X[BC]D");
+  EXPECT_EQ(derive_text("axiom: A[C][BE]F\nA > [=][B=]F --> X\n", 1), "X[C][BE]F");
+  EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [C=]D --> X\n", 1), "A[BC]D");
+  EXPECT_EQ(error_of("axiom: A\nA > B=(x) --> X\n"), "plant.l:2:6: '=' (the rest of the branch) takes no parameters");
 }
 
 // A strict predecessor of several modules (CPFG manual 3.1) replaces them all, with the right
@@ -111,6 +126,41 @@ TEST(Cpfg, QueryModulesTakeTheTurtleState) {
 // printf is accepted and prints nothing (CPFG manual 5.4).
 TEST(Cpfg, PrintfPrintsNothing) {
   EXPECT_EQ(derive_text("Start: {n = 2; printf(\"n = %f\\n\", n);}\naxiom: A(n)\n", 0), "A(2)");
+}
+
+// The preprocessor (CPFG manual ch. 2): #ifdef / #ifndef / #else / #endif, lines continued by
+// one or two backslashes, and '#' inside a line is the width module, not a comment.
+TEST(Cpfg, ConditionalsContinuationsAndHashInsideALine) {
+  const std::string conditional = "#ifdef TALL\naxiom: F(2)\n#else\naxiom: F(1)\n#endif\n";
+  EXPECT_EQ(derive_text("#define TALL 1\n" + conditional, 0), "F(2)");
+  EXPECT_EQ(derive_text(conditional, 0), "F(1)");
+  EXPECT_EQ(derive_text("#ifndef TALL\n#ifdef TALL\naxiom: A\n#endif\naxiom: B\n#endif\n", 0), "B");
+  EXPECT_EQ(derive_text("#define GROW(x) \\\n  (x) + 1\n#define M 2 \\\\\n + 2\naxiom: A(GROW(M))\n", 0), "A(5)");
+  EXPECT_EQ(derive_text("axiom: F # F ! F\n", 0), "F#F!F");
+  EXPECT_EQ(error_of("axiom: A\n  #ifdef X\naxiom: A\n"), "plant.l:2:3: #ifdef or #ifndef is never closed (expected #endif)");
+  EXPECT_EQ(error_of("axiom: A\n#else\n"), "plant.l:2:1: '#else' without #ifdef or #ifndef");
+}
+
+// #include finds the file beside the including one (a vlab object folder), and errors in it
+// name the included file.
+TEST(Cpfg, IncludeReadsTheFileBesideTheGrammar) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "treeanim_test_cpfg_include";
+  std::filesystem::create_directories(dir / "sub");
+  std::ofstream(dir / "sub" / "rules.l") << "#define N 3\nA(n) --> F(n) B(N)\n";
+  std::ofstream(dir / "sub" / "broken.l") << "\nA(n) --> F(n) )\n";
+  const std::string grammar = (dir / "sub" / "plant.l").string();
+  const Grammar g = parse_grammar({{grammar, "axiom: A(1)\n#include \"rules.l\"\n", false}}, {});
+  const ModuleString word = derive(g, {1, 1, 100});
+  ASSERT_EQ(word.size(), 2u);
+  EXPECT_EQ(word.symbols[1], 'B');
+  EXPECT_EQ(word.params_of(1)[0], 3.0);
+  try {
+    parse_grammar({{grammar, "axiom: A(1)\n#include \"broken.l\"\n", false}}, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "sub" / "broken.l").string() + ":2:15: expected a module symbol, got ')'");
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Cpfg, EndlessLoopStopsWithItsPlace) {

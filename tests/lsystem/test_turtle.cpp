@@ -307,6 +307,58 @@ TEST(Turtle, MaterialIncrementsDecrementsAndSets) {
             (std::vector<int32_t>{0, 1, 5, 4, 0, 0, 3}));
 }
 
+// cpfg's modules (docs/turtle.md "cpfg modules"): ';' and ',' step the colour index, '#' and
+// '!' the width by the view file's increment.
+TEST(Turtle, CpfgColourIndexSemicolonAndComma) {
+  EXPECT_EQ(draw("F;F;(5)F,F,(0)F;F").segment_material, (std::vector<int32_t>{0, 1, 5, 4, 0, 1}));
+}
+
+TEST(Turtle, CpfgWidthStepsByTheViewIncrement) {
+  TurtleSettings settings;
+  settings.initial_width = 3.0;
+  settings.width_increment = 0.5;
+  EXPECT_EQ(draw("F#F#F!F!(1)F#(4)F!!!!!!!!!!F", settings).segment_width,
+            (std::vector<double>{3.0, 3.5, 4.0, 3.5, 1.0, 4.0, 0.0}));
+  settings.width_increment.reset();  // without a view file '#' adds 1 and '!' scales
+  EXPECT_EQ(draw("F#F!F", settings).segment_width, (std::vector<double>{3.0, 4.0, 4.0 * settings.width_factor}));
+}
+
+// '~' with an id letter ("~l(s)") and '@O(r)' are leaves of the default shape; circles draw nothing.
+TEST(Turtle, CpfgSurfacesAndSpheresAreDefaultLeaves) {
+  const Skeleton k = draw("~l(4)F~l(2)F~(3)@O(0.5)@o(1)@c(1)~");
+  EXPECT_EQ(k.leaf_scale, (std::vector<double>{4.0, 2.0, 3.0, 0.5, 1.0}));
+  EXPECT_EQ(k.leaf_segment, (std::vector<int32_t>{-1, 0, 1, 1, 1}));
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>(6, 0)));
+  EXPECT_EQ(k.segment_count(), 2u);
+}
+
+TEST(Turtle, CpfgRollMoveAndHeading) {
+  const std::string turns = "+(30)&(40)/(50)";
+  const Frame rolled = leaf_frame(draw(turns + "@vL"), 0);
+  EXPECT_GT(std::abs(leaf_frame(draw(turns + "L"), 0).l.y()), 0.1);  // the roll has work to do
+  EXPECT_NEAR(rolled.l.y(), 0.0, 1e-12);
+  expect_near(rolled.h, leaf_frame(draw(turns + "$L"), 0).h);
+  expect_near(rolled.l, leaf_frame(draw(turns + "$L"), 0).l);
+
+  const Skeleton moved = draw("F@M(2,3,4)F");
+  expect_near(moved.segment_start[1], Vector3d(2, 3, 4));
+  expect_near(moved.segment_end[1], Vector3d(2, 4, 4));
+
+  const Skeleton headed = draw("@R(2,0,0)F@R(0,0,1,0,1,0)F");
+  expect_near(headed.segment_end[0], Vector3d(1, 0, 0));
+  expect_near(headed.segment_end[1], Vector3d(1, 0, 1));
+  expect_near(headed.segment_up[1], Vector3d(0, 1, 0));
+  expect_orthonormal_right_handed(leaf_frame(draw("@R(1,1,0)L"), 0));
+}
+
+TEST(Turtle, CpfgGeneralisedCylinderMakesLowercaseFDraw) {
+  const Skeleton k = draw("f@Gsf(2)f@Gef");
+  ASSERT_EQ(k.segment_count(), 2u);
+  expect_near(k.segment_start[0], Vector3d(0, 1, 0));
+  expect_near(k.segment_end[1], Vector3d(0, 4, 0));
+  EXPECT_EQ(k.segment_parent, (std::vector<int32_t>{-1, 0}));
+}
+
 TEST(Turtle, EmptyWordGivesAnEmptySkeleton) {
   const Skeleton k = draw("");
   EXPECT_EQ(k.segment_count(), 0u);

@@ -1,0 +1,2 @@
+angle increment: 20
+surface: leaf leaf.s 1

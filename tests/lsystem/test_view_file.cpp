@@ -1,0 +1,125 @@
+// cpfg view files (docs/scene.md "lsystem.view", CPFG manual 8.1) and the funcedit functions
+// they name: files written for these tests in cpfg's style, in a folder of their own.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "common/errors.h"
+#include "lsystem/view_file.h"
+
+namespace treeanim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder per test, as a vlab object folder holds its .v and the files it names.
+class ViewFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("treeanim_view_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  }
+  std::string error_of(const std::string& view_text) const {
+    try {
+      read_view_file(write("plant.v", view_text));
+    } catch (const InputError& e) {
+      std::string message = e.what();
+      const std::string prefix = dir_.string() + "/";
+      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : message;
+    }
+    return "no error";
+  }
+
+  fs::path dir_;
+};
+
+// A funcedit function: y = x on [0, 1] (control points on a line give a line).
+const char* kLinear = "fver 1 1\nname: grow\nsamples: 5\nflip: off\nrange: 0, 1\ntype: bspline\npoints: 4\n"
+                      "0 0\n0.333333 0.333333\n0.666667 0.666667\n1 1\n";
+
+TEST_F(ViewFile, ReadsTheSettingsThatShapeTheTreeAndPassesRenderingOnes) {
+  const ViewSettings v = read_view_file(write("plant.v",
+                                              "maximum depth: 10\nAngle increment: 22.5\ninitial color: 3\n"
+                                              "initial line width: 0.4\nline width increment: 0.05\n"
+                                              "viewpoint: 0,0,1\ntropism: T: 0,-1,0 E: 0.2\n"
+                                              "surface: l leaf.s 1\nsurface: p petal.s 2 5\nlight: O: 1 1 1\n"));
+  EXPECT_EQ(v.angle, 22.5);
+  EXPECT_EQ(v.initial_width, 0.4);
+  EXPECT_EQ(v.width_increment, 0.05);
+  ASSERT_TRUE(v.tropism);
+  EXPECT_EQ(*v.tropism, Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(v.tropism_elasticity, 0.2);
+  EXPECT_EQ(v.surfaces, (std::vector<char>{'l', 'p'}));
+  EXPECT_TRUE(v.functions.empty());
+}
+
+TEST_F(ViewFile, AngleFactorDividesTheCircleAndWidthsInPixelsAreLeftOut) {
+  const ViewSettings v = read_view_file(write("plant.v", "angle factor: 16\ninitial line width: 3 pixels\n"));
+  EXPECT_EQ(v.angle, 22.5);
+  EXPECT_FALSE(v.initial_width);
+  EXPECT_FALSE(v.width_increment);
+  EXPECT_FALSE(v.tropism);
+}
+
+TEST_F(ViewFile, FunctionFilesInBothFormatsAreFoundBesideTheViewFile) {
+  write("grow.func", kLinear);
+  write("old.func", std::string("range: 0, 1\npoints: 2\n0 1\n1 3\n"));  // the format before "fver"
+  write("pair.fset", std::string("funcgalleryver 1 1\nitems: 2\n") + kLinear + "\n" + kLinear);  // both named "grow"
+  const ViewSettings v = read_view_file(write("plant.v", "function: grow.func 5\nfunction: old.func\n"
+                                                         "function set: pair.fset\n"));
+  ASSERT_EQ(v.functions.size(), 4u);
+  for (const SampledFunction& f : v.functions) ASSERT_GE(f.samples.size(), 3u);
+  const std::vector<double>& linear = v.functions[0].samples;
+  EXPECT_NEAR(linear.front(), 0.0, 1e-9);
+  EXPECT_NEAR(linear[linear.size() / 2], 0.5, 1e-3);
+  EXPECT_NEAR(linear.back(), 1.0, 1e-9);
+  EXPECT_NEAR(v.functions[1].samples.front(), 1.0, 1e-9);
+  EXPECT_NEAR(v.functions[1].samples.back(), 3.0, 1e-9);
+  EXPECT_EQ(v.functions[2].samples, linear);
+  EXPECT_EQ(v.functions[3].samples, linear);
+  EXPECT_EQ(v.functions[0].name, "grow");
+  EXPECT_EQ(v.functions[1].name, "");
+}
+
+TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
+  EXPECT_EQ(error_of("viewpoint: 0,0,1\nangle increment: wide\n"), "plant.v:2:1: expected a number after 'angle increment:'");
+  EXPECT_EQ(error_of("angle factor: 0\n"), "plant.v:1:1: expected a non-zero 'angle factor:'");
+  EXPECT_EQ(error_of("line width increment: nan\n"), "plant.v:1:1: expected a number after 'line width increment:'");
+  EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: expected 'T: x,y,z' (non-zero) after 'tropism:'");
+  EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: expected a number after 'E:'");
+  EXPECT_EQ(error_of("surface: leaf leaf.s 1\n"), "plant.v:1:1: expected a one-letter surface id after 'surface:'");
+  EXPECT_EQ(error_of("function: none.func\n"), "none.func: cannot read the function file (no such file)");
+  write("bad.func", "fver 1 1\nname: f\npoints: 2\n0 0\n1\n");
+  EXPECT_EQ(error_of("\n\nfunction: bad.func\n"), "bad.func:5:1: expected a point 'x y'");
+  write("empty.func", "\n");
+  EXPECT_EQ(error_of("function: empty.func\n"),
+            "empty.func:2:1: expected a funcedit function starting with 'fver 1 1' (or 'range:' in the older format)");
+  write("short.fset", "funcgalleryver 1 1\nitems: 2\n" + std::string(kLinear));
+  EXPECT_EQ(error_of("function set: short.fset\n"),
+            "short.fset:14:1: expected a funcedit function starting with 'fver 1 1' (or 'range:' in the older format)");
+  write("noitems.fset", "funcgalleryver 1 1\n");
+  EXPECT_EQ(error_of("function set: noitems.fset\n"), "noitems.fset:2:1: expected 'items: n' after 'funcgalleryver'");
+}
+
+TEST_F(ViewFile, MissingViewFileIsAnInputError) {
+  try {
+    read_view_file(dir_ / "none.v");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "none.v").string() + ": cannot read the view file (no such file)");
+  }
+}
+
+}  // namespace
+}  // namespace treeanim
