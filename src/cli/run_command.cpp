@@ -129,7 +129,7 @@ int run_command(const RunRequest& request) {
   for (long long k = write_first; k < start.frame && k <= write_last; ++k) {
     FrameJournal& source = journal ? *journal : *start.journal;
     FrameData data = source.read(k - write_first);
-    seam.add(data.positions);
+    if (info.loop) seam.add(data.positions);
     outputs.push(std::move(data));
   }
 
@@ -148,7 +148,7 @@ int run_command(const RunRequest& request) {
     if (frame >= write_first) {
       FrameData data = make_frame(state, frame, outputs.wants_velocities());
       if (scene.time.loop) data.time = double(frame) * frame_dt;  // the warm-up ran periods ahead
-      seam.add(data.positions);
+      if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
       if (journal) journal->append(data);
       outputs.push(std::move(data));
     }
