@@ -1,4 +1,6 @@
 // cpfg's notation (docs/grammar.md "cpfg files"): grammars written for these tests in its style.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -144,7 +146,7 @@ TEST(Cpfg, ConditionalsContinuationsAndHashInsideALine) {
 // #include finds the file beside the including one (a vlab object folder), and errors in it
 // name the included file.
 TEST(Cpfg, IncludeReadsTheFileBesideTheGrammar) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "treeanim_test_cpfg_include";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("treeanim_test_cpfg_include-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir / "sub");
   std::ofstream(dir / "sub" / "rules.l") << "#define N 3\nA(n) --> F(n) B(N)\n";
   std::ofstream(dir / "sub" / "broken.l") << "\nA(n) --> F(n) )\n";

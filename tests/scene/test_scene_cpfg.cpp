@@ -1,6 +1,8 @@
 // A scene naming a cpfg grammar and its view file (docs/scene.md "lsystem.view"): the files
 // are found relative to the scene, the files they name beside them, and the scene's own keys
 // override the view file's settings.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -22,7 +24,7 @@ namespace fs = std::filesystem;
 // A vlab-like object folder: grammar, view file, and a function the view file names (y = 2x),
 // used by its name.
 fs::path write_object() {
-  const fs::path dir = fs::temp_directory_path() / "treeanim_test_scene_cpfg" / "object";
+  const fs::path dir = fs::temp_directory_path() / ("treeanim_test_scene_cpfg-" + std::to_string(::getpid())) / "object";
   fs::create_directories(dir);
   std::ofstream(dir / "plant.l") << "#define N 3\nLsystem: 1\nderivation length: N\nAxiom: #A(0)\n"
                                     "A(n) --> F(func(DOUBLE, n / N)) #[+ ~l(1)] A(n + 1)\nEndlsystem\n";

@@ -1,4 +1,6 @@
 // /hsm and /wind readers (scene/sim_sections.h), the wind CSV and the wind field.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -95,7 +97,7 @@ TEST(WindOptions, RejectsBadKeys) {
 }
 
 TEST(WindOptions, ReadsCsvFileRelativeToTheScene) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "treeanim_test_wind";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("treeanim_test_wind-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "gale.csv") << "time,speed,dx,dy,dz,gust\n# calm start\n0,0,1,0,0,0\n1.5, 12, 0,0,2, 3\n";
   const WindOptions o = read_wind(Json::parse(R"({"wind": {"file": "gale.csv"}})"), dir);
@@ -106,6 +108,7 @@ TEST(WindOptions, ReadsCsvFileRelativeToTheScene) {
   EXPECT_EQ(o.keys[1].gust, 3);
   EXPECT_NE(error_of([&] { read_wind(Json::parse(R"({"wind": {"file": "missing.csv"}})"), dir); }).find("cannot open wind file"),
             std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(WindCsv, ErrorsNameFileAndLine) {
