@@ -1,6 +1,8 @@
 // Checkpoint files and the frame journal (docs/checkpoint.md): a state written and read back
 // into a fresh Simulator continues bit-identically; a checkpoint of another scene, a damaged
 // one and one of another tree are refused with the reason.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -17,12 +19,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("treeanim-test-checkpoint-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh folder for one test (per process: ctest runs tests side by side), removed at its end.
+struct ScratchDir {
+  fs::path path;
+  explicit ScratchDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("treeanim-test-checkpoint-" + std::to_string(::getpid()) + "-" + name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
 
 // f() => the message of the InputError it throws, "" when it throws none.
 template <typename F>
@@ -59,7 +68,8 @@ bool same_bytes(const T& a, const T& b) {
 
 TEST(Checkpoint, RoundTripThroughTheFileContinuesBitIdentically) {
   const TreeModel model = testing::grown_tree(5, 2, 4);
-  const fs::path dir = scratch_dir("roundtrip");
+  const ScratchDir scratch("roundtrip");
+  const fs::path& dir = scratch.path;
   for (Precision precision : {Precision::kDouble, Precision::kFloat}) {
     SCOPED_TRACE(precision == Precision::kFloat ? "float" : "double");
     const HsmOptions options = detaching_and_sleeping(precision);
@@ -96,7 +106,8 @@ TEST(Checkpoint, RoundTripThroughTheFileContinuesBitIdentically) {
 
 TEST(Checkpoint, RefusesAnotherSceneADamagedFileAndAnotherTree) {
   const TreeModel model = testing::grown_tree(4, 1, 4);
-  const fs::path dir = scratch_dir("refuse");
+  const ScratchDir scratch("refuse");
+  const fs::path& dir = scratch.path;
   Simulator sim(model, HsmOptions{}, gale(), 1.0 / 24, 2);
   const SimState state = sim.initial_state(0);
   const CheckpointKey key{scene_hash("{}", "treeanim 1"), "treeanim 1", false};
@@ -124,7 +135,8 @@ TEST(Checkpoint, RefusesAnotherSceneADamagedFileAndAnotherTree) {
 }
 
 TEST(FrameJournal, KeepsWholeRecordsAndTruncatesToTheCheckpoint) {
-  const fs::path dir = scratch_dir("journal");
+  const ScratchDir scratch("journal");
+  const fs::path& dir = scratch.path;
   const JournalLayout layout{"fnv1a64:0000000000000001", 10, 2, 1, true};
   FrameData frame;
   frame.positions = {1, 2, 3, 4, 5, 6};

@@ -1,5 +1,7 @@
 // cpfg view files (docs/scene.md "lsystem.view", CPFG manual 8.1) and the funcedit functions
 // they name: files written for these tests in cpfg's style, in a folder of their own.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,7 +22,8 @@ class ViewFile : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("treeanim_view_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("treeanim_view_" + std::to_string(::getpid()) + "_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
