@@ -36,10 +36,15 @@ fs::path write_object() {
 
 Skeleton grow(const std::string& lsystem) {
   const fs::path base = write_object();
+  struct RemovedAtTheEnd {  // also when growing throws
+    fs::path path;
+    ~RemovedAtTheEnd() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } folder{base};
   const Scene scene = load_scene_text(R"({"lsystem": )" + lsystem + "}", "s.json", base, {});
-  Skeleton skeleton = grow_skeleton(scene.lsystem, nullptr);
-  fs::remove_all(base);
-  return skeleton;
+  return grow_skeleton(scene.lsystem, nullptr);
 }
 
 TEST(SceneCpfg, GrammarAndViewFileGrowTheTree) {
