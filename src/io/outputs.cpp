@@ -135,18 +135,19 @@ void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const st
   std::vector<fs::path> probes;                    // the first file of each folder
   for (size_t i = 0; i < workers.size(); ++i) {
     workers[i]->sink->for_each_target([&](const fs::path& target) {
-      fs::path file;
+      OutputTarget resolved;
       try {
-        file = resolve_output_target(target);
+        resolved = resolve_output_target(target);
       } catch (const InputError& e) {
         throw InputError(outputs[i].pointer + "/path: " + e.what());
       }
+      const fs::path& file = resolved.file;
+      const std::string& kind = resolved.kind;
       const std::string absolute = file.is_absolute() ? file.string() : (cwd / file).string();
       const auto [it, inserted] = writer.emplace(absolute, i);
       if (!inserted)
         throw InputError(outputs[i].pointer + "/path: writes " + file.string() + ", which " +
                          outputs[it->second].pointer + " writes too");
-      const std::string kind = non_regular_kind(file);
       if (!kind.empty())
         throw InputError(outputs[i].pointer + "/path: " + target.string() +
                          (file == target ? " is " : " links to " + file.string() + ", ") + kind +

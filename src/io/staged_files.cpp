@@ -1,6 +1,5 @@
 #include "io/staged_files.h"
 
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -27,11 +26,32 @@ fs::path temporary_path(const fs::path& target) {
   return target.parent_path() / name;
 }
 
-fs::path resolve_output_target(const fs::path& target) {
+namespace {
+
+// What an lstat() found, as non_regular_kind describes it.
+std::string kind_of(const fs::file_status& status) {
+  switch (status.type()) {
+    case fs::file_type::not_found:
+    case fs::file_type::none:  // unreachable: the probe of the folder reports why
+    case fs::file_type::regular: return "";
+    case fs::file_type::directory: return "a directory";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::fifo: return "a FIFO";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::symlink: return "a symbolic link";
+    default: return "a file that is not a regular file";
+  }
+}
+
+}  // namespace
+
+OutputTarget resolve_output_target(const fs::path& target) {
   fs::path path = target;
   for (int links = 0;; ++links) {
     std::error_code error;
-    if (!fs::is_symlink(fs::symlink_status(path, error))) return path;
+    const fs::file_status status = fs::symlink_status(path, error);
+    if (!fs::is_symlink(status)) return {path, kind_of(status)};
     if (links == 40)  // Linux's own limit on a chain (ELOOP)
       throw InputError(target.string() + ": a loop of symbolic links, or a chain of more than 40");
     const fs::path next = fs::read_symlink(path, error);
@@ -41,16 +61,8 @@ fs::path resolve_output_target(const fs::path& target) {
 }
 
 std::string non_regular_kind(const fs::path& path) {
-  struct stat info;
-  if (::lstat(path.c_str(), &info) != 0) return "";  // absent (or unreachable: the probe reports it)
-  if (S_ISREG(info.st_mode)) return "";
-  if (S_ISDIR(info.st_mode)) return "a directory";
-  if (S_ISCHR(info.st_mode)) return "a character device";
-  if (S_ISBLK(info.st_mode)) return "a block device";
-  if (S_ISFIFO(info.st_mode)) return "a FIFO";
-  if (S_ISSOCK(info.st_mode)) return "a socket";
-  if (S_ISLNK(info.st_mode)) return "a symbolic link";
-  return "a file that is not a regular file";
+  std::error_code error;
+  return kind_of(fs::symlink_status(path, error));
 }
 
 void check_writable_target(const fs::path& target) {
@@ -68,7 +80,7 @@ void check_writable_target(const fs::path& target) {
 }
 
 fs::path StagedFiles::stage(const fs::path& target) {
-  targets_.push_back(resolve_output_target(target));
+  targets_.push_back(resolve_output_target(target).file);
   temporaries_.push_back(temporary_path(target));
   return temporaries_.back();
 }

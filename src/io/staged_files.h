@@ -11,10 +11,16 @@ namespace treeanim {
 // target => "<dir>/.<name>.tmp-<pid>" (hidden, same folder so rename() is atomic).
 std::filesystem::path temporary_path(const std::filesystem::path& target);
 
-// The file that writing `target` replaces: `target`, or where its chain of symbolic links ends.
-// A link is followed as cp and editors do, so the link stays and the file it names is replaced
-// (a dangling link: that file is created). Throws InputError on a loop or a chain over 40 links.
-std::filesystem::path resolve_output_target(const std::filesystem::path& target);
+// The file that writing a target replaces, and what stands there now.
+struct OutputTarget {
+  std::filesystem::path file;  // the target, or where its chain of symbolic links ends
+  std::string kind;            // as non_regular_kind: "" when absent or a regular file
+};
+
+// Follows `target`'s symbolic links as cp and editors do, so the link stays and the file it
+// names is replaced (a dangling link: that file is created); one lstat() per link, never an
+// open(). Throws InputError on a loop or a chain over 40 links.
+OutputTarget resolve_output_target(const std::filesystem::path& target);
 
 // What stands at `path` when it is neither absent nor a regular file: "a directory", "a character
 // device", "a block device", "a FIFO", "a socket"; "" otherwise. Looks with lstat(), so it never
