@@ -134,6 +134,7 @@ void write_prediction(const CheckpointFile& file, hid_t group, const StepPredict
   file.array(group, "prediction_velocity", file_type, memory_type, {3, hsize_t(p.velocity.rows())}, p.velocity.data());
   file.array(group, "prediction_drag_force", file_type, memory_type, {3, hsize_t(p.drag_force.rows())},
              p.drag_force.data());
+  file.array(group, "prediction_goal", file_type, memory_type, {3, hsize_t(p.goal.rows())}, p.goal.data());
 }
 
 template <typename Real>
@@ -142,9 +143,11 @@ void read_prediction(const CheckpointFile& file, hid_t group, const StepPredicti
   p.offset.resize(shape.offset.rows(), 3);
   p.velocity.resize(shape.velocity.rows(), 3);
   p.drag_force.resize(shape.drag_force.rows(), 3);
+  p.goal.resize(shape.goal.rows(), 3);
   file.read_array(group, "prediction_offset", memory_type, {3, hsize_t(p.offset.rows())}, p.offset.data());
   file.read_array(group, "prediction_velocity", memory_type, {3, hsize_t(p.velocity.rows())}, p.velocity.data());
   file.read_array(group, "prediction_drag_force", memory_type, {3, hsize_t(p.drag_force.rows())}, p.drag_force.data());
+  file.read_array(group, "prediction_goal", memory_type, {3, hsize_t(p.goal.rows())}, p.goal.data());
 }
 
 }  // namespace

@@ -39,12 +39,13 @@ void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>
 }
 
 // Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
-// asleep) and block.pull, each vertex's mean correction; kFromState: 0, after loading
-// u = x - x0 and v from the state (anchors included: they hold where they are).
+// asleep), their factors and, `with_pull`, block.pull, each vertex's mean correction;
+// kFromState first loads u = x - x0 and v from the state (anchors included: they hold where
+// they are).
 template <typename Real>
 void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                  const StepScratch<Real>& scratch, VertexPass pass, bool any_asleep, size_t begin, int n,
-                  VertexBlock<Real>& block) {
+                  const StepScratch<Real>& scratch, bool load_state, bool with_pull, bool any_asleep, size_t begin,
+                  int n, VertexBlock<Real>& block) {
   const TreeModel& tree = model.tree;
   StepPrediction<Real>& prediction = state.prediction<Real>();
   for (int k = 0; k < n; ++k) {
@@ -54,17 +55,85 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
     block.damping[k] = still ? Real(1) : model.vertex_damping[v];
+    block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
     block.flying[k] = still ? 0 : attachment.vertex_flying[v];
     Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
-    if (pass == VertexPass::kFromState) {
+    if (load_state) {
       prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
       prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
-    } else if (!still) {
+    } else if (with_pull && !still) {
       pull = mean_correction(tree, attachment, scratch, static_cast<uint32_t>(v)).transpose();
     }
     for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
   }
+}
+
+// The corrected vertices (prediction) => the state's positions and velocities, in double;
+// a vertex that does not move keeps its values.
+template <typename Real>
+void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                 bool any_asleep) {
+  const TreeModel& tree = model.tree;
+  const StepPrediction<Real>& prediction = state.prediction<Real>();
+#pragma omp parallel for schedule(static) if (model.parallel)
+  for (size_t v = 0; v < model.V; ++v) {
+    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
+                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+    if (still) continue;
+    state.positions.col(v) = tree.rest_positions.col(v) + prediction.offset.row(v).transpose().template cast<double>();
+    state.velocities.col(v) = prediction.velocity.row(v).transpose().template cast<double>();
+  }
+}
+
+// One kernel over every vertex, in parallel blocks => the lowest vertex whose values are not
+// finite and (`check_runaway`) the lowest attached one farther than the runaway limit.
+// Without sleeping islands every free vertex reads its mean correction from one row
+// (anchors: the zero row, with factors that keep them still); otherwise, and when a frame
+// starts from the state, each block is gathered lane by lane.
+template <typename Real, typename Kernel>
+std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                                                SimState& state, StepScratch<Real>& scratch, bool load_state,
+                                                bool with_pull, bool any_asleep, bool check_runaway, Kernel kernel) {
+  const TreeModel& tree = model.tree;
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  uint32_t bad = kNone, runaway = kNone;
+#pragma omp parallel if (model.parallel) reduction(min : bad, runaway)
+  {
+    const auto [first, last] =
+        balanced_range(tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    const bool direct = !load_state && !any_asleep;
+    if (direct && with_pull) average_shared_pulls(model, attachment, scratch, first, last);
+    const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
+                                  scratch.member_correction.col(2).data()};
+    VertexBlock<Real> block;
+    for (size_t begin = first; begin < last; begin += kVertexBlock) {
+      const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
+      VertexInputs<Real> in;
+      if (direct) {
+        in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
+              model.vertex_drag.data() + begin, model.vertex_damping.data() + begin,
+              model.vertex_half_damping.data() + begin, attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}};
+        std::fill(block.moving, block.moving + n, uint8_t(1));
+      } else {
+        gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
+        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
+              block.half_damping, block.global, block.flying, {}};
+      }
+      for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
+      if (!kernel(begin, n, in, block)) continue;
+      // Rare: find the first vertex at fault, as the scalar tests would.
+      for (int k = 0; k < n; ++k) {
+        if (!block.moving[k]) continue;
+        const uint32_t v = static_cast<uint32_t>(begin + k);
+        if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite()) bad = std::min(bad, v);
+        if (check_runaway && !attachment.vertex_flying[v] &&
+            prediction.offset.row(v).template cast<double>().squaredNorm() > model.runaway_distance2)
+          runaway = std::min(runaway, v);
+      }
+    }
+  }
+  return {bad, runaway};
 }
 
 }  // namespace
@@ -73,74 +142,20 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
 template <typename Real>
 bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
-  using Inputs = VertexInputs<Real>;
-  const TreeModel& tree = model.tree;
   StepPrediction<Real>& prediction = state.prediction<Real>();
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
-  uint32_t bad = kNone, runaway = kNone;
-#pragma omp parallel if (model.parallel) reduction(min : bad, runaway)
-  {
-    const auto [first, last] =
-        balanced_range(tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    // Without sleeping islands every free vertex moves and reads its mean correction from
-    // one row (anchors: the zero row, with factors that keep them still); otherwise, and when
-    // a frame starts from the state, each block is gathered lane by lane.
-    const bool direct = pass != VertexPass::kFromState && !any_asleep;
-    if (direct) average_shared_pulls(model, attachment, scratch, first, last);
-    const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
-                                  scratch.member_correction.col(2).data()};
-    VertexBlock<Real> block;
-    for (size_t begin = first; begin < last; begin += kVertexBlock) {
-      const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
-      Inputs in;
-      if (direct) {
-        in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
-              model.vertex_drag.data() + begin, model.vertex_damping.data() + begin,
-              attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin};
-        std::fill(block.moving, block.moving + n, uint8_t(1));
-      } else {
-        gather_block(model, attachment, state, scratch, pass, any_asleep, begin, n, block);
-        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
-              block.global, block.flying};
-      }
-      const bool end = pass == VertexPass::kLastStep;
-      const bool detach = model.detach_enabled;
-      const bool flagged =
-          end ? (detach ? predict_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
-                        : predict_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block))
-              : (detach ? predict_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block)
-                        : predict_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block));
-      if (end) {
-        // (3 x V) columns: x, y, z of a vertex are adjacent. A still lane keeps its value.
-        double* positions = state.positions.data() + 3 * begin;
-        double* velocities = state.velocities.data() + 3 * begin;
-        const double* rest = tree.rest_positions.data() + 3 * begin;
-#pragma omp simd
-        for (int k = 0; k < n; ++k)
-          for (int i = 0; i < 3; ++i) {
-            const bool moving = block.moving[k] != 0;
-            positions[3 * k + i] = moving ? rest[3 * k + i] + double(block.end_offset[i][k]) : positions[3 * k + i];
-            velocities[3 * k + i] = moving ? double(block.end_velocity[i][k]) : velocities[3 * k + i];
-          }
-      }
-      if (flagged) {  // rare: find the first vertex at fault, as the scalar tests would
-        for (int k = 0; k < n; ++k) {
-          if (!block.moving[k]) continue;
-          const uint32_t v = static_cast<uint32_t>(begin + k);
-          if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite() ||
-              (end && !(state.positions.col(v).allFinite() && state.velocities.col(v).allFinite())))
-            bad = std::min(bad, v);
-          const double moved2 = end ? Eigen::Matrix<Real, 3, 1>(block.end_offset[0][k], block.end_offset[1][k],
-                                                                block.end_offset[2][k])
-                                          .template cast<double>()
-                                          .squaredNorm()
-                                    : 0.0;
-          if (!attachment.vertex_flying[v] && moved2 > model.runaway_distance2) runaway = std::min(runaway, v);
-        }
-      }
-    }
-  }
+  const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
+  // 4. Correct the matched step (or load the state), and measure the drag of the next one.
+  auto [bad, runaway] = for_vertex_blocks(
+      model, attachment, state, scratch, load, !load, any_asleep, end,
+      [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+        if (model.store_drag_force)
+          return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                     : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
+        return end ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
+                   : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
+      });
   // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
   auto where = [&](uint32_t v) {
     return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
@@ -150,11 +165,20 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   if (runaway != kNone) {
     char distances[96];
     std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m)",
-                  (state.positions.col(runaway) - tree.rest_positions.col(runaway)).norm(),
-                  std::sqrt(model.runaway_distance2) / 2);
+                  prediction.offset.row(runaway).template cast<double>().norm(), std::sqrt(model.runaway_distance2) / 2);
     throw SimulationError(where(runaway) + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
   }
+  if (end) write_state(model, attachment, state, any_asleep);
+  // 1. The static deflection under that drag, and the prediction of the next step. The
+  // state's velocities are taken at its time: the first kick from them is half a step's.
+  const Real kick = load ? Real(0.5) : Real(1);
+  if (model.beam) compute_static_offsets(model, attachment, state, scratch);
+  bad = for_vertex_blocks(model, attachment, state, scratch, false, false, any_asleep, false,
+                          [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+                            return predict_block(model, attachment, scratch, prediction, begin, n, in, kick, block);
+                          }).first;
+  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
   return any_asleep;
 }
 

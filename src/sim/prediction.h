@@ -1,8 +1,10 @@
 #pragma once
-// The prediction of one step for a block of vertices (docs/solver.md, "One step" 1 and
-// "Wind and forces"): corrected u and v => damping, gravity, the global pull back to rest
-// (Eq. 8, -k u / h) and the exact quadratic drag => v* and u_p = u + h v*. One loop without
-// branches, vectorised across vertices; correction.cpp drives it.
+// The two per-vertex kernels of a step, for a block of vertices (docs/solver.md, "One step"
+// 1 and 4, "Wind and forces"): correct_block applies the mean correction of the matched step
+// and measures the drag the next step will feel; predict_block predicts the next step:
+// damping, gravity, the global pull toward the static deflection (Eq. 8) and the exact
+// quadratic drag => v* and u_p = u + h v*. Loops without branches, vectorised across
+// vertices; correction.cpp drives them.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -20,14 +22,15 @@ inline const std::array<uint32_t, kVertexBlock> kLaneIndex = [] {
   return lanes;
 }();
 
-// Where predict_block reads a block's vertices: the mean correction of vertex k is row
+// Where the kernels read a block's vertices: the mean correction of vertex k is row
 // pull_row[k] of `pull`; the factors are per vertex.
 template <typename Real>
 struct VertexInputs {
   const Real* pull[3];
   const uint32_t* pull_row;
-  const Real *drag, *damping, *global;
+  const Real *drag, *damping, *half_damping, *global;
   const uint8_t* flying;
+  const Real* goal[3];  // m: the offset from rest the global term pulls toward
 };
 
 template <typename Real>
@@ -36,93 +39,30 @@ struct VertexBlock {
   Real pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
   // Per-step factors of each vertex; a vertex that does not move gets those of a still
   // point (damping 1, no drag, no pull, no fall), which map its u = 0, v = 0 onto themselves
-  // exactly, so that the loop needs no branch.
+  // exactly, so that the loops need no branch.
   Real drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
-  Real damping[kVertexBlock];              // velocity factor
+  Real damping[kVertexBlock];              // velocity factor per step
+  Real half_damping[kVertexBlock];         // velocity factor per half step
   Real global[kVertexBlock];               // global rate per step
   uint8_t flying[kVertexBlock];            // 1 on a flying leaf
-  Real end_offset[3][kVertexBlock];        // m, corrected u at the end of a frame (kEnd)
-  Real end_velocity[3][kVertexBlock];      // m/s, corrected v at the end of a frame (kEnd)
   Real check[kVertexBlock];                // sum of the new values: finite iff all are
   Real excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
 };
 
-// Corrected vertices [begin, begin + n) => their prediction for the next step in
-// `prediction`, written for every lane (a still lane maps onto itself); with `kEnd` also the
-// corrected u and v in block.end_*. The drag's square root and division dominate the loop.
-// Returns true when some moving vertex turned non-finite or (kEnd) ran away; the caller
-// finds which.
-template <bool kEnd, bool kDetach, typename Real>
-inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
-                          const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-  const double h = model.h;
-  const Real inv_h = static_cast<Real>(1.0 / h), step = static_cast<Real>(h);
-  const Eigen::Vector3d& gravity = model.options.gravity;
-  const Real gravity_step[3] = {static_cast<Real>(gravity.x() * h), static_cast<Real>(gravity.y() * h),
-                                static_cast<Real>(gravity.z() * h)};
-  const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
-                        scratch.cluster_air.col(2).data()};
-  Real* force[3] = {nullptr, nullptr, nullptr};
-  if constexpr (kDetach)
-    for (int i = 0; i < 3; ++i) force[i] = prediction.drag_force.col(i).data() + begin;
-  const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
-  const double* mass = model.tree.vertex_mass.data() + begin;
-  const Real limit2 = static_cast<Real>(model.runaway_distance2);
-  Real *offset_x = prediction.offset.col(0).data() + begin, *offset_y = prediction.offset.col(1).data() + begin,
-       *offset_z = prediction.offset.col(2).data() + begin;
-  Real *velocity_x = prediction.velocity.col(0).data() + begin, *velocity_y = prediction.velocity.col(1).data() + begin,
-       *velocity_z = prediction.velocity.col(2).data() + begin;
-#pragma omp simd
-  for (int k = 0; k < n; ++k) {
-    const uint32_t c = air_cluster[k], row = in.pull_row[k];
-    const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
-    const Real ux = offset_x[k] + px, uy = offset_y[k] + py, uz = offset_z[k] + pz;
-    const Real vx = velocity_x[k] + px * inv_h, vy = velocity_y[k] + py * inv_h, vz = velocity_z[k] + pz * inv_h;
-    // A flying leaf falls (its global rate is 0); an attached vertex is pulled back. These
-    // impulses first, then the quadratic drag integrated exactly over the step for constant
-    // air velocity from the velocity they left: du/dt = -k|u|u gives |u(h)| = |u0| / (1 + k|u0|h),
-    // so the change never overshoots the air velocity, whatever the wind speed or step. In
-    // this order the drag damps the whole step (docs/solver.md, "Wind and forces").
-    const Real damping = in.damping[k], falling = static_cast<Real>(in.flying[k]), pull_back = in.global[k] * inv_h;
-    const Real fx = (vx * damping + falling * gravity_step[0]) - pull_back * ux;
-    const Real fy = (vy * damping + falling * gravity_step[1]) - pull_back * uy;
-    const Real fz = (vz * damping + falling * gravity_step[2]) - pull_back * uz;
-    const Real rx = air[0][c] - fx, ry = air[1][c] - fy, rz = air[2][c] - fz;
-    const Real kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
-    const Real share = kuh / (1 + kuh);
-    const Real nx = fx + rx * share, ny = fy + ry * share, nz = fz + rz * share;
-    const Real ax = ux + step * nx, ay = uy + step * ny, az = uz + step * nz;
-    velocity_x[k] = nx;
-    velocity_y[k] = ny;
-    velocity_z[k] = nz;
-    offset_x[k] = ax;
-    offset_y[k] = ay;
-    offset_z[k] = az;
-    if constexpr (kDetach) {
-      const Real scale = static_cast<Real>(mass[k]) * inv_h;
-      force[0][k] = rx * share * scale;
-      force[1][k] = ry * share * scale;
-      force[2][k] = rz * share * scale;
-    }
-    Real sum = ((ax + nx) + (ay + ny)) + (az + nz);
-    Real excess = 0;  // > 0: an attached vertex ran away (kEnd)
-    if constexpr (kEnd) {
-      block.end_offset[0][k] = ux;
-      block.end_offset[1][k] = uy;
-      block.end_offset[2][k] = uz;
-      block.end_velocity[0][k] = vx;
-      block.end_velocity[1][k] = vy;
-      block.end_velocity[2][k] = vz;
-      sum += (vx + vy) + vz;
-      excess = (1 - falling) * (ux * ux + uy * uy + uz * uz) - limit2;
-    }
-    block.check[k] = sum;
-    block.excess[k] = excess;
-  }
-  // One test for the block: a sum of finite values is finite (it only overflows far past any
-  // tree, and then the caller's rescan finds nothing). Kept out of the loop above: a
-  // reduction there stops GCC from vectorising it. The order of the sum decides nothing.
+// Exact quadratic drag over one step for constant air: du/dt = -k|u|u from u0 = air - v gives
+// |u(h)| = |u0| / (1 + k|u0|h), so the velocity change u0 k|u0|h / (1 + k|u0|h) never
+// overshoots the air velocity, whatever the wind speed or step. => that fraction of u0.
+template <typename Real>
+inline Real drag_share(Real drag, Real rx, Real ry, Real rz, Real step) {
+  const Real kuh = drag * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
+  return kuh / (1 + kuh);
+}
+
+// Block of n lanes => true when some moving lane turned non-finite or ran away; the caller
+// finds which. Kept out of the kernels' loops: a reduction there stops GCC from vectorising
+// them. The order of the sum decides nothing.
+template <typename Real>
+inline bool block_flagged(const VertexBlock<Real>& block, int n) {
   Real total = 0, worst = 0;
 #pragma omp simd reduction(+ : total) reduction(max : worst)
   for (int k = 0; k < n; ++k) {
@@ -130,6 +70,120 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     worst = std::max(worst, block.excess[k]);
   }
   return !(total - total == 0) || worst > 0;
+}
+
+// Predicted vertices [begin, begin + n) => corrected u and v in place (`prediction` then
+// holds the state at the step's end) and, with kForce, the drag each will feel over the next
+// step from its damped velocity (prediction.drag_force). With kEnd the runaway limit is
+// checked. Returns block_flagged.
+template <bool kEnd, bool kForce, typename Real>
+inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
+                          const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+  const Real inv_h = static_cast<Real>(1.0 / model.h), step = static_cast<Real>(model.h);
+  const Real half_inv_h = static_cast<Real>(0.5 / model.h);
+  const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
+                        scratch.cluster_air.col(2).data()};
+  Real* force[3] = {nullptr, nullptr, nullptr};
+  if constexpr (kForce)
+    for (int i = 0; i < 3; ++i) force[i] = prediction.drag_force.col(i).data() + begin;
+  const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
+  const double* mass = model.tree.vertex_mass.data() + begin;
+  const Real limit2 = static_cast<Real>(model.runaway_distance2);
+  Real* offset[3] = {prediction.offset.col(0).data() + begin, prediction.offset.col(1).data() + begin,
+                     prediction.offset.col(2).data() + begin};
+  Real* velocity[3] = {prediction.velocity.col(0).data() + begin, prediction.velocity.col(1).data() + begin,
+                       prediction.velocity.col(2).data() + begin};
+#pragma omp simd
+  for (int k = 0; k < n; ++k) {
+    const uint32_t row = in.pull_row[k];
+    const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+    const Real ux = offset[0][k] + px, uy = offset[1][k] + py, uz = offset[2][k] + pz;
+    const Real vx = velocity[0][k] + px * inv_h, vy = velocity[1][k] + py * inv_h, vz = velocity[2][k] + pz * inv_h;
+    offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
+    velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+    if constexpr (kForce) {
+      // The drag at the step's start, from the velocity there: half a step of damping and of
+      // the last goal's pull after the staggered v (second order; docs/solver.md "One step").
+      const uint32_t c = air_cluster[k];
+      const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h;
+      const Real rx = air[0][c] - (vx * half - pull_back * (ux - in.goal[0][k]));
+      const Real ry = air[1][c] - (vy * half - pull_back * (uy - in.goal[1][k]));
+      const Real rz = air[2][c] - (vz * half - pull_back * (uz - in.goal[2][k]));
+      const Real kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
+      const Real scale = kuh / std::sqrt(1 + Real(0.25) * kuh * kuh) * static_cast<Real>(mass[k]) * inv_h;
+      force[0][k] = rx * scale;
+      force[1][k] = ry * scale;
+      force[2][k] = rz * scale;
+    }
+    block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
+    Real excess = 0;  // > 0: an attached vertex ran away
+    if constexpr (kEnd)
+      excess = (1 - static_cast<Real>(in.flying[k])) * (ux * ux + uy * uy + uz * uz) - limit2;
+    block.excess[k] = excess;
+  }
+  return block_flagged(block, n);
+}
+
+// Corrected vertices [begin, begin + n) => their prediction for the next step, in place,
+// written for every lane (a still lane maps onto itself). `kick` is 1, or 1/2 when the
+// velocities are not staggered (a step from the state: leapfrog's first half kick). The
+// drag's square roots and divisions dominate the loop. Returns block_flagged.
+template <typename Real>
+inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
+                          const VertexInputs<Real>& in, Real kick, VertexBlock<Real>& block) {
+  const double h = model.h;
+  const Real inv_h = static_cast<Real>(1.0 / h) * kick, step = static_cast<Real>(h), half_step = static_cast<Real>(h / 2);
+  // The drag moves an attached vertex itself only without the beam (per_step stiffness);
+  // with it, the drag acts through the goal. A flying leaf always feels it.
+  const Real direct = model.beam ? Real(0) : Real(1);
+  // The global term: a kick toward the goal with the beam, else a projection of the prediction.
+  const Real kicked = model.beam ? Real(1) : Real(0), projected = Real(1) - kicked;
+  const Real inv_step = static_cast<Real>(1.0 / h);
+  const Eigen::Vector3d& gravity = model.options.gravity;
+  const Real gravity_step[3] = {static_cast<Real>(gravity.x() * h) * kick, static_cast<Real>(gravity.y() * h) * kick,
+                                static_cast<Real>(gravity.z() * h) * kick};
+  const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
+                        scratch.cluster_air.col(2).data()};
+  const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
+  Real* offset[3] = {prediction.offset.col(0).data() + begin, prediction.offset.col(1).data() + begin,
+                     prediction.offset.col(2).data() + begin};
+  Real* velocity[3] = {prediction.velocity.col(0).data() + begin, prediction.velocity.col(1).data() + begin,
+                       prediction.velocity.col(2).data() + begin};
+#pragma omp simd
+  for (int k = 0; k < n; ++k) {
+    const uint32_t c = air_cluster[k];
+    const Real ux = offset[0][k], uy = offset[1][k], uz = offset[2][k];
+    const Real ax = air[0][c], ay = air[1][c], az = air[2][c];
+    // A symmetric (Strang) splitting of the step's velocity change about the kick of the
+    // corrected position: half the damping, half the drag, the kick (gravity on a flying leaf,
+    // with the beam the global pull toward the goal on an attached vertex), half the drag,
+    // half the damping. Each half is exact for its own term, so the whole is second order in
+    // h and never overshoots (docs/solver.md, "One step").
+    const Real half = in.half_damping[k], falling = static_cast<Real>(in.flying[k]);
+    const Real pull_back = in.global[k] * inv_h * kicked, drag = in.drag[k] * std::max(direct, falling);
+    Real vx = velocity[0][k] * half, vy = velocity[1][k] * half, vz = velocity[2][k] * half;
+    Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
+    vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]);
+    vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]);
+    vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]);
+    share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    vx = (vx + (ax - vx) * share) * half, vy = (vy + (ay - vy) * share) * half, vz = (vz + (az - vz) * share) * half;
+    Real px = ux + step * vx, py = uy + step * vy, pz = uz + step * vz;
+    // Without the beam, Eq. 8 as the paper writes it: the global rate moves the predicted
+    // position toward rest, a projection that no wind or step can overshoot.
+    const Real project = in.global[k] * projected;
+    const Real ex = project * (in.goal[0][k] - px), ey = project * (in.goal[1][k] - py), ez = project * (in.goal[2][k] - pz);
+    px += ex, py += ey, pz += ez;
+    vx += ex * inv_step, vy += ey * inv_step, vz += ez * inv_step;
+    velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+    offset[0][k] = px, offset[1][k] = py, offset[2][k] = pz;
+    block.check[k] = ((px + vx) + (py + vy)) + (pz + vz);
+    block.excess[k] = 0;
+  }
+  return block_flagged(block, n);
 }
 
 }  // namespace treeanim

@@ -17,7 +17,10 @@ struct StepPrediction {
   using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;  // (n x 3), a column per axis
   Rows3 offset;      // (V x 3) m, u_p = p - x0: the predicted position as a displacement from rest
   Rows3 velocity;    // (V x 3) m/s, v* of the predicted step
-  Rows3 drag_force;  // (V x 3) N, the drag in that step; (0 x 3) unless leaves can detach
+  Rows3 drag_force;  // (V x 3) N, the drag in that step; (0 x 3) without detaching leaves or the beam
+  // (V x 3) m, the offset from rest the global term pulled toward in that step (the static
+  // deflection; 0 without the beam). The next step's velocity estimate reads it.
+  Rows3 goal;
 };
 
 struct SimState {

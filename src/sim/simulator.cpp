@@ -48,7 +48,8 @@ SimState Solver<Real>::initial_state(double time) const {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   prediction.offset.setZero(model.V, 3);
   prediction.velocity.setZero(model.V, 3);
-  prediction.drag_force.setZero(model.detach_enabled ? model.V : 0, 3);
+  prediction.drag_force.setZero(model.store_drag_force ? model.V : 0, 3);
+  prediction.goal.setZero(model.V, 3);
   return state;
 }
 
@@ -64,10 +65,11 @@ void Solver<Real>::adopt(SimState& state, long long frame) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   const auto rows = static_cast<Eigen::Index>(model.V);
   if (prediction.offset.rows() != rows || prediction.velocity.rows() != rows ||
-      prediction.drag_force.rows() != (model.detach_enabled ? rows : 0)) {
+      prediction.drag_force.rows() != (model.store_drag_force ? rows : 0) || prediction.goal.rows() != rows) {
     prediction.offset.setZero(rows, 3);
     prediction.velocity.setZero(rows, 3);
-    prediction.drag_force.setZero(model.detach_enabled ? rows : 0, 3);
+    prediction.drag_force.setZero(model.store_drag_force ? rows : 0, 3);
+    prediction.goal.setZero(rows, 3);
     state.predicted = false;
   }
   adopt_leaf_flags(model, state, attachment);

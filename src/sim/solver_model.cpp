@@ -4,6 +4,7 @@
 
 #include "common/errors.h"
 #include "sim/solver_model.h"
+#include "sim/bar_chain.h"
 #include "sim/stiffness.h"
 
 namespace treeanim {
@@ -85,6 +86,34 @@ void precompute_drag(SolverModel<Real>& m, const WindOptions& w) {
   }
 }
 
+// Leaf cluster c => the compliance of its petiole, rad/(N m): it turns by options.leaf_turn
+// when a 10 m/s wind blows across its blade (a scale-free stiffness: a large leaf has a
+// stout petiole). 0 for a leaf without area or arm.
+template <typename Real>
+double leaf_compliance(const SolverModel<Real>& m, const WindOptions& wind, uint32_t c) {
+  const TreeModel& tree = m.tree;
+  double area = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+    const uint32_t v = tree.cluster_members[s];
+    area += tree.vertex_drag_area[v];
+    centroid += tree.vertex_drag_area[v] * tree.rest_positions.col(v);
+  }
+  if (!(area > 0)) return 0;
+  const double arm = (centroid / area - m.chain.cluster_joint.col(c)).norm();
+  const double moment = 0.5 * wind.air_density * wind.leaf_drag_coefficient * area * 100 * arm;  // at 10 m/s
+  return moment > 0 ? m.options.leaf_turn / moment : 0;
+}
+
+// The bar chain of the beam (bar_chain.h), each leaf's petiole compliance added.
+template <typename Real>
+void precompute_beam(SolverModel<Real>& m, const WindOptions& wind) {
+  m.chain = build_bar_chain(m.tree, m.options.youngs_modulus);
+  for (size_t c = 0; c < m.C; ++c)
+    if (m.tree.cluster_kind[c] == kClusterLeaf)
+      m.chain.cluster_compliance[c] = leaf_compliance(m, wind, static_cast<uint32_t>(c));
+}
+
 // Clusters sharing a non-anchored vertex => one island (anchors hold, they do not couple).
 template <typename Real>
 void precompute_islands(SolverModel<Real>& m) {
@@ -130,6 +159,7 @@ template <typename Real>
 SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const WindOptions& w, double dt, int n)
     : tree(t), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n), V(t.vertex_count()), C(t.cluster_count()),
       M(t.membership_count()), L(t.leaf_count()), I(0), detach_enabled(o.leaf_detach_force > 0 && t.leaf_count() > 0),
+      beam(o.stiffness == StiffnessMode::kPhysical && o.global_matching), store_drag_force(detach_enabled || beam),
       parallel(t.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   const double size = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
@@ -143,7 +173,10 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   cluster_alpha = rates.cluster_alpha;
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
   vertex_damping.assign(rates.vertex_damping.begin(), rates.vertex_damping.end());
+  vertex_half_damping.resize(V);
+  for (size_t v = 0; v < V; ++v) vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
   precompute_drag(*this, w);
+  precompute_beam(*this, w);
   precompute_islands(*this);
   a.cluster_flying.assign(C, 0);
   a.vertex_flying.assign(V, 0);
@@ -215,6 +248,10 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   member_correction.setZero(m.M + 1, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
+  cluster_load.setZero(3, m.C);
+  cluster_moment.setZero(3, m.C);
+  cluster_static_rotation.setZero(9, m.C);
+  cluster_static_joint.setZero(3, m.C);
   island_fell_asleep.assign(m.I, 0);
 }
 

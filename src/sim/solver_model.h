@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/bar_chain.h"
 #include "sim/sim_options.h"
 #include "sim/sim_state.h"
 #include "sim/wind.h"
@@ -80,6 +81,10 @@ struct SolverModel {
   double runaway_distance2;
   size_t V, C, M, L, I;
   bool detach_enabled;                     // leaf_detach_force > 0 and the tree has leaves
+  // Physical stiffness with the global term: it pulls toward the static deflection of the
+  // clusters as a beam (beam_statics.cpp), and the drag acts on branches through it.
+  bool beam;
+  bool store_drag_force;                   // the prediction keeps each vertex's drag (detachment, beam)
   // Threads only pay off above a few thousand memberships; below, the fork/join costs more
   // than the work (results are identical either way).
   bool parallel;
@@ -91,7 +96,9 @@ struct SolverModel {
   std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
   std::vector<Real> vertex_damping;        // (V) velocity factor per step
+  std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---
@@ -119,6 +126,10 @@ struct StepScratch {
   Rows3<Real> member_correction;
   Rows3<Real> cluster_air;                 // (C x 3) m/s, air velocity at the cluster for the step being predicted
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of this step's fit, column-major
+  Eigen::Matrix3Xd cluster_load;           // (3 x C) N, drag on the cluster and everything beyond it
+  Eigen::Matrix3Xd cluster_moment;         // (3 x C) N m, its moment about the cluster's joint
+  Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_static_rotation;  // (9 x C) the cluster's turn in the static deflection
+  Eigen::Matrix3Xd cluster_static_joint;   // (3 x C) m, where its joint is in the static deflection
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
   AirSample air;                           // the wind at the time being sampled
 

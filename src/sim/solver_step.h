@@ -35,6 +35,13 @@ template <typename Real>
 void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                         StepScratch<Real>& scratch, long long frame);
 
+// --- beam_statics.cpp ---
+// The step's drag (prediction.drag_force) and positions, the clusters' fits => each vertex's
+// offset in the tree's static deflection under those loads (prediction.goal).
+template <typename Real>
+void compute_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                            StepScratch<Real>& scratch);
+
 // --- shape_matching.cpp ---
 // Predicted positions => rotations, shifts and per-membership corrections of every awake
 // cluster: branches and free leaves, then the attached leaves (attached_leaves.cpp), each

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "common/errors.h"
+#include "sim/bar_chain.h"
 
 namespace treeanim {
 
@@ -58,17 +59,9 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, Ste
       if (!model.vertex_anchored[v]) own_mass[c] += model.vertex_mass[v] / k;
     }
   const std::vector<uint32_t> order = parents_first(model);
-  // Children before parents: the limb hanging from c has the mass of its subtree and the
-  // length of its longest branch path (leaves add mass, not length).
-  std::vector<double> limb_mass(own_mass), limb_length(C, 0);
-  for (size_t i = C; i-- > 0;) {
-    const uint32_t c = order[i];
-    if (model.cluster_kind[c] == kClusterBranch) limb_length[c] += model.cluster_length[c];
-    const int32_t p = model.cluster_parent[c];
-    if (p < 0) continue;
-    limb_mass[p] += limb_mass[c];
-    limb_length[p] = std::max(limb_length[p], limb_length[c]);
-  }
+  // The limb hanging from each cluster: its first frequency as a bar chain (Rayleigh), so
+  // that taper, branching and the crown's mass, leaves included, set it as they set a tree's.
+  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, E));
   // Parents before children: a cluster sways at most at the frequency of the softest limb
   // between it and the ground (a twig on a swaying bough moves with the bough).
   rates.cluster_frequency.assign(C, 0);
@@ -80,10 +73,8 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, Ste
       rates.cluster_limb_frequency[c] = std::isfinite(parent) ? parent : 0;
       continue;
     }
-    const double r = model.cluster_radius[c];
-    rates.cluster_frequency[c] = cantilever_frequency(E, r, model.cluster_length[c], own_mass[c]);
-    const double limb = cantilever_frequency(E, r, limb_length[c], limb_mass[c]);
-    rates.cluster_limb_frequency[c] = std::min(parent, limb);
+    rates.cluster_frequency[c] = cantilever_frequency(E, model.cluster_radius[c], model.cluster_length[c], own_mass[c]);
+    rates.cluster_limb_frequency[c] = std::min(parent, limb[c]);
   }
 }
 

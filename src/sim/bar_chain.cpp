@@ -1,0 +1,104 @@
+#include "sim/bar_chain.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace treeanim {
+
+BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus) {
+  const size_t C = tree.cluster_count();
+  BarChain chain;
+  chain.cluster_joint.setZero(3, C);
+  chain.cluster_compliance.assign(C, 0);
+  std::vector<int64_t> first(C, -1);  // each cluster's first segment
+  for (size_t s = tree.segment_cluster.size(); s-- > 0;)
+    if (tree.segment_cluster[s] < C) first[tree.segment_cluster[s]] = static_cast<int64_t>(s);
+  std::vector<double> half(C, 0);  // (C) rad/(N m), half the flexibility L / (E I) of each branch cluster
+  for (size_t c = 0; c < C; ++c) {
+    const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+    const int32_t leaf = tree.cluster_leaf[c];
+    if (tree.cluster_kind[c] == kClusterLeaf && leaf >= 0) {
+      chain.cluster_joint.col(c) = tree.rest_positions.col(tree.leaf_attachment_vertex[leaf]);
+      continue;
+    }
+    if (first[c] >= 0) {
+      chain.cluster_joint.col(c) = tree.segment_start[first[c]];
+    } else if (end > begin) {  // no segment (a hand-built model): its members' centre
+      for (uint32_t s = begin; s < end; ++s) chain.cluster_joint.col(c) += tree.rest_positions.col(tree.cluster_members[s]);
+      chain.cluster_joint.col(c) /= double(end - begin);
+    }
+    if (tree.cluster_kind[c] == kClusterLeaf) continue;
+    const double r = tree.cluster_radius[c], second_moment = std::numbers::pi * r * r * r * r / 4;
+    half[c] = second_moment > 0 ? tree.cluster_length[c] / (2 * youngs_modulus * second_moment) : 0;
+  }
+  for (size_t c = 0; c < C; ++c) {
+    if (tree.cluster_kind[c] == kClusterLeaf) continue;
+    chain.cluster_compliance[c] = half[c];
+    const int32_t p = tree.cluster_parent[c];
+    if (p < 0) continue;
+    // It continues its parent's axis when its base ring was built for the parent's segment
+    // (a lateral has a base ring of its own).
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+      const int32_t segment = tree.vertex_segment[tree.cluster_members[s]];
+      if (segment >= 0 && size_t(segment) < tree.segment_cluster.size() &&
+          tree.segment_cluster[segment] == static_cast<uint32_t>(p)) {
+        chain.cluster_compliance[c] += half[p];
+        break;
+      }
+    }
+  }
+  return chain;
+}
+
+std::vector<double> limb_frequencies(const TreeModel& tree, const BarChain& chain) {
+  const size_t C = tree.cluster_count(), V = tree.vertex_count();
+  std::vector<double> stiffness(C, 0), inertia(C, 0);  // (C) sum m g.u, sum m |u|^2 of each limb
+  for (const Eigen::Vector3d load : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ()}) {
+    // Each vertex's weight, turned along `load`, shared among its clusters; children before
+    // parents (cluster_parent[c] < c), the moment about each joint of everything beyond it.
+    Eigen::Matrix3Xd force = Eigen::Matrix3Xd::Zero(3, C), moment = Eigen::Matrix3Xd::Zero(3, C);
+    for (size_t v = 0; v < V; ++v) {
+      const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+      if (tree.vertex_anchored[v] || end == begin) continue;
+      const Eigen::Vector3d f = load * (tree.vertex_mass[v] / double(end - begin));
+      for (uint32_t s = begin; s < end; ++s) {
+        const uint32_t c = static_cast<uint32_t>(
+            std::upper_bound(tree.cluster_offsets.begin(), tree.cluster_offsets.end(), tree.vertex_memberships[s]) -
+            tree.cluster_offsets.begin() - 1);
+        force.col(c) += f;
+        moment.col(c) += (tree.rest_positions.col(v) - chain.cluster_joint.col(c)).cross(f);
+      }
+    }
+    for (size_t c = C; c-- > 0;) {
+      const int32_t p = tree.cluster_parent[c];
+      if (p < 0) continue;
+      force.col(p) += force.col(c);
+      moment.col(p) += moment.col(c) + (chain.cluster_joint.col(c) - chain.cluster_joint.col(p)).cross(force.col(c));
+    }
+    // Each vertex moves with the deepest of its clusters; walking up from there, the turns of
+    // the joints passed so far are its deflection in the limb clamped at the current joint.
+    for (size_t v = 0; v < V; ++v) {
+      const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+      if (tree.vertex_anchored[v] || end == begin) continue;
+      int32_t c = static_cast<int32_t>(
+          std::upper_bound(tree.cluster_offsets.begin(), tree.cluster_offsets.end(), tree.vertex_memberships[end - 1]) -
+          tree.cluster_offsets.begin() - 1);
+      const double m = tree.vertex_mass[v];
+      Eigen::Vector3d u = Eigen::Vector3d::Zero();
+      for (; c >= 0; c = tree.cluster_parent[c]) {
+        u += (chain.cluster_compliance[c] * moment.col(c)).cross(tree.rest_positions.col(v) - chain.cluster_joint.col(c));
+        stiffness[c] += m * load.dot(u);
+        inertia[c] += m * u.squaredNorm();
+      }
+    }
+  }
+  std::vector<double> frequency(C, std::numeric_limits<double>::infinity());
+  for (size_t c = 0; c < C; ++c)
+    if (inertia[c] > 0 && stiffness[c] > 0) frequency[c] = std::sqrt(stiffness[c] / inertia[c]);
+  return frequency;
+}
+
+}  // namespace treeanim
