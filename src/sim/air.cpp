@@ -4,29 +4,23 @@
 
 namespace treeanim {
 
-void set_air_time(const WindField& wind, double t, AirSample& air) {
-  air.base = wind.base(t);
-  air.scale = wind.temporal_phases(t, air.sin_b, air.cos_b);
-}
+void set_air_time(const WindField& wind, double t, AirSample& air) { wind.sample_time(t, air); }
 
 template <typename Real>
 void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                         StepScratch<Real>& scratch, size_t c) {
   const WindField& wind = model.wind;
-  const AirSample& air = scratch.air;
-  const int N = wind.mode_count();
+  Eigen::Vector3d velocity;
   if (attachment.cluster_flying[c]) {
-    double sin_a[kMaxModes], cos_a[kMaxModes];
+    double sin_a[kMaxPhases], cos_a[kMaxPhases];
     wind.spatial_phases(Eigen::Vector3d(attachment.cluster_rest_centre.col(c) + state.cluster_shift.col(c)), sin_a,
                         cos_a);
-    const Eigen::Vector3d velocity = air.base + wind.turbulence(sin_a, cos_a, air.sin_b, air.cos_b, air.scale);
-    scratch.cluster_air.row(c) = velocity.transpose().template cast<Real>();
+    velocity = wind.velocity(sin_a, cos_a, scratch.air);
   } else {
-    const Eigen::Vector3d velocity =
-        air.base + wind.turbulence(&model.cluster_turbulence_sin[c * N], &model.cluster_turbulence_cos[c * N],
-                                   air.sin_b, air.cos_b, air.scale);
-    scratch.cluster_air.row(c) = velocity.transpose().template cast<Real>();
+    const size_t P = size_t(wind.phase_count());
+    velocity = wind.velocity(&model.cluster_phase_sin[c * P], &model.cluster_phase_cos[c * P], scratch.air);
   }
+  scratch.cluster_air.row(c) = velocity.transpose().template cast<Real>();
 }
 
 template void sample_cluster_air(const SolverModel<float>&, const Attachment<float>&, const SimState&,

@@ -181,13 +181,13 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   a.cluster_flying.assign(C, 0);
   a.vertex_flying.assign(V, 0);
   a.leaf_attached.assign(L, 1);
-  // Spatial turbulence phases at the rest centres: the tree moves little against the
-  // length scale of the eddies, so they are evaluated once (flying leaves use their centre).
-  const int N = wind.mode_count();
-  cluster_turbulence_sin.resize(C * N);
-  cluster_turbulence_cos.resize(C * N);
+  // Spatial phases of the wind at the rest centres: the tree moves little against the length
+  // scales of the eddies and gusts, so they are evaluated once (flying leaves use their centre).
+  const size_t P = size_t(wind.phase_count());
+  cluster_phase_sin.resize(C * P);
+  cluster_phase_cos.resize(C * P);
   for (size_t c = 0; c < C; ++c)
-    wind.spatial_phases(a.cluster_rest_centre.col(c), &cluster_turbulence_sin[c * N], &cluster_turbulence_cos[c * N]);
+    wind.spatial_phases(a.cluster_rest_centre.col(c), &cluster_phase_sin[c * P], &cluster_phase_cos[c * P]);
 }
 
 // Weights are vertex masses; a cluster without mass (all members anchored or massless)

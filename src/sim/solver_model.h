@@ -20,7 +20,6 @@
 namespace treeanim {
 
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
-constexpr int kMaxModes = 64;  // the scene reader caps wind.turbulence_modes here
 
 // Arrays of 3-vectors that the step reads or writes are (n x 3): a column per axis
 // (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
@@ -93,7 +92,9 @@ struct SolverModel {
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint32_t> cluster_pin_own_slot;  // (C) leaf pinned to a branch: membership of the shared vertex in the leaf
-  std::vector<double> cluster_turbulence_sin, cluster_turbulence_cos;  // (C x N) spatial phases at t0
+  // (C x P) spatial phases of the wind (turbulence modes, then gust waves) at t0: the air a
+  // cluster feels is a function of its world position
+  std::vector<double> cluster_phase_sin, cluster_phase_cos;
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
   std::vector<Real> vertex_damping;        // (V) velocity factor per step
   std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step
@@ -109,13 +110,6 @@ struct SolverModel {
 
   SolverModel(const TreeModel& tree, const HsmOptions& options, const WindOptions& wind, double frame_dt,
               int substeps);
-};
-
-// The wind terms shared by every cluster at one time (set_air_time).
-struct AirSample {
-  Eigen::Vector3d base = Eigen::Vector3d::Zero();  // m/s, mean wind + gust
-  double scale = 0;                                // m/s, turbulence amplitude
-  double sin_b[kMaxModes] = {}, cos_b[kMaxModes] = {};  // temporal phases of the modes
 };
 
 // Per-step buffers: written before they are read within a step (no allocation in the step).

@@ -31,6 +31,14 @@ size_t interval_of(const std::vector<double>& times, double t) {
   return lo;
 }
 
+// Wave vector k, drift per period D (non-zero) => k with its component along D rounded to a
+// whole number of cycles over D, so that sin(k . (x - D(t)) + ...) repeats with the loop.
+Eigen::Vector3d whole_cycles_along(const Eigen::Vector3d& k, const Eigen::Vector3d& drift) {
+  const Eigen::Vector3d along = drift.normalized();
+  const double cycles = std::round(k.dot(drift) / (2 * std::numbers::pi));
+  return k + (2 * std::numbers::pi * cycles / drift.norm() - k.dot(along)) * along;
+}
+
 }  // namespace
 
 WindField::WindField(const WindOptions& options)
@@ -41,7 +49,7 @@ WindField::WindField(const WindOptions& options)
     key_gust.push_back(k.gust);
   }
   // Exact integral of the piecewise-linear mean wind (trapezoids), for the advection of the
-  // frozen turbulence: a function of t alone, so the field does not depend on the step.
+  // frozen patterns: a function of t alone, so the field does not depend on the step.
   key_advection.assign(key_time.size(), Eigen::Vector3d::Zero());
   for (size_t k = 1; k < key_time.size(); ++k)
     key_advection[k] = key_advection[k - 1] +
@@ -49,10 +57,11 @@ WindField::WindField(const WindOptions& options)
 
   std::mt19937_64 rng(options.seed ^ 0x7475726275ull);  // "turbu": the turbulence stream
   const int n = options.turbulence_modes;
-  mode_wave.resize(3, n);
+  mode_turbulence = n;
+  mode_wave.resize(3, n + kGustWaves);
   mode_amplitude.resize(3, n);
-  mode_phase.resize(n);
-  mode_omega.resize(n);
+  mode_phase.resize(n + kGustWaves);
+  mode_omega.resize(n + kGustWaves);
   // Unit amplitudes normal to k (divergence-free modes); the sum of n modes with random
   // directions has a per-component rms of sqrt(n/6), hence the factor sqrt(6/n).
   const double normalise = std::sqrt(6.0 / n);
@@ -67,13 +76,40 @@ WindField::WindField(const WindOptions& options)
     mode_phase[m] = 2 * std::numbers::pi * uniform01(rng);
     mode_omega[m] = 2 * std::numbers::pi * options.turbulence_frequency * (0.5 + uniform01(rng));
   }
-  // Gusts: three sinusoids at incommensurate multiples of the gust rate, normalised to [-1, 1].
-  const double ratios[3] = {1.0, 1.6180339887498949, 2.4142135623730951};
-  for (int j = 0; j < 3; ++j) {
-    gust_omega[j] = 2 * std::numbers::pi * options.gust_frequency * ratios[j];
-    gust_phase[j] = 2 * std::numbers::pi * uniform01(rng);
+  // Gusts: three waves at incommensurate multiples of the gust rate, summed and normalised to
+  // [-1, 1]; their fronts are tilted by up to 45 degrees about the up axis (gusts of finite width).
+  const double ratios[kGustWaves] = {1.0, 1.6180339887498949, 2.4142135623730951};
+  double rates[kGustWaves], tilts[kGustWaves];
+  for (int j = 0; j < kGustWaves; ++j) {
+    rates[j] = 2 * std::numbers::pi * options.gust_frequency * ratios[j];
+    mode_phase[n + j] = 2 * std::numbers::pi * uniform01(rng);
+    mode_omega[n + j] = 0;
   }
+  for (double& tilt : tilts) tilt = std::numbers::pi / 4 * (2 * uniform01(rng) - 1);
+  make_gust_waves(rates, tilts);
   if (loop_period > 0) make_periodic();
+}
+
+void WindField::make_gust_waves(const double* rates, const double* tilts) {
+  // The gust pattern is frozen in the air like the turbulence, so at a point it changes at
+  // k . mean: its wave numbers along the wind are the rates over the fastest key's speed,
+  // which gives the asked rates in that wind and slower gusts in weaker wind. The wave
+  // vectors point upwind: in a steady wind from the first key on, each wave at the origin is
+  // sin(w (t - t_first) + phi), the gust signal of a single point.
+  size_t fastest = 0;
+  for (size_t k = 1; k < key_wind.size(); ++k)
+    if (key_wind[k].norm() > key_wind[fastest].norm()) fastest = k;
+  const double speed = key_wind.empty() ? 0.0 : key_wind[fastest].norm();
+  const int n = mode_turbulence;
+  if (!(speed > 0)) {  // calm throughout: there are no gusts to carry
+    mode_wave.rightCols(kGustWaves).setZero();
+    return;
+  }
+  const Eigen::Vector3d along = key_wind[fastest] / speed;
+  Eigen::Vector3d across = along.cross(Eigen::Vector3d::UnitY());
+  across = across.norm() > 1e-6 ? across.normalized() : along.unitOrthogonal();  // a vertical wind
+  for (int j = 0; j < kGustWaves; ++j)
+    mode_wave.col(n + j) = -rates[j] / speed * (along + std::tan(tilts[j]) * across);
 }
 
 void WindField::make_periodic() {
@@ -83,18 +119,17 @@ void WindField::make_periodic() {
     const double cycles = std::max(1.0, std::round(omega * loop_period / (2 * std::numbers::pi)));
     return 2 * std::numbers::pi * cycles / loop_period;
   };
-  for (double& omega : gust_omega) omega = whole_cycles(omega);
+  for (int m = 0; m < mode_count(); ++m) mode_omega[m] = whole_cycles(mode_omega[m]);
   const double drift = loop_advection.norm();
+  if (drift == 0) return;  // D(t) itself repeats: every wave does
+  // The frozen patterns drift by loop_advection per period: k . drift must be whole cycles too.
+  // Only the wave vector's component along the drift changes.
+  for (int j = mode_count(); j < phase_count(); ++j)
+    mode_wave.col(j) = whole_cycles_along(mode_wave.col(j), loop_advection);
+  // A turbulence mode keeps its amplitude normal to the new wave vector (divergence-free).
+  const Eigen::Vector3d along = loop_advection / drift;
   for (int m = 0; m < mode_count(); ++m) {
-    mode_omega[m] = whole_cycles(mode_omega[m]);
-    if (drift == 0) continue;
-    // The frozen field drifts by loop_advection per period: k . drift must be whole cycles too.
-    // Only the wave vector's component along the drift changes; the amplitude is kept normal
-    // to it, so the field stays divergence-free.
-    const Eigen::Vector3d along = loop_advection / drift;
-    Eigen::Vector3d k = mode_wave.col(m);
-    const double cycles = std::round(k.dot(loop_advection) / (2 * std::numbers::pi));
-    k += (2 * std::numbers::pi * cycles / drift - k.dot(along)) * along;
+    Eigen::Vector3d k = whole_cycles_along(mode_wave.col(m), loop_advection);
     if (k.norm() < 1e-12) k = mode_wave.col(m).cross(along);  // a mode with no drift component left
     const double scale = mode_amplitude.col(m).norm();
     Eigen::Vector3d a = mode_amplitude.col(m) - mode_amplitude.col(m).dot(k.normalized()) * k.normalized();
@@ -129,20 +164,6 @@ double WindField::gust_amplitude(double t) const {
   return (1 - s) * key_gust[k] + s * key_gust[k + 1];
 }
 
-double WindField::gust_signal(double t) const {
-  double sum = 0;
-  for (int j = 0; j < 3; ++j) sum += std::sin(gust_omega[j] * t + gust_phase[j]);
-  return sum / 3;
-}
-
-Eigen::Vector3d WindField::base(double t) const {
-  const Eigen::Vector3d m = mean(t);
-  const double gust = gust_amplitude(t);
-  const double speed = m.norm();
-  if (gust == 0 || speed == 0) return m;  // a gust needs a direction: none in still air
-  return m * (1 + gust * gust_signal(t) / speed);
-}
-
 bool WindField::calm(double t) const { return mean(t).squaredNorm() == 0; }
 
 Eigen::Vector3d WindField::advection(double t) const {
@@ -162,30 +183,51 @@ Eigen::Vector3d WindField::key_advection_at(double t) const {
 }
 
 void WindField::spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const {
-  for (int m = 0; m < mode_count(); ++m) {
+  for (int m = 0; m < phase_count(); ++m) {
     const double a = mode_wave.col(m).dot(x) + mode_phase[m];
     sin_a[m] = std::sin(a);
     cos_a[m] = std::cos(a);
   }
 }
 
-double WindField::temporal_phases(double t, double* sin_b, double* cos_b) const {
+void WindField::sample_time(double t, AirSample& air) const {
+  air.mean = mean(t);
+  const double speed = air.mean.norm();
+  // A gust needs a direction: none in still air.
+  air.gust = speed > 0 ? Eigen::Vector3d(air.mean * (gust_amplitude(t) / speed)) : Eigen::Vector3d::Zero();
+  air.turbulence = intensity * speed;
   const Eigen::Vector3d d = advection(t);
-  for (int m = 0; m < mode_count(); ++m) {
-    const double b = mode_omega[m] * t - mode_wave.col(m).dot(d);
-    sin_b[m] = std::sin(b);
-    cos_b[m] = std::cos(b);
+  for (int j = 0; j < phase_count(); ++j) {
+    const double b = mode_omega[j] * t - mode_wave.col(j).dot(d);
+    air.sin_b[j] = std::sin(b);
+    air.cos_b[j] = std::cos(b);
   }
-  return intensity * mean(t).norm();
 }
 
-Eigen::Vector3d WindField::turbulence(const double* sin_a, const double* cos_a, const double* sin_b,
-                                      const double* cos_b, double scale) const {
-  Eigen::Vector3d u = Eigen::Vector3d::Zero();
-  if (scale == 0) return u;
-  for (int m = 0; m < mode_count(); ++m)
-    u += mode_amplitude.col(m) * (sin_a[m] * cos_b[m] + cos_a[m] * sin_b[m]);
-  return u * scale;
+// sin(a + b) = sin(k . (x - D(t)) + w t + phi) for each phase: the turbulence modes along
+// their amplitude vectors, the gust waves averaged into a signal in [-1, 1] along the wind.
+Eigen::Vector3d WindField::velocity(const double* sin_a, const double* cos_a, const AirSample& air) const {
+  Eigen::Vector3d v = air.mean;
+  if ((air.gust.array() != 0).any()) {
+    double gust = 0;
+    for (int j = mode_count(); j < phase_count(); ++j) gust += sin_a[j] * air.cos_b[j] + cos_a[j] * air.sin_b[j];
+    v += air.gust * (gust / kGustWaves);
+  }
+  if (air.turbulence != 0) {
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (int m = 0; m < mode_count(); ++m)
+      u += mode_amplitude.col(m) * (sin_a[m] * air.cos_b[m] + cos_a[m] * air.sin_b[m]);
+    v += u * air.turbulence;
+  }
+  return v;
+}
+
+Eigen::Vector3d WindField::velocity(const Eigen::Vector3d& x, double t) const {
+  double sin_a[kMaxPhases], cos_a[kMaxPhases];
+  spatial_phases(x, sin_a, cos_a);
+  AirSample air;
+  sample_time(t, air);
+  return velocity(sin_a, cos_a, air);
 }
 
 }  // namespace treeanim

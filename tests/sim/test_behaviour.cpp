@@ -1,5 +1,6 @@
 // Whole-bake behaviour on grown trees: coming to rest, thin versus thick branches, leaves
-// detaching, sleeping, thread-count determinism, convergence in the substep count.
+// detaching, sleeping, trees downwind of each other, thread-count determinism, convergence in
+// the substep count.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -9,6 +10,7 @@
 
 #include "sim/simulator.h"
 #include "sim/stiffness.h"
+#include "correlation.h"
 #include "grown_tree.h"
 #include "sim_test_models.h"
 
@@ -16,6 +18,8 @@ namespace treeanim {
 namespace {
 
 using testing::grown_tree;
+using testing::best_lag;
+using testing::correlation;
 using testing::gust_then_calm;
 
 double max_displacement(const SimState& state, const TreeModel& model) {
@@ -216,6 +220,46 @@ TEST(Behaviour, SleepingBakeMatchesTheFullBake) {
   woken.advance_frame(b, 24 * 25 + 1);
   EXPECT_EQ(b.island_asleep[0], 0);
   EXPECT_GT(max_displacement(b, model), 0);
+}
+
+// The tip displacement from rest (m) of a small tree standing at `origin`, every frame of `frames`.
+std::vector<Eigen::Vector3d> tip_motion(const Eigen::Vector3d& origin, const WindOptions& wind, int frames) {
+  const TreeModel model = testing::small_tree(6, origin);
+  Eigen::Index tip = 0;
+  model.rest_positions.row(1).maxCoeff(&tip);
+  Simulator sim(model, HsmOptions{}, wind, 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  std::vector<Eigen::Vector3d> motion;
+  for (int f = 1; f <= frames; ++f) {
+    sim.advance_frame(state, f);
+    motion.push_back(state.positions.col(tip) - model.rest_positions.col(tip));
+  }
+  return motion;
+}
+
+TEST(Behaviour, TheTreeDownwindSwaysLikeTheOneUpwindLater) {
+  // Two identical trees 24 m apart along an 8 m/s wind: the gusts and the frozen turbulence
+  // (no evolution in place) reach the second 3 s = 72 frames later, and so does its sway once
+  // both have forgotten their start. A third, 1 m across the wind from the first, sways alike
+  // in eddies of a forest's size (turbulence_length 16 m; docs/solver.md "Wind and forces").
+  WindOptions wind;
+  wind.keys = {{0, 8, {1, 0, 0}, 3}};
+  wind.turbulence_length = 16;
+  wind.turbulence_frequency = 0;
+  const Eigen::Vector3d upwind(-10, 0, 5);
+  const int frames = 24 * 40;
+  const size_t settled = 24 * 10;
+  const std::vector<Eigen::Vector3d> a = tip_motion(upwind, wind, frames),
+                                     b = tip_motion(upwind + Eigen::Vector3d(24, 0, 0), wind, frames),
+                                     c = tip_motion(upwind + Eigen::Vector3d(0, 0, 1), wind, frames);
+  const size_t lag = best_lag(a, b, settled, 24 * 6);
+  EXPECT_NEAR(double(lag), 72, 1);
+  EXPECT_GT(correlation(a, b, settled, lag), 0.99);
+  EXPECT_LT(correlation(a, b, settled, 0), 0.9);
+  EXPECT_GT(correlation(a, c, settled, 0), 0.95);
+  RecordProperty("lag_frames", int(lag));
+  RecordProperty("correlation_at_lag", std::to_string(correlation(a, b, settled, lag)));
+  RecordProperty("correlation_1m_across", std::to_string(correlation(a, c, settled, 0)));
 }
 
 TEST(Behaviour, IdenticalBytesFor1And2And4Threads) {

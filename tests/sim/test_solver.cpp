@@ -166,7 +166,7 @@ TEST(Solver, AttachedLeafBalancesTheTorqueAboutItsPetiole) {
   advance(sim, state, 1, 480);  // 20 s: settled
 
   const std::vector<double> global = compute_step_rates(model, awake(), h).vertex_global;
-  const Eigen::Vector3d air = WindField(wind).base(state.time);
+  const Eigen::Vector3d air = WindField(wind).mean(state.time);
   const uint32_t a = model.leaf_attachment_vertex[0];
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();
   double scale = 0;

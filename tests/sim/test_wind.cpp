@@ -1,13 +1,20 @@
-// WindField: a looping wind repeats exactly with its period, everywhere (mean, gusts and the
-// advected turbulence); without a loop the field is what it was.
+// WindField as one field over a forest: neighbours feel nearly the same air, a gust reaches a
+// point downwind distance / speed later, points far apart across the wind differ; the field
+// is finite in calm air and through reversals; a looping wind repeats exactly with its
+// period, everywhere (mean, gusts and the advected turbulence).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
+#include "correlation.h"
 #include "sim/wind.h"
 
 namespace treeanim {
 namespace {
+
+using testing::best_lag;
+using testing::correlation;
 
 WindOptions gusty_wind() {
   WindOptions wind;
@@ -18,12 +25,98 @@ WindOptions gusty_wind() {
   return wind;
 }
 
-// The air velocity at x and t: mean and gust, plus turbulence.
-Eigen::Vector3d air(const WindField& field, const Eigen::Vector3d& x, double t) {
-  std::vector<double> sa(size_t(field.mode_count())), ca(sa.size()), sb(sa.size()), cb(sa.size());
-  field.spatial_phases(x, sa.data(), ca.data());
-  const double scale = field.temporal_phases(t, sb.data(), cb.data());
-  return field.base(t) + field.turbulence(sa.data(), ca.data(), sb.data(), cb.data(), scale);
+// A forest's wind: 8 m/s along x with 3 m/s gusts and the default turbulence, except its length.
+WindOptions forest_wind(double turbulence_length) {
+  WindOptions wind;
+  wind.keys = {{0.0, 8.0, Eigen::Vector3d(1, 0, 0), 3.0}};
+  wind.turbulence_length = turbulence_length;
+  wind.seed = 5;
+  return wind;
+}
+
+// Air velocity at x sampled every dt from t = 0, n samples (m/s).
+std::vector<Eigen::Vector3d> air_series(const WindField& field, const Eigen::Vector3d& x, double dt, int n) {
+  std::vector<Eigen::Vector3d> series;
+  for (int i = 0; i < n; ++i) series.push_back(field.velocity(x, i * dt));
+  return series;
+}
+
+TEST(Wind, PointsOneMetreApartFeelNearlyTheSameAir) {
+  // Over 60 s, with eddies of a forest's size (turbulence_length 16 m: an integral length of
+  // 4.3 m, docs/solver.md "Wind and forces"), along and across the wind, as trees stand.
+  const WindField field(forest_wind(16));
+  const double dt = 1.0 / 24;
+  const Eigen::Vector3d x(30, 4, -20);
+  const std::vector<Eigen::Vector3d> here = air_series(field, x, dt, 60 * 24);
+  for (const Eigen::Vector3d& step : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 0, 1)}) {
+    const double r = correlation(here, air_series(field, x + step, dt, 60 * 24));
+    EXPECT_GT(r, 0.95) << "1 m along " << step.transpose();
+    RecordProperty(step.x() > 0 ? "correlation_1m_along" : "correlation_1m_across", std::to_string(r));
+  }
+}
+
+TEST(Wind, AGustReachesAPointDownwindDistanceOverSpeedLater) {
+  // Without turbulence the air is the mean wind plus the gust along it: 100 m downwind the
+  // gust signal is the upwind one 100 m / 8 m/s = 12.5 s later, whatever the wind's heading.
+  WindOptions options = forest_wind(4);
+  options.turbulence_intensity = 0;
+  const Eigen::Vector3d heading = Eigen::Vector3d(1, 0, 0.6).normalized();
+  options.keys = {{0.0, 8.0, heading, 3.0}};
+  const WindField field(options);
+  const double dt = 1.0 / 24, lag = 100 / 8.0;
+  const Eigen::Vector3d upwind(-40, 5, 12), downwind = upwind + 100 * heading;
+  for (const double t : {0.0, 3.7, 61.0, 1e4})
+    EXPECT_NEAR((field.velocity(downwind, t + lag) - field.velocity(upwind, t)).norm(), 0, 1e-9) << "t " << t;
+  // The cross-correlation over 120 s peaks at the lag, to the sample.
+  const std::vector<Eigen::Vector3d> a = air_series(field, upwind, dt, 120 * 24),
+                                     b = air_series(field, downwind, dt, 120 * 24);
+  const size_t best = best_lag(a, b, 0, 30 * 24);
+  EXPECT_EQ(best, size_t(std::lround(lag / dt)));
+  EXPECT_GT(correlation(a, b, 0, best), 0.999);
+  EXPECT_LT(correlation(a, b), 0.9);  // not simply the same gust everywhere
+  RecordProperty("lag_s", std::to_string(double(best) * dt));
+}
+
+TEST(Wind, PointsAHundredMetresApartAcrossTheWindDiffer) {
+  // Eddies of the default 4 m and gust fronts tilted by up to 45 degrees: across the wind
+  // 100 m apart, the air velocities are uncorrelated, averaged over seeds.
+  double sum = 0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    WindOptions options = forest_wind(4);
+    options.seed = seed;
+    const WindField field(options);
+    const Eigen::Vector3d x(10, 3, 0);
+    const double r = correlation(air_series(field, x, 1.0 / 24, 60 * 24),
+                                 air_series(field, x + Eigen::Vector3d(0, 0, 100), 1.0 / 24, 60 * 24));
+    EXPECT_LT(std::fabs(r), 0.5) << "seed " << seed;
+    sum += r;
+  }
+  EXPECT_LT(std::fabs(sum / 8), 0.15);
+  RecordProperty("correlation_100m_across", std::to_string(sum / 8));
+}
+
+TEST(Wind, FiniteAndContinuousInCalmAirAndThroughAReversal) {
+  // Calm before, a gale that turns round through still air, calm after; far from the origin.
+  WindOptions options;
+  options.keys = {{1.0, 0.0, Eigen::Vector3d(1, 0, 0), 0.0},
+                  {3.0, 20.0, Eigen::Vector3d(1, 0, 0), 6.0},
+                  {5.0, 20.0, Eigen::Vector3d(-1, 0, 0.1).normalized(), 6.0},
+                  {7.0, 0.0, Eigen::Vector3d(0, 0, 1), 0.0}};
+  const WindField field(options);
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(5e3, 10, -7e3)}) {
+    EXPECT_EQ(field.velocity(x, 0.5), Eigen::Vector3d::Zero());
+    EXPECT_EQ(field.velocity(x, 1e6), Eigen::Vector3d::Zero());
+    Eigen::Vector3d previous = field.velocity(x, 0);
+    for (int i = 1; i <= 80000; ++i) {
+      const Eigen::Vector3d v = field.velocity(x, i * 1e-4);
+      ASSERT_TRUE(v.allFinite()) << "t " << i * 1e-4;
+      // Continuous but where the mean wind is still (t = 4 s: the gust's direction turns round).
+      if (std::fabs(i * 1e-4 - 4) > 0.01) {
+        EXPECT_LT((v - previous).norm(), 0.5) << "t " << i * 1e-4;
+      }
+      previous = v;
+    }
+  }
 }
 
 TEST(Wind, ALoopRepeatsWithItsPeriodEverywhere) {
@@ -31,23 +124,25 @@ TEST(Wind, ALoopRepeatsWithItsPeriodEverywhere) {
   options.loop_start = 0.5;
   options.loop_period = 9.5;  // the keys' wind at 0.5 s and 10 s differ: the loop still wraps
   const WindField field(options);
-  for (const Eigen::Vector3d& x : {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(3.3, 7.1, -2.4)}) {
+  for (const Eigen::Vector3d& x :
+       {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(3.3, 7.1, -2.4), Eigen::Vector3d(-250, 4, 310)}) {
     for (const double t : {0.5, 1.37, 6.02, 9.99}) {
-      const Eigen::Vector3d once = air(field, x, t);
+      const Eigen::Vector3d once = field.velocity(x, t);
       for (const int periods : {1, 3, 40}) {
-        const Eigen::Vector3d later = air(field, x, t + periods * options.loop_period);
+        const Eigen::Vector3d later = field.velocity(x, t + periods * options.loop_period);
         EXPECT_LT((later - once).norm(), 1e-9 * (1 + periods)) << "t " << t << " periods " << periods;
       }
     }
   }
   // Not a constant: the loop still has gusts and turbulence.
-  EXPECT_GT((air(field, Eigen::Vector3d(0, 1, 0), 1.0) - air(field, Eigen::Vector3d(0, 1, 0), 2.0)).norm(), 0.1);
+  const Eigen::Vector3d x(0, 1, 0);
+  EXPECT_GT((field.velocity(x, 1.0) - field.velocity(x, 2.0)).norm(), 0.1);
 }
 
 TEST(Wind, WithoutALoopTheFieldDoesNotRepeat) {
   const WindField field(gusty_wind());
   const Eigen::Vector3d x(0, 1, 0);
-  EXPECT_GT((air(field, x, 1.0) - air(field, x, 1.0 + 9.5)).norm(), 1e-3);
+  EXPECT_GT((field.velocity(x, 1.0) - field.velocity(x, 1.0 + 9.5)).norm(), 1e-3);
 }
 
 }  // namespace
