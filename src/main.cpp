@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
   run_app->add_flag("--resume", run.resume,
                     "Continue from the newest usable checkpoint and complete every output; without "
                     "one, bake from the start");
+  run_app->add_option("--shard", run.shard,
+                      "Bake only task I of N of a forest's trees (0-based, balanced by estimated cost; I may be "
+                      "'auto' for $SLURM_ARRAY_TASK_ID); docs/farm.md");
   CLI::Option* quiet_flag = run_app->add_flag("-q,--quiet", quiet, "No progress or summary");
   run_app->add_flag("-v,--verbose", verbose, "Stage timings and details")->excludes(quiet_flag);
   run_app->footer(
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
       "  treeanim run configs/demo.json\n"
       "  treeanim run configs/demo.json -o out/ --frames 0:47 --threads 2\n"
       "  treeanim run configs/demo.json -o out/ --checkpoint-every 24 --resume\n"
+      "  treeanim run configs/forest-demo.json -o out/ --shard 2/4 --checkpoint-every 8 --resume\n"
       "  treeanim run scene.json --set lsystem.iterations=6 --set time.substeps=8 --quiet");
 
   std::filesystem::path validate_scene;

@@ -19,6 +19,7 @@ struct RunRequest {
   long long checkpoint_every = 0;             // frames between checkpoints; 0 = none
   std::filesystem::path checkpoint_dir;       // "" = out_dir/checkpoints
   bool resume = false;                        // start from the newest usable checkpoint
+  std::optional<std::string> shard;           // "I/N" or "auto/N": bake the forest's shard I of N only
   Verbosity verbosity = Verbosity::kNormal;
 };
 
