@@ -174,7 +174,7 @@ Forest read_forest(SceneObject section, const ForestDefaults& defaults) {
   std::optional<SceneObject> scatter;
   if (section.has("scatter")) {
     scatter = section.object("scatter");
-    scatter_count = scatter->integer("count", 0, 0, 10'000'000);
+    scatter_count = scatter->integer("count", 0, 0, 1'000'000);
   } else {
     section.declare("scatter");
   }
