@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
   run_app->add_flag("--resume", run.resume,
                     "Continue from the newest usable checkpoint and complete every output; without "
                     "one, bake from the start");
+  run_app->add_option("--shard", run.shard,
+                      "Bake only task I of N of a forest's trees (0-based, balanced by estimated cost; I may be "
+                      "'auto' for $SLURM_ARRAY_TASK_ID); docs/farm.md");
   CLI::Option* quiet_flag = run_app->add_flag("-q,--quiet", quiet, "No progress or summary");
   run_app->add_flag("-v,--verbose", verbose, "Stage timings and details")->excludes(quiet_flag);
   run_app->footer(
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
       "  treeanim run configs/demo.json\n"
       "  treeanim run configs/demo.json -o out/ --frames 0:47 --threads 2\n"
       "  treeanim run configs/demo.json -o out/ --checkpoint-every 24 --resume\n"
+      "  treeanim run configs/forest-demo.json -o out/ --shard 2/4 --checkpoint-every 8 --resume\n"
       "  treeanim run scene.json --set lsystem.iterations=6 --set time.substeps=8 --quiet");
 
   std::filesystem::path validate_scene;
@@ -87,6 +91,39 @@ int main(int argc, char** argv) {
       "  treeanim info configs/demo.json --json | jq .mesh.vertices\n"
       "  treeanim info configs/demo.json --resolved-scene --set time.fps=30");
 
+  FarmRequest farm;
+  CLI::App* farm_app = app.add_subcommand("farm", "Bake a forest on a render farm: plan, submit, gather (docs/farm.md)");
+  farm_app->require_subcommand(1);
+  CLI::App* plan_app = farm_app->add_subcommand("plan", "Split a forest into tasks balanced by estimated cost; print them");
+  CLI::App* submit_app =
+      farm_app->add_subcommand("submit", "Write the farm job scripts (a task per shard, then a gather) and submit them");
+  CLI::App* gather_app =
+      farm_app->add_subcommand("gather", "Check every tree of a forest is baked and write OUT/forest.json");
+  for (CLI::App* sub : {plan_app, submit_app, gather_app}) {
+    sub->add_option("scene", farm.scene, "Scene file (JSON) with a /forest")->required();
+    sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE");
+  }
+  plan_app->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(CLI::Range(1, 1'000'000));
+  plan_app->add_option("--json", farm.json, "Also write the plan as JSON to this file");
+  plan_app->footer("Example:\n  treeanim farm plan configs/forest-demo.json --tasks 4 --json plan.json");
+  submit_app->add_option("--engine", farm.engine, "slurm: write sbatch scripts and submit them; script: a plain shell script for any queue")
+      ->required()->check(CLI::IsMember({"slurm", "script"}));
+  submit_app->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(CLI::Range(1, 1'000'000));
+  submit_app->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)");
+  submit_app->add_flag("--wait", farm.wait, "Wait for the gather job and exit with its status (slurm)");
+  submit_app->add_option("--checkpoint-every", farm.checkpoint_every, "Frames between checkpoints (default: frames / 8)")
+      ->check(CLI::Range(1LL, 1'000'000'000LL));
+  submit_app->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(CLI::Range(1, 1024));
+  submit_app->add_option("--sbatch-arg", farm.sbatch_args, "An extra #SBATCH option, e.g. --partition=bake; repeatable");
+  submit_app->footer(
+      "Examples:\n"
+      "  treeanim farm submit configs/forest-demo.json --engine slurm --tasks 4 -o /shared/out --wait\n"
+      "  treeanim farm submit configs/forest-demo.json --engine script --tasks 4 -o out/");
+  gather_app->add_option("-o,--out", farm.out_dir, "Output folder of the tasks (default: the working folder)");
+  gather_app->add_option("--tasks", farm.tasks, "Tasks the forest was split into: name the task of each missing tree")
+      ->check(CLI::Range(1, 1'000'000));
+  gather_app->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -100,6 +137,9 @@ int main(int argc, char** argv) {
       return run_command(run);
     }
     if (*validate_app) return validate_command(validate_scene, validate_overrides);
+    if (*plan_app) return farm_plan_command(farm);
+    if (*submit_app) return farm_submit_command(farm);
+    if (*gather_app) return farm_gather_command(farm);
     return info_command(info_scene, info_overrides,
                         info_resolved ? InfoFormat::kResolvedScene
                         : info_json   ? InfoFormat::kJson

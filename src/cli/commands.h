@@ -19,6 +19,7 @@ struct RunRequest {
   long long checkpoint_every = 0;             // frames between checkpoints; 0 = none
   std::filesystem::path checkpoint_dir;       // "" = out_dir/checkpoints
   bool resume = false;                        // start from the newest usable checkpoint
+  std::optional<std::string> shard;           // "I/N" or "auto/N": bake the forest's shard I of N only
   Verbosity verbosity = Verbosity::kNormal;
 };
 
@@ -31,6 +32,29 @@ enum class InfoFormat { kText, kJson, kResolvedScene };
 // Prints counts and estimates as text or as one JSON object, or the resolved scene.
 int info_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides,
                  InfoFormat format);
+
+// treeanim farm plan | submit | gather (docs/farm.md).
+struct FarmRequest {
+  std::filesystem::path scene;
+  std::vector<std::string> overrides;         // --set PATH=VALUE, passed on to every task
+  size_t tasks = 0;                           // farm tasks the forest is split into
+  std::filesystem::path out_dir;              // -o; "" = the working folder
+  std::filesystem::path json;                 // plan: also write the plan here
+  std::string engine;                         // submit: "slurm" or "script"
+  bool wait = false;                          // submit: wait for the gather job and return its status
+  long long checkpoint_every = 0;             // submit: frames between checkpoints; 0 = frames / 8
+  int cpus_per_task = 1;                      // submit: cores (OpenMP threads) of each task
+  std::vector<std::string> sbatch_args;       // submit: extra #SBATCH options (--partition=x)
+  std::filesystem::path logs;                 // gather: the tasks' logs (task-I.log) to point at
+};
+
+// Prints (and with --json writes) the tasks: trees per task, estimated core-hours and bytes.
+int farm_plan_command(const FarmRequest& request);
+// Writes the job scripts and, for slurm, submits the array and the gather job behind it.
+int farm_submit_command(const FarmRequest& request);
+// Checks every tree's bake is complete and writes OUT/forest.json; else names what is missing
+// (with the tasks and their logs) and returns 4.
+int farm_gather_command(const FarmRequest& request);
 
 // "START:END" => inclusive range within [first, last]; throws InputError naming --frames.
 std::pair<long long, long long> parse_frame_range(const std::string& text, long long first,

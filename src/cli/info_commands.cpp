@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/forest_tasks.h"
 #include "cli/prepare_tree.h"
 
 namespace treeanim {
@@ -27,8 +28,12 @@ void print_counts(const Json& summary) {
 int validate_command(const std::filesystem::path& scene_file,
                      const std::vector<std::string>& overrides) {
   const Scene scene = load_scene(scene_file, overrides);
-  const PreparedTree tree = prepare_tree(scene);
-  print_counts(tree_summary(scene, tree));
+  if (scene.forest) {
+    estimate_forest(scene);  // grows one tree of each variant
+    std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
+  } else {
+    print_counts(tree_summary(scene, prepare_tree(scene)));
+  }
   std::printf("%s: OK\n", scene_file.string().c_str());
   return 0;
 }
@@ -41,8 +46,19 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
     std::cout << scene.resolved.dump(2) << "\n";
     return 0;
   }
-  const PreparedTree tree = prepare_tree(scene);
-  const Json summary = tree_summary(scene, tree);
+  // A forest: the figures of its first tree.
+  const Scene first = scene.forest ? tree_scene(scene, 0) : Scene();
+  const Scene& one = scene.forest ? first : scene;
+  const PreparedTree tree = prepare_tree(one);
+  Json summary = tree_summary(one, tree);
+  if (scene.forest) {
+    summary["forest"] = {{"trees", scene.forest->trees.size()},
+                         {"variants", scene.forest->variants.size()},
+                         {"tree", scene.forest->trees[0].id}};
+    if (format == InfoFormat::kText)
+      std::printf("forest of %zu trees, %zu variants; tree %s:\n", scene.forest->trees.size(),
+                  scene.forest->variants.size(), scene.forest->trees[0].id.c_str());
+  }
   if (format == InfoFormat::kJson) {
     std::cout << summary.dump(2) << "\n";
     return 0;

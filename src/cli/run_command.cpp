@@ -1,38 +1,13 @@
+// treeanim run: one tree, or a forest's trees one after another (cli/forest_run.cpp).
 #include <omp.h>
 
-#include <chrono>
-#include <csignal>
-#include <cstdio>
-#include <optional>
-
-#include "cli/bake_start.h"
+#include "cli/bake_tree.h"
 #include "cli/commands.h"
-#include "cli/loop_bake.h"
-#include "cli/prepare_tree.h"
+#include "cli/forest_run.h"
 #include "cli/signals.h"
 #include "common/errors.h"
-#include "io/outputs.h"
-#include "sim/simulator.h"
-#include "treeanim_version.h"
 
 namespace treeanim {
-
-namespace {
-
-// Solver state (double) => the float frame the sinks write.
-FrameData make_frame(const SimState& state, long long frame, bool with_velocities) {
-  FrameData data;
-  data.frame = frame;
-  data.time = state.time;
-  data.positions.assign(state.positions.data(), state.positions.data() + state.positions.size());
-  if (with_velocities)
-    data.velocities.assign(state.velocities.data(),
-                           state.velocities.data() + state.velocities.size());
-  data.leaf_attached = state.leaf_attached;
-  return data;
-}
-
-}  // namespace
 
 std::pair<long long, long long> parse_frame_range(const std::string& text, long long first,
                                                   long long last) {
@@ -57,126 +32,13 @@ std::pair<long long, long long> parse_frame_range(const std::string& text, long 
 
 int run_command(const RunRequest& request) {
   install_interrupt_handlers();
-  const auto wall_start = std::chrono::steady_clock::now();
-  const bool verbose = request.verbosity == Verbosity::kVerbose;
-  std::FILE* log = request.verbosity == Verbosity::kQuiet ? nullptr : stderr;
-
-  const Scene scene = load_scene(request.scene, request.overrides);
-  const long long first = scene.time.start;
-  const long long last = first + scene.time.frames - 1;
-  // --frames only chooses what is written: the simulation starts at time.start (or at a
-  // checkpoint of this bake), so frame k of a split bake is bit-identical to frame k of the
-  // whole bake.
-  const auto [write_first, write_last] =
-      request.frames ? parse_frame_range(*request.frames, first, last) : std::pair{first, last};
   if (request.threads > 0) omp_set_num_threads(request.threads);
-
-  const PreparedTree tree = prepare_tree(scene);
-  if (verbose)
-    std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters\n",
-                 tree.grow_seconds, tree.model_seconds, tree.model.vertex_count(),
-                 tree.model.cluster_count());
-
-  BakeInfo info;
-  info.scene_json = scene.resolved.dump(2);
-  info.generator = std::string("treeanim ") + TREEANIM_VERSION;
-  info.fps = scene.time.fps;
-  info.frame_start = write_first;
-  info.frame_count = write_last - write_first + 1;
-  info.substeps = scene.time.substeps;
-  info.seed = scene.seed;
-  // Only a bake of the whole loop closes it; --frames writes a part of it.
-  info.loop = scene.time.loop && write_first == first && write_last == last;
-  info.loop_end_time = double(last + 1) / scene.time.fps;
-  OutputSet outputs(scene.outputs, request.out_dir, tree.model, info);
-
-  const double frame_dt = 1.0 / scene.time.fps;
-  Simulator simulator(tree.model, scene.hsm, scene.wind, frame_dt, scene.time.substeps);
-  BakePlan plan;
-  plan.first = first;
-  plan.write_first = write_first;
-  plan.write_last = write_last;
-  plan.frame_dt = frame_dt;
-  plan.resume = request.resume;
-  plan.use_checkpoints = request.resume || request.frames.has_value();
-  plan.checkpoint_dir = !request.checkpoint_dir.empty() ? request.checkpoint_dir
-                        : request.out_dir.empty()       ? std::filesystem::path("checkpoints")
-                                                        : request.out_dir / "checkpoints";
-  plan.key = {scene_hash(info.scene_json, info.generator), info.generator, scene.hsm.precision == Precision::kFloat};
-  plan.journal = {plan.key.scene_hash, write_first, tree.model.vertex_count(), tree.model.leaf_count(),
-                  outputs.wants_velocities()};
-  BakeStart start = find_bake_start(plan, simulator, log);
-  SimState& state = start.state;
-  // A loop starts from the tree's periodic motion: whole periods run first (not on a resume,
-  // whose checkpoint lies past them).
-  LoopWarmup warmup;
-  if (scene.time.loop && start.checkpoint.empty()) warmup = warm_up_loop(simulator, state, first, scene.time.frames, log);
-  SeamMeter seam;
-  if (!start.checkpoint.empty() && log)
-    std::fprintf(log, "treeanim: resuming at frame %lld from %s\n", start.frame, start.checkpoint.c_str());
-  std::optional<FrameJournal> journal;  // this bake's, when it writes checkpoints
-  if (request.checkpoint_every > 0) {
-    remove_foreign_checkpoints(plan, start.frame, state, log);
-    if (start.journal) {
-      journal = std::move(start.journal);
-      journal->truncate(start.frame - write_first);  // the frames before the checkpoint's
-    } else {
-      journal = FrameJournal::create(journal_path(plan.checkpoint_dir, write_first), plan.journal);
-    }
-  }
-  outputs.begin();
-  // The frames written before the checkpoint are not in it: the journal gives them back.
-  for (long long k = write_first; k < start.frame && k <= write_last; ++k) {
-    FrameJournal& source = journal ? *journal : *start.journal;
-    FrameData data = source.read(k - write_first);
-    if (info.loop) seam.add(data.positions);
-    outputs.push(std::move(data));
-  }
-
-  Progress progress(write_last - start.frame + 1, request.verbosity, stderr);
-  const auto sim_start = std::chrono::steady_clock::now();
-  for (long long frame = start.frame; frame <= write_last; ++frame) {
-    if (frame > start.frame) simulator.advance_frame(state, frame);
-    if (const int signal_number = pending_signal()) {
-      outputs.abort();
-      progress.finish();
-      std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept%s\n",
-                   signal_number == SIGINT ? "SIGINT" : "SIGTERM", frame,
-                   journal ? " (--resume continues from the last checkpoint)" : "");
-      return signal_number == SIGINT ? kExitSigint : kExitSigterm;
-    }
-    if (frame >= write_first) {
-      FrameData data = make_frame(state, frame, outputs.wants_velocities());
-      if (scene.time.loop) data.time = double(frame) * frame_dt;  // the warm-up ran periods ahead
-      if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
-      if (journal) journal->append(data);
-      outputs.push(std::move(data));
-    }
-    // The journal reaches the disk before the checkpoint that names its frames as written.
-    if (journal && frame > start.frame && (frame - first) % request.checkpoint_every == 0) {
-      journal->sync();
-      write_checkpoint(checkpoint_path(plan.checkpoint_dir, frame), state, frame, plan.key);
-    }
-    progress.update(frame - start.frame + 1);
-  }
-  outputs.finish();
-  progress.finish();
-
-  if (request.verbosity != Verbosity::kQuiet) {
-    std::printf("baked %lld frames: %zu vertices, %zu clusters, %lld substeps in %.2f s "
-                "(simulation + writing %.2f s)\n",
-                write_last - write_first + 1, tree.model.vertex_count(),
-                tree.model.cluster_count(), (write_last - start.frame) * scene.time.substeps,
-                seconds_since(wall_start), seconds_since(sim_start));
-    for (const auto& path : outputs.final_paths()) std::printf("  wrote %s\n", path.string().c_str());
-    for (const auto& [path, line] : outputs.reports()) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
-    if (info.loop)
-      std::printf("  loop: %d warm-up period%s%s; seam %.3g m, %.2f x the median frame step (%.3g m)\n",
-                  warmup.periods, warmup.periods == 1 ? "" : "s",
-                  warmup.converged || !start.checkpoint.empty() ? "" : " (the motion did not repeat: baked as it stands)",
-                  seam.seam(), seam.median_step() > 0 ? seam.seam() / seam.median_step() : 0.0, seam.median_step());
-  }
-  return 0;
+  const Scene scene = load_scene(request.scene, request.overrides);
+  if (scene.forest) return run_forest(scene, request);
+  if (request.shard)
+    throw InputError("--shard " + *request.shard + ": shards split the trees of a /forest, and " +
+                     request.scene.string() + " has one tree (split its frames with --frames)");
+  return bake_tree(scene, request, nullptr).exit_code;
 }
 
 }  // namespace treeanim

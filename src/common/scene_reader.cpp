@@ -174,6 +174,20 @@ Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector
   return fallback;
 }
 
+std::array<double, 2> SceneObject::pair(const std::string& key, std::array<double, 2> fallback, Range range) {
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) {
+    (*node_)[key] = Json::array({fallback[0], fallback[1]});
+    return fallback;
+  }
+  std::array<double, 2> v{};
+  bool ok = value->is_array() && value->size() == 2;
+  for (int i = 0; ok && i < 2; ++i) ok = as_finite_number((*value)[i], &v[i]) && range.contains(v[i]);
+  if (!ok) fail_expected(key, "an array of 2 numbers, each " + range.describe());
+  return v;
+}
+
 std::optional<std::filesystem::path> SceneObject::optional_path(const std::string& key) {
   auto text = optional_string(key);
   if (!text) return std::nullopt;

@@ -9,6 +9,7 @@
 //
 // Messages: "<pointer>: expected <what>, got <value>". The caller prefixes the file name.
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -55,6 +56,8 @@ class SceneObject {
                      const std::vector<std::string>& choices);
   Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback);
   std::optional<Eigen::Vector3d> optional_vector3(const std::string& key);
+  // Two finite numbers, each within `range` ([x, z] on the ground, a [lo, hi] interval).
+  std::array<double, 2> pair(const std::string& key, std::array<double, 2> fallback, Range range = Range::any());
   // A path string resolved against the scene file's folder (absolute paths kept).
   std::optional<std::filesystem::path> optional_path(const std::string& key);
 
@@ -72,6 +75,8 @@ class SceneObject {
   // "<pointer>/<key>" with JSON-pointer escaping.
   std::string pointer_of(const std::string& key) const;
   const std::string& pointer() const { return pointer_; }
+  // The object as read so far (defaults of the keys read are filled in).
+  const Json& json() const { return *node_; }
   // Throws InputError "<pointer>/<key>: <message>".
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   // Throws InputError "<pointer>/<key>: expected <expected>, got <value>".

@@ -265,6 +265,12 @@ std::vector<std::pair<fs::path, std::string>> OutputSet::reports() const {
   return reports;
 }
 
+std::vector<fs::path> OutputSet::files(size_t k) const {
+  std::vector<fs::path> files;
+  impl_->workers.at(k)->sink->for_each_target([&](const fs::path& file) { files.push_back(file); });
+  return files;
+}
+
 std::vector<fs::path> OutputSet::final_paths() const {
   std::vector<fs::path> paths;
   for (const auto& worker : impl_->workers)

@@ -61,6 +61,8 @@ class OutputSet {
   void abort() noexcept;
   // Final paths (files, or the first file of a sequence pattern) for the summary line.
   std::vector<std::filesystem::path> final_paths() const;
+  // Every file of output k, in the order of its sink (a sequence: each frame's file and the rest mesh).
+  std::vector<std::filesystem::path> files(size_t k) const;
   // After finish(): what outputs have to say besides their paths (a fit's error), by output path.
   std::vector<std::pair<std::filesystem::path, std::string>> reports() const;
 

@@ -62,6 +62,22 @@ void prepare_loop(SceneObject time_section, Scene& scene) {
   scene.wind.loop_period = period;
 }
 
+// Output paths of a forest of several trees must differ per tree ({tree}); a scene of one tree
+// has no id to put there.
+void check_tree_placeholders(const Scene& scene, const SceneReader& reader) {
+  const size_t trees = scene.forest ? scene.forest->trees.size() : 1;
+  for (const OutputOptions& output : scene.outputs) {
+    const bool has = output.path.string().find(kTreePlaceholder) != std::string::npos;
+    if (has && !scene.forest)
+      reader.fail(output.pointer + "/path", "{tree} stands for the id of a tree of a /forest, and this scene has no "
+                                            "/forest: remove it from the path");
+    if (!has && trees > 1)
+      reader.fail(output.pointer + "/path", "the forest has " + std::to_string(trees) +
+                                                " trees and this path no {tree}: every tree would write the same "
+                                                "file; put the tree's id in it, e.g. \"trees/{tree}.h5\"");
+  }
+}
+
 }  // namespace
 
 void apply_override(Json& document, const std::string& assignment) {
@@ -133,14 +149,21 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   SceneObject root = reader.root();
   root.optional_string("description");
   scene.seed = static_cast<uint64_t>(root.integer("seed", 1, 0, (1LL << 53)));
-  scene.lsystem = read_lsystem_options(root.object("lsystem"), scene.seed);
+  const bool forest = root.has("forest");
+  // A forest whose variants all bring their own grammar needs no top-level one.
+  const bool top_lsystem = !forest || root.has("lsystem");
+  if (top_lsystem) scene.lsystem = read_lsystem_options(root.object("lsystem"), scene.seed);
+  else root.declare("lsystem");
   scene.tree = read_tree_options(root.object("tree"));
   scene.hsm = read_hsm_options(root.object("hsm"));
   scene.wind = read_wind_options(root.object("wind"), scene.seed);
   scene.time = read_time_options(root.object("time"));
   if (scene.time.loop) prepare_loop(root.object("time"), scene);
+  if (forest)
+    scene.forest = read_forest(root.object("forest"), {scene.seed, top_lsystem ? &scene.lsystem : nullptr, &scene.tree});
   for (SceneObject element : root.array_of_objects("outputs"))
     scene.outputs.push_back(read_output_options(element));
+  check_tree_placeholders(scene, reader);
   reader.check_unknown_keys();
   return scene;
 }

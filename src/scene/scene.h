@@ -3,12 +3,14 @@
 // stage and the resolved scene JSON (defaults filled in) that outputs record.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/scene_reader.h"
 #include "io/output_options.h"
 #include "lsystem/lsystem_options.h"
+#include "scene/forest.h"
 #include "sim/sim_options.h"
 #include "tree/tree_options.h"
 
@@ -27,12 +29,13 @@ struct Scene {
   std::filesystem::path file;  // the scene file ("" when loaded from text)
   Json resolved;               // the scene with every default filled in
   uint64_t seed = 1;           // /seed, the default of every per-purpose seed
-  LsystemOptions lsystem;
+  LsystemOptions lsystem;      // /lsystem (a forest whose variants all have their own may leave it out)
   TreeOptions tree;
   HsmOptions hsm;
   WindOptions wind;
   TimeOptions time;
   std::vector<OutputOptions> outputs;
+  std::optional<Forest> forest;  // /forest: many trees; none = the one tree of /lsystem
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a
@@ -45,5 +48,10 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<std::strin
 Scene load_scene_text(const std::string& text, const std::string& name,
                       const std::filesystem::path& base_dir,
                       const std::vector<std::string>& overrides);
+
+// A forest's tree `index` => its own one-tree scene: its variant's grammar with the tree's seed,
+// the tree options at its scale, {tree} in output paths replaced by its id, and as resolved
+// JSON the forest reduced to this tree (what its outputs record; a scene that bakes it again).
+Scene tree_scene(const Scene& forest_scene, size_t index);
 
 }  // namespace treeanim

@@ -37,5 +37,8 @@ struct TreeOptions {
 
 // /tree section => options.
 TreeOptions read_tree_options(SceneObject section);
+// options, factor => the options of the same tree `factor` times as large: every length (scale,
+// radii, leaf size and petiole) multiplied, so masses follow the volume and the sway the size.
+TreeOptions scaled_tree_options(TreeOptions options, double factor);
 
 }  // namespace treeanim

@@ -7,7 +7,8 @@ Each case runs in CORPUS_DIR (paths in its args are relative to it; a lone surro
 \udcda in cases.json stands for the byte 0xDA, as os.fsencode maps it); "{tmp}" in an argument is
 replaced by a fresh empty folder, which must still be empty afterwards (a refused bake writes
 nothing), and "{corpus}" (in arguments and messages) by the corpus folder, which no case may
-change (a refused bake replaces nothing).
+change (a refused bake replaces nothing). An optional "env" object sets environment variables
+for the case ({tmp} and {corpus} replaced as in arguments), e.g. a PATH without sbatch.
 """
 import json
 import os
@@ -34,9 +35,12 @@ def run_case(binary, corpus, case):
     with tempfile.TemporaryDirectory(prefix="treeanim-bad-") as tmp:
         args = [a.replace("{tmp}", tmp).replace("{corpus}", corpus) for a in case["args"]]
         message = case["message"].replace("{corpus}", corpus)
+        env = dict(os.environ)
+        for name, value in case.get("env", {}).items():
+            env[name] = value.replace("{tmp}", tmp).replace("{corpus}", corpus)
         try:
             done = subprocess.run([binary] + args, cwd=corpus, capture_output=True, text=True,
-                                  errors="replace", timeout=120)
+                                  errors="replace", timeout=120, env=env)
         except subprocess.TimeoutExpired:
             return ["timed out after 120 s"]
         problems = []

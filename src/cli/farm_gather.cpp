@@ -1,0 +1,56 @@
+// treeanim farm gather: every tree complete => OUT/forest.json; else what is missing, by task.
+#include <cstdio>
+#include <map>
+
+#include "cli/commands.h"
+#include "cli/forest_manifest.h"
+#include "cli/forest_tasks.h"
+#include "common/errors.h"
+
+namespace treeanim {
+
+int farm_gather_command(const FarmRequest& request) {
+  const Scene scene = load_scene(request.scene, request.overrides);
+  if (!scene.forest) throw InputError(request.scene.string() + ": no /forest: farm gather collects a forest's trees");
+  const Forest& forest = *scene.forest;
+  const GatherReport report = gather_forest(scene, request.out_dir);
+  if (report.missing.empty()) {
+    std::printf("forest: all %zu trees complete; manifest %s\n", forest.trees.size(),
+                forest_manifest_path(request.out_dir).string().c_str());
+    return 0;
+  }
+  std::map<size_t, std::vector<size_t>> by_task;  // task => indices into report.missing
+  std::vector<size_t> task_of(forest.trees.size(), 0);
+  if (request.tasks > 0) {
+    const auto tasks = assign_tasks(estimate_forest(scene).tree_cost, request.tasks);
+    for (size_t k = 0; k < tasks.size(); ++k)
+      for (size_t t : tasks[k]) task_of[t] = k;
+  }
+  for (size_t m = 0; m < report.missing.size(); ++m) by_task[task_of[report.missing[m]]].push_back(m);
+  std::fprintf(stderr, "treeanim: %zu of %zu trees are not complete; %s not written\n", report.missing.size(),
+               forest.trees.size(), forest_manifest_path(request.out_dir).string().c_str());
+  const std::string out = request.out_dir.empty() ? "" : " -o '" + request.out_dir.string() + "'";
+  for (const auto& [task, missing] : by_task) {
+    if (request.tasks > 0) {
+      std::fprintf(stderr, "  task %zu of %zu", task, request.tasks);
+      if (!request.logs.empty())
+        std::fprintf(stderr, " (log %s)", (request.logs / ("task-" + std::to_string(task) + ".log")).c_str());
+      std::fprintf(stderr, ": %zu tree%s\n", missing.size(), missing.size() == 1 ? "" : "s");
+    }
+    for (size_t m : missing)
+      std::fprintf(stderr, "    %s: %s\n", forest.trees[report.missing[m]].id.c_str(), report.reasons[m].c_str());
+  }
+  std::string failed;
+  for (const auto& entry : by_task) failed += (failed.empty() ? "" : " ") + std::to_string(entry.first);
+  if (request.tasks > 0)
+    std::fprintf(stderr, "what to do: read the logs above, then run each failed task I again (it resumes), for I "
+                         "in %s:\n  treeanim run '%s' --shard I/%zu%s --resume\nand gather again.\n",
+                 failed.c_str(), request.scene.string().c_str(), request.tasks, out.c_str());
+  else
+    std::fprintf(stderr, "what to do: bake the missing trees again (treeanim run '%s'%s --resume bakes only "
+                         "those), then gather again.\n",
+                 request.scene.string().c_str(), out.c_str());
+  return kExitOutput;
+}
+
+}  // namespace treeanim

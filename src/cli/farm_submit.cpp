@@ -1,0 +1,227 @@
+// treeanim farm submit: a forest's bake as farm jobs (docs/farm.md). The job scripts call this
+// very executable (/proc/self/exe) on the scene by absolute path: every task runs
+// `treeanim run SCENE --shard I/N -o OUT --checkpoint-every K --resume`, then one gather job.
+#include <unistd.h>
+
+#include <cstdio>
+#include <system_error>
+
+#include "cli/commands.h"
+#include "cli/forest_tasks.h"
+#include "cli/run_program.h"
+#include "common/errors.h"
+#include "io/staged_files.h"
+#include "io/text_output.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// text => one shell word with the same bytes.
+std::string quoted(const std::string& text) {
+  std::string word = "'";
+  for (char c : text) word += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return word + "'";
+}
+
+// Everything the scripts name, absolute.
+struct FarmJob {
+  fs::path treeanim;  // this executable
+  fs::path scene;
+  fs::path out;
+  fs::path farm;      // OUT/farm: the scripts
+  fs::path logs;      // OUT/farm/logs: task-I.log, gather.log
+  std::string name;   // the scene file's stem
+  size_t tasks = 1;
+  long long checkpoint_every = 1;
+  int cpus = 1;
+  std::string overrides;  // " --set 'A=B'" ...
+};
+
+// The command of task `index` (a shell expression, e.g. "$SLURM_ARRAY_TASK_ID").
+std::string task_command(const FarmJob& job, const std::string& index) {
+  return quoted(job.treeanim.string()) + " run " + quoted(job.scene.string()) + " --shard \"" + index + "/" +
+         std::to_string(job.tasks) + "\" -o " + quoted(job.out.string()) + " --checkpoint-every " +
+         std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) + job.overrides;
+}
+
+std::string gather_command(const FarmJob& job) {
+  return quoted(job.treeanim.string()) + " farm gather " + quoted(job.scene.string()) + " -o " +
+         quoted(job.out.string()) + " --tasks " + std::to_string(job.tasks) + " --logs " +
+         quoted(job.logs.string()) + job.overrides;
+}
+
+std::string header(const FarmJob& job, const std::string& what) {
+  return "#!/bin/bash\n# " + what + " of " + job.scene.string() + ", written by treeanim farm submit (docs/farm.md).\n";
+}
+
+std::string array_script(const FarmJob& job, const std::vector<std::string>& sbatch_args) {
+  std::string text = header(job, "Slurm job array: " + std::to_string(job.tasks) + " shards of the forest");
+  text += "#SBATCH --job-name=treeanim-" + job.name + "\n";
+  text += "#SBATCH --array=0-" + std::to_string(job.tasks - 1) + "\n";
+  text += "#SBATCH --requeue\n#SBATCH --open-mode=append\n";
+  text += "#SBATCH --output=" + (job.logs / "task-%a.log").string() + "\n";
+  text += "#SBATCH --cpus-per-task=" + std::to_string(job.cpus) + "\n";
+  for (const std::string& arg : sbatch_args) text += "#SBATCH " + arg + "\n";
+  return text + "# A requeued task resumes: finished trees are skipped, the tree in progress continues from its checkpoint.\n" +
+         "exec " + task_command(job, "$SLURM_ARRAY_TASK_ID") + "\n";
+}
+
+std::string gather_script(const FarmJob& job, const std::vector<std::string>& sbatch_args) {
+  std::string text = header(job, "Slurm gather job, after every task of the array");
+  text += "#SBATCH --job-name=treeanim-" + job.name + "-gather\n";
+  text += "#SBATCH --open-mode=append\n#SBATCH --output=" + (job.logs / "gather.log").string() + "\n";
+  for (const std::string& arg : sbatch_args) text += "#SBATCH " + arg + "\n";
+  return text + "exec " + gather_command(job) + "\n";
+}
+
+std::string plain_script(const FarmJob& job) {
+  std::string text = header(job, std::to_string(job.tasks) + " tasks and the gather for any queue");
+  text += "# usage: " + job.name + ".sh [TASK | gather]: task TASK (0 to " + std::to_string(job.tasks - 1) +
+          "), the gather, or without\n# an argument every task in turn and then the gather. A queue runs one "
+          "task per job, then the gather.\nset -u\n";
+  text += "logs=" + quoted(job.logs.string()) + "\nmkdir -p \"$logs\"\n";
+  text += "task() {\n  " + task_command(job, "$1") + " >> \"$logs/task-$1.log\" 2>&1\n}\n";
+  text += "gather() {\n  " + gather_command(job) + " 2>&1 | tee -a \"$logs/gather.log\"\n  return \"${PIPESTATUS[0]}\"\n}\n";
+  text += "case \"${1:-all}\" in\n"
+          "  all)\n    i=0\n    while [ \"$i\" -lt " + std::to_string(job.tasks) + " ]; do\n"
+          "      task \"$i\" || echo \"task $i failed with exit $? (log $logs/task-$i.log)\" >&2\n"
+          "      i=$((i + 1))\n    done\n    gather ;;\n"
+          "  gather) gather ;;\n"
+          "  *) task \"$1\" ;;\n"
+          "esac\n";
+  return text;
+}
+
+// Folders made for a submission, removed again (when still empty) if it fails.
+class MadeFolders {
+ public:
+  void make(const fs::path& folder) {
+    std::vector<fs::path> missing;
+    for (fs::path p = folder; !p.empty() && !fs::exists(p); p = p.parent_path()) missing.push_back(p);
+    std::error_code error;
+    fs::create_directories(folder, error);
+    if (error) throw OutputError(folder.string() + ": cannot create the folder: " + error.message());
+    made_.insert(made_.end(), missing.begin(), missing.end());
+  }
+  void undo() noexcept {
+    std::error_code ignored;
+    for (const fs::path& p : made_) fs::remove(p, ignored);  // deepest first; fails on a non-empty one
+  }
+
+ private:
+  std::vector<fs::path> made_;
+};
+
+// The job id at the start of sbatch --parsable's output ("123" or "123;cluster"); "" if none.
+std::string job_id(const std::string& out) {
+  size_t end = 0;
+  while (end < out.size() && out[end] >= '0' && out[end] <= '9') ++end;
+  return out.substr(0, end);
+}
+
+std::string trimmed(const std::string& text) {
+  const size_t last = text.find_last_not_of(" \n\r\t");
+  return last == std::string::npos ? "" : text.substr(0, last + 1);
+}
+
+int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
+  const fs::path sbatch = find_on_path("sbatch");
+  if (sbatch.empty())
+    throw InputError("--engine slurm: no sbatch on PATH: run farm submit on a Slurm login node (or install Slurm's "
+                     "client commands), or write a plain script with --engine script; nothing was submitted");
+  const fs::path array = job.farm / (job.name + ".sbatch"), gather = job.farm / (job.name + "-gather.sbatch");
+  MadeFolders folders;
+  folders.make(job.logs);
+  // Submitted from temporaries (sbatch copies a script when it submits), renamed only when both are in.
+  const fs::path array_temporary = temporary_path(array), gather_temporary = temporary_path(gather);
+  const auto discard = [&] {
+    std::error_code ignored;
+    fs::remove(array_temporary, ignored);
+    fs::remove(gather_temporary, ignored);
+    folders.undo();
+  };
+  try {
+    write_text_output(array_temporary, array_script(job, request.sbatch_args), true);
+    write_text_output(gather_temporary, gather_script(job, request.sbatch_args), true);
+  } catch (...) {
+    discard();
+    throw;
+  }
+  const ProgramResult first = run_program(sbatch, {"--parsable", array_temporary.string()});
+  const std::string array_id = first.status == 0 ? job_id(first.out) : "";
+  if (array_id.empty()) {
+    discard();
+    throw InputError("--engine slurm: " + sbatch.string() + " refused the job array (exit " +
+                     std::to_string(first.status) + "): " + trimmed(first.err + first.out) +
+                     "; nothing was submitted: fix what it says (partition, account, limits: --sbatch-arg) and "
+                     "submit again");
+  }
+  std::vector<std::string> args{"--parsable", "--dependency=afterany:" + array_id};
+  if (request.wait) args.push_back("--wait");
+  args.push_back(gather_temporary.string());
+  if (request.wait)  // sbatch --wait returns when the gather job ends: the scripts must be in place by then
+    std::printf("submitted job array %s (%zu tasks); waiting for the gather job\n", array_id.c_str(), job.tasks);
+  std::fflush(stdout);
+  const ProgramResult second = run_program(sbatch, args);
+  const std::string gather_id = job_id(second.out);
+  if (gather_id.empty()) {
+    const fs::path scancel = find_on_path("scancel");
+    if (!scancel.empty()) run_program(scancel, {array_id});
+    discard();
+    throw InputError("--engine slurm: " + sbatch.string() + " refused the gather job (exit " +
+                     std::to_string(second.status) + "): " + trimmed(second.err + second.out) +
+                     "; the job array " + array_id + " was cancelled, nothing is left submitted");
+  }
+  std::error_code error;
+  fs::rename(array_temporary, array, error);
+  if (!error) fs::rename(gather_temporary, gather, error);
+  if (error) throw OutputError(array.string() + ": cannot rename the job script into place: " + error.message());
+  std::printf("submitted job array %s (%zu tasks, logs %s) and gather job %s after it\n  scripts %s, %s\n",
+              array_id.c_str(), job.tasks, (job.logs / "task-<I>.log").c_str(), gather_id.c_str(), array.c_str(),
+              gather.c_str());
+  if (!request.wait) {
+    std::printf("  the manifest will be %s; the gather's report: %s\n", (job.out / "forest.json").c_str(),
+                (job.logs / "gather.log").c_str());
+    return 0;
+  }
+  std::printf("gather job %s ended with exit %d; its report: %s\n", gather_id.c_str(), second.status,
+              (job.logs / "gather.log").c_str());
+  return second.status;
+}
+
+}  // namespace
+
+int farm_submit_command(const FarmRequest& request) {
+  const Scene scene = load_scene(request.scene, request.overrides);
+  if (!scene.forest) throw InputError(request.scene.string() + ": no /forest: farm submit bakes a forest's trees");
+  estimate_forest(scene);  // grows one tree of each variant: a bad grammar fails here, not in every task
+  FarmJob job;
+  std::error_code error;
+  job.treeanim = fs::read_symlink("/proc/self/exe", error);
+  if (error) throw OutputError("/proc/self/exe: cannot find this executable: " + error.message());
+  job.scene = fs::absolute(request.scene).lexically_normal();
+  job.out = fs::absolute(request.out_dir.empty() ? fs::path(".") : request.out_dir).lexically_normal();
+  if (job.out.has_filename() == false) job.out = job.out.parent_path();
+  job.farm = job.out / "farm";
+  job.logs = job.farm / "logs";
+  job.name = request.scene.stem().string();
+  job.tasks = request.tasks;
+  job.checkpoint_every =
+      request.checkpoint_every > 0 ? request.checkpoint_every : std::max(1LL, (scene.time.frames + 7) / 8);
+  job.cpus = request.cpus_per_task;
+  for (const std::string& assignment : request.overrides) job.overrides += " --set " + quoted(assignment);
+
+  if (request.engine == "slurm") return submit_to_slurm(job, request);
+  if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");
+  const fs::path script = job.farm / (job.name + ".sh");
+  write_text_output(script, plain_script(job), true);
+  std::printf("wrote %s: %zu tasks then the gather; run it (every task in turn), or give your queue one job per "
+              "task ('%s I', I = 0 to %zu) and then '%s gather'\n",
+              script.c_str(), job.tasks, script.c_str(), job.tasks - 1, script.c_str());
+  return 0;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,131 @@
+#include "cli/forest_manifest.h"
+
+#include "common/json_text.h"
+#include "common/read_text_file.h"
+#include "io/checkpoint.h"
+#include "io/text_output.h"
+#include "treeanim_version.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Json vector_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+// A file an output wrote => how the manifest names it: relative to the manifest's folder when
+// it lies there, else as it is.
+std::string manifest_name(const fs::path& file, const fs::path& out_dir) {
+  if (out_dir.empty() || file.is_absolute() != out_dir.is_absolute()) return file.string();
+  const fs::path relative = file.lexically_relative(out_dir.lexically_normal());
+  return relative.empty() || *relative.begin() == ".." ? file.string() : relative.string();
+}
+
+// The column-major 4x4 matrix (glTF's order) that takes a point of the tree's files to the world.
+Json placement_matrix(const TreePlacement& placement) {
+  Json matrix = Json::array();
+  for (int column = 0; column < 4; ++column)
+    for (int row = 0; row < 4; ++row)
+      matrix.push_back(row == 3      ? (column == 3 ? 1.0 : 0.0)
+                       : column == 3 ? placement.translation[row]
+                                     : placement.rotation(row, column));
+  return matrix;
+}
+
+}  // namespace
+
+fs::path tree_part_path(const fs::path& out_dir, const std::string& id) {
+  return out_dir / "forest.parts" / (id + ".json");
+}
+
+fs::path forest_manifest_path(const fs::path& out_dir) { return out_dir / "forest.json"; }
+
+std::string tree_bake_key(const Scene& tree_scene) {
+  return scene_hash(tree_scene.resolved.dump(2), std::string("treeanim ") + TREEANIM_VERSION);
+}
+
+void write_tree_part(const fs::path& out_dir, const Scene& forest_scene, size_t index, const Scene& tree_scene,
+                     const TreeBakeResult& result) {
+  const ForestTree& tree = forest_scene.forest->trees[index];
+  Json outputs = Json::array();
+  for (size_t k = 0; k < tree_scene.outputs.size(); ++k) {
+    Json files = Json::array();
+    for (const fs::path& file : result.files[k]) files.push_back(manifest_name(file, out_dir));
+    outputs.push_back({{"format", tree_scene.outputs[k].format}, {"files", std::move(files)}});
+  }
+  const Json part = {
+      {"id", tree.id},
+      {"variant", forest_scene.forest->variants[tree.variant].name},
+      {"seed", tree.seed},
+      {"position", vector_json(tree.position)},
+      {"rotation", tree.rotation},
+      {"scale", tree.scale},
+      {"matrix", placement_matrix(make_tree_placement(tree.position, tree.rotation))},
+      {"bounds", {{"min", vector_json(result.bounds.min())}, {"max", vector_json(result.bounds.max())}}},
+      {"frame_start", result.frame_start},
+      {"frame_count", result.frame_count},
+      {"vertices", result.vertices},
+      {"outputs", std::move(outputs)},
+      {"bake", tree_bake_key(tree_scene)}};
+  write_text_output(tree_part_path(out_dir, tree.id), part.dump(2) + "\n");
+}
+
+std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::string& id, const std::string& key,
+                                       std::string& why) {
+  const fs::path path = tree_part_path(out_dir, id);
+  std::string text, reason;
+  if (!read_text_file(path, text, reason)) {
+    why = "not baked (no " + path.string() + ")";
+    return std::nullopt;
+  }
+  Json part;
+  try {
+    part = parse_json_text(text, path.string());
+    if (part.at("bake").get<std::string>() != key) {
+      why = path.string() + " is of another scene or treeanim version";
+      return std::nullopt;
+    }
+    for (const Json& output : part.at("outputs"))
+      for (const Json& name : output.at("files")) {
+        const fs::path file(name.get<std::string>());
+        std::error_code error;
+        if (!fs::is_regular_file(file.is_absolute() ? file : out_dir / file, error)) {
+          why = "its file " + file.string() + " is missing";
+          return std::nullopt;
+        }
+      }
+  } catch (const std::exception& error) {
+    why = path.string() + " cannot be read: " + error.what();
+    return std::nullopt;
+  }
+  return part;
+}
+
+GatherReport gather_forest(const Scene& scene, const fs::path& out_dir) {
+  GatherReport report;
+  Json trees = Json::array();
+  for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
+    std::string why;
+    const Scene one = tree_scene(scene, t);
+    auto part = complete_tree_part(out_dir, scene.forest->trees[t].id, tree_bake_key(one), why);
+    if (!part) {
+      report.missing.push_back(t);
+      report.reasons.push_back(why);
+    } else if (report.missing.empty()) {
+      trees.push_back(std::move(*part));
+    }
+  }
+  if (!report.missing.empty()) return report;
+  const Json manifest = {{"format", "treeanim-forest"},
+                         {"format_version", 1},
+                         {"generator", std::string("treeanim ") + TREEANIM_VERSION},
+                         {"units", "m"},
+                         {"up_axis", "Y"},
+                         {"fps", scene.time.fps},
+                         {"trees", std::move(trees)}};
+  write_text_output(forest_manifest_path(out_dir), manifest.dump(2) + "\n");
+  return report;
+}
+
+}  // namespace treeanim

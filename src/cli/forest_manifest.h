@@ -1,0 +1,43 @@
+#pragma once
+// The forest manifest (docs/outputs.md "Forest manifest"): a part per finished tree in
+// OUT/forest.parts/<id>.json, written by whichever process baked it, and OUT/forest.json, the
+// parts of every tree in forest order, written once all are complete (farm gather).
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/bake_tree.h"
+#include "scene/scene.h"
+
+namespace treeanim {
+
+// out_dir ("" = the working folder), tree id => the tree's part file.
+std::filesystem::path tree_part_path(const std::filesystem::path& out_dir, const std::string& id);
+// out_dir => the forest manifest.
+std::filesystem::path forest_manifest_path(const std::filesystem::path& out_dir);
+
+// A tree's one-tree scene => the key of its bake: the checkpoint's scene hash (resolved scene
+// and treeanim version). A part of another key belongs to an older bake.
+std::string tree_bake_key(const Scene& tree_scene);
+
+// Writes tree `index`'s part (atomically) after its outputs are all in place.
+void write_tree_part(const std::filesystem::path& out_dir, const Scene& forest_scene, size_t index,
+                     const Scene& tree_scene, const TreeBakeResult& result);
+
+// The tree's part when its bake is complete: the part is there, of this key, and every file it
+// lists exists; else nullopt, with the reason in `why`.
+std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, const std::string& id,
+                                       const std::string& key, std::string& why);
+
+struct GatherReport {
+  std::vector<size_t> missing;       // trees whose bake is not complete, ascending
+  std::vector<std::string> reasons;  // (missing) why
+};
+
+// Every tree complete => writes OUT/forest.json and returns no missing trees; else writes
+// nothing and returns them. Throws OutputError when the manifest cannot be written.
+GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir);
+
+}  // namespace treeanim

@@ -1,0 +1,82 @@
+#include "cli/forest_tasks.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <numeric>
+#include <queue>
+
+#include "cli/prepare_tree.h"
+#include "common/errors.h"
+#include "io/output_estimate.h"
+
+namespace treeanim {
+
+ForestEstimate estimate_forest(const Scene& scene) {
+  const Forest& forest = *scene.forest;
+  const long long steps = scene.time.frames * scene.time.substeps;
+  std::vector<uint64_t> variant_cost(forest.variants.size(), 0);
+  std::vector<double> variant_bytes(forest.variants.size(), 0);
+  std::vector<size_t> variant_vertices(forest.variants.size(), 0);
+  std::vector<bool> built(forest.variants.size(), false);
+  for (size_t t = 0; t < forest.trees.size(); ++t) {
+    const uint32_t v = forest.trees[t].variant;
+    if (built[v]) continue;
+    built[v] = true;
+    const Scene one = tree_scene(scene, t);
+    const PreparedTree tree = prepare_tree(one);
+    variant_vertices[v] = tree.model.vertex_count();
+    variant_cost[v] = uint64_t(tree.model.vertex_count()) * uint64_t(steps);
+    for (const OutputOptions& output : one.outputs)
+      variant_bytes[v] += estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
+                                                 scene.time.frames);
+  }
+  ForestEstimate estimate;
+  for (const ForestTree& tree : forest.trees) {
+    estimate.tree_cost.push_back(variant_cost[tree.variant]);
+    estimate.tree_bytes.push_back(variant_bytes[tree.variant]);
+    estimate.tree_vertices.push_back(variant_vertices[tree.variant]);
+  }
+  return estimate;
+}
+
+std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost, size_t tasks) {
+  std::vector<size_t> order(cost.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
+  using Load = std::pair<uint64_t, size_t>;  // (cost so far, task): the least first, ties by task
+  std::priority_queue<Load, std::vector<Load>, std::greater<Load>> least;
+  for (size_t k = 0; k < tasks; ++k) least.emplace(0, k);
+  std::vector<std::vector<size_t>> assigned(tasks);
+  for (size_t tree : order) {
+    auto [load, task] = least.top();
+    least.pop();
+    assigned[task].push_back(tree);
+    least.emplace(load + cost[tree], task);
+  }
+  for (auto& trees : assigned) std::sort(trees.begin(), trees.end());
+  return assigned;
+}
+
+Shard parse_shard(const std::string& text) {
+  const std::string expected = "--shard '" + text +
+                               "': expected I/N with 0 <= I < N, the 0-based task of N (I may be 'auto', "
+                               "which reads $SLURM_ARRAY_TASK_ID)";
+  const size_t slash = text.find('/');
+  if (slash == std::string::npos) throw InputError(expected);
+  std::string index = text.substr(0, slash);
+  if (index == "auto") {
+    const char* env = std::getenv("SLURM_ARRAY_TASK_ID");
+    if (!env) throw InputError("--shard '" + text + "': SLURM_ARRAY_TASK_ID is not set (not a Slurm array task): give I/N");
+    index = env;
+  }
+  const auto parse = [&](const std::string& digits) {
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError(expected);
+    return static_cast<size_t>(std::stoul(digits));
+  };
+  Shard shard{parse(index), parse(text.substr(slash + 1))};
+  if (shard.count == 0 || shard.index >= shard.count) throw InputError(expected);
+  return shard;
+}
+
+}  // namespace treeanim

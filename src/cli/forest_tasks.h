@@ -1,0 +1,39 @@
+#pragma once
+// A forest split into farm tasks (docs/farm.md "Shards"): each tree's cost estimated, the trees
+// dealt to tasks so that every task costs about the same, and which task a process runs.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace treeanim {
+
+// Seconds of one core per vertex and substep of a bake, measured on the reference machine
+// (docs/farm.md "Measured here"): converts estimated costs into CPU-hours.
+inline constexpr double kSecondsPerVertexStep = 5.3e-8;
+
+// What one tree of each variant costs, from one model per variant (the first tree of it): the
+// vertex count does not depend on a tree's scale, and only a stochastic grammar's seed changes it.
+struct ForestEstimate {
+  std::vector<uint64_t> tree_cost;   // (trees) vertices x substeps of the bake
+  std::vector<double> tree_bytes;    // (trees) estimated bytes of the tree's outputs
+  std::vector<size_t> tree_vertices; // (trees) vertices of the tree's variant model
+};
+
+// Builds each used variant's model once (derivation, mesh); no simulation. Throws InputError.
+ForestEstimate estimate_forest(const Scene& scene);
+
+// Costs, tasks => the trees of each task (ascending), dealt longest first to the task with the
+// least cost so far (ties: the lower index); deterministic, so every shard of a farm job agrees.
+std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost, size_t tasks);
+
+struct Shard {
+  size_t index = 0;  // 0-based task
+  size_t count = 1;  // tasks
+};
+
+// "I/N" (or "auto/N": I from $SLURM_ARRAY_TASK_ID) => shard; InputError unless 0 <= I < N.
+Shard parse_shard(const std::string& text);
+
+}  // namespace treeanim

@@ -1,0 +1,91 @@
+#include "scene/forest_layout.h"
+
+#include <cmath>
+#include <unordered_map>
+
+namespace treeanim {
+
+namespace {
+
+// Points binned in square cells of the spacing: a point closer than the spacing to p lies in
+// p's cell or one of its 8 neighbours, so each test costs O(1) however large the forest.
+class GroundGrid {
+ public:
+  explicit GroundGrid(double spacing) : cell_(spacing) {}
+
+  // True when a point already added is closer than the spacing to p; `which` gets its index.
+  bool near(const Eigen::Vector2d& p, size_t* which) const {
+    if (cell_ <= 0) return false;
+    const long long cx = cell(p.x()), cz = cell(p.y());
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dz = -1; dz <= 1; ++dz) {
+        const auto found = cells_.find(key(cx + dx, cz + dz));
+        if (found == cells_.end()) continue;
+        for (size_t i : found->second)
+          if ((points_[i] - p).squaredNorm() < cell_ * cell_) {
+            if (which) *which = i;
+            return true;
+          }
+      }
+    return false;
+  }
+
+  void add(const Eigen::Vector2d& p) {
+    points_.push_back(p);
+    if (cell_ > 0) cells_[key(cell(p.x()), cell(p.y()))].push_back(points_.size() - 1);
+  }
+
+ private:
+  long long cell(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
+  static uint64_t key(long long x, long long z) { return (uint64_t(x) << 32) ^ (uint64_t(z) & 0xffffffffull); }
+
+  double cell_;                                                // m, the spacing
+  std::vector<Eigen::Vector2d> points_;                        // (P) m, in the order added
+  std::unordered_map<uint64_t, std::vector<size_t>> cells_;    // cell => indices into points_
+};
+
+}  // namespace
+
+uint64_t splitmix64(uint64_t& state) {
+  uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+double uniform01(uint64_t& state) { return static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53; }
+
+std::optional<std::pair<size_t, size_t>> closer_than(const std::vector<Eigen::Vector2d>& points, double spacing) {
+  GroundGrid grid(spacing);
+  for (size_t i = 0; i < points.size(); ++i) {
+    size_t other = 0;
+    if (grid.near(points[i], &other)) return std::pair{other, i};
+    grid.add(points[i]);
+  }
+  return std::nullopt;
+}
+
+std::vector<Eigen::Vector2d> scatter_points(uint64_t seed, size_t count, const ScatterArea& area, double spacing,
+                                            long long attempts, const std::vector<Eigen::Vector2d>& fixed) {
+  GroundGrid grid(spacing);
+  for (const Eigen::Vector2d& p : fixed) grid.add(p);
+  uint64_t state = seed ^ 0x7363617474657200ull;  // "scatter": this purpose's stream
+  const Eigen::Vector2d extent = area.max - area.min;
+  std::vector<Eigen::Vector2d> placed;
+  placed.reserve(count);
+  while (placed.size() < count) {
+    bool fitted = false;
+    for (long long dart = 0; dart < attempts && !fitted; ++dart) {
+      const double u = uniform01(state), v = uniform01(state);
+      const Eigen::Vector2d p(area.min.x() + u * extent.x(), area.min.y() + v * extent.y());
+      if (grid.near(p, nullptr)) continue;
+      grid.add(p);
+      placed.push_back(p);
+      fitted = true;
+    }
+    if (!fitted) break;
+  }
+  return placed;
+}
+
+}  // namespace treeanim

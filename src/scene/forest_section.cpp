@@ -1,0 +1,207 @@
+// /forest => variants and placed trees (docs/scene.md "forest").
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <unordered_map>
+
+#include "common/errors.h"
+#include "scene/forest.h"
+#include "scene/forest_layout.h"
+
+namespace treeanim {
+
+namespace {
+
+constexpr uint64_t kSeedMask = (1ull << 53) - 1;  // seeds are JSON integers: at most 2^53
+
+// A name that is safe as (part of) a file name on every system a farm uses.
+bool is_file_safe(const std::string& name) {
+  if (name.empty() || name.size() > 64 || name[0] == '.' || name[0] == '-') return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '.';
+  });
+}
+
+std::string number_text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+ForestVariant read_variant(SceneObject element, const ForestDefaults& defaults) {
+  ForestVariant variant;
+  const auto name = element.optional_string("name");
+  if (!name || !is_file_safe(*name))
+    element.fail_expected("name", "a name of 1 to 64 letters, digits, '_', '-' or '.' (not first)");
+  variant.name = *name;
+  variant.weight = element.number("weight", 1, Range::non_negative());
+  if (element.has("lsystem"))
+    variant.lsystem = read_lsystem_options(element.object("lsystem"), defaults.seed);
+  else if (defaults.lsystem)
+    variant.lsystem = *defaults.lsystem;
+  else
+    element.fail("lsystem", "expected the variant's grammar (an object like /lsystem): the scene has no "
+                            "top-level /lsystem for it to fall back to");
+  variant.tree = element.has("tree") ? read_tree_options(element.object("tree")) : *defaults.tree;
+  variant.resolved = element.json();
+  return variant;
+}
+
+// The variants, or the scene's own sections as the one variant "default".
+std::vector<ForestVariant> read_variants(SceneObject& section, const ForestDefaults& defaults) {
+  std::vector<ForestVariant> variants;
+  if (!section.has("variants")) {
+    section.declare("variants");
+    if (!defaults.lsystem)
+      section.fail("variants", "expected variants: the scene has no top-level /lsystem to grow its trees from");
+    ForestVariant variant;
+    variant.name = "default";
+    variant.lsystem = *defaults.lsystem;
+    variant.tree = *defaults.tree;
+    variant.resolved = Json{{"name", variant.name}, {"weight", variant.weight}};
+    variants.push_back(std::move(variant));
+    return variants;
+  }
+  std::vector<SceneObject> elements = section.array_of_objects("variants");
+  if (elements.empty()) section.fail("variants", "expected at least one variant, got []");
+  std::unordered_map<std::string, size_t> names;
+  for (SceneObject& element : elements) {
+    variants.push_back(read_variant(element, defaults));
+    const auto [it, inserted] = names.emplace(variants.back().name, variants.size() - 1);
+    if (!inserted)
+      element.fail("name", "\"" + it->first + "\" names " + section.pointer_of("variants") + "/" +
+                               std::to_string(it->second) + " too");
+  }
+  return variants;
+}
+
+// "0007": index i of a forest of `total` trees, zero-padded to at least 4 digits.
+std::string padded_id(size_t i, size_t total) {
+  const size_t width = std::max<size_t>(4, std::to_string(total > 0 ? total - 1 : 0).size());
+  std::string text = std::to_string(i);
+  return std::string(width - std::min(width, text.size()), '0') + text;
+}
+
+ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, const std::vector<ForestVariant>& variants,
+                            uint64_t scene_seed) {
+  ForestTree tree;
+  tree.pointer = element.pointer();
+  const auto id = element.optional_string("id");
+  if (id && !is_file_safe(*id))
+    element.fail_expected("id", "an id of 1 to 64 letters, digits, '_', '-' or '.' (not first)");
+  tree.id = id ? *id : padded_id(index, total);
+  const std::string variant = element.string("variant", variants.front().name);
+  const auto found = std::find_if(variants.begin(), variants.end(), [&](const auto& v) { return v.name == variant; });
+  if (found == variants.end()) {
+    std::string names;
+    for (const auto& v : variants) names += (names.empty() ? "\"" : ", \"") + v.name + "\"";
+    element.fail("variant", "expected one of the variants' names (" + names + "), got \"" + variant + "\"");
+  }
+  tree.variant = static_cast<uint32_t>(found - variants.begin());
+  tree.position = element.vector3("position", Eigen::Vector3d::Zero());
+  tree.rotation = element.number("rotation", 0);
+  tree.scale = element.number("scale", 1, Range::positive());
+  uint64_t state = scene_seed ^ 0x7472656573656564ull ^ (uint64_t(index) << 20);  // "treeseed", by index
+  tree.seed = static_cast<uint64_t>(
+      element.integer("seed", static_cast<long long>(splitmix64(state) & kSeedMask), 0, 1LL << 53));
+  return tree;
+}
+
+// Scattered trees after the listed ones: positions by dart throwing, and per tree a variant by
+// weight, a rotation, a scale and a seed drawn from the tree's own stream (scatter seed, index),
+// so that a change of spacing or area moves trees without changing what they are.
+void scatter_trees(SceneObject scatter, long long count, Forest& forest, uint64_t scene_seed) {
+  if (!scatter.has("min") || !scatter.has("max"))
+    scatter.fail(scatter.has("min") ? "max" : "min", "expected the area's corners min and max, each [x, z] in m");
+  const auto min = scatter.pair("min", {0, 0}), max = scatter.pair("max", {0, 0});
+  const ScatterArea area{{min[0], min[1]}, {max[0], max[1]}};
+  if (!(area.min.array() <= area.max.array()).all())
+    scatter.fail("max", "expected a corner at or beyond min in x and z");
+  const auto seed = static_cast<uint64_t>(scatter.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
+  const long long attempts = scatter.integer("attempts", 1000, 1, 1'000'000);
+  const auto rotation = scatter.pair("rotation", {0, 360});
+  const auto scale = scatter.pair("scale", {1, 1}, Range::positive());
+  if (rotation[0] > rotation[1]) scatter.fail_expected("rotation", "[lo, hi] degrees with lo <= hi");
+  if (scale[0] > scale[1]) scatter.fail_expected("scale", "[lo, hi] with lo <= hi");
+  double total_weight = 0;
+  for (const ForestVariant& v : forest.variants) total_weight += v.weight;
+  if (!(total_weight > 0))
+    scatter.fail("count", "the variants' weights sum to 0: give a variant a weight > 0 to scatter");
+
+  std::vector<Eigen::Vector2d> listed;
+  for (const ForestTree& tree : forest.trees) listed.emplace_back(tree.position.x(), tree.position.z());
+  const auto points = scatter_points(seed, static_cast<size_t>(count), area, forest.spacing, attempts, listed);
+  if (points.size() < static_cast<size_t>(count))
+    scatter.fail("count", "placed " + std::to_string(points.size()) + " of " + std::to_string(count) +
+                              " trees in the area with /forest/spacing " + number_text(forest.spacing) + " m (" +
+                              std::to_string(attempts) +
+                              " darts each): enlarge the area (min, max), lower the count or the spacing");
+  const size_t first = forest.trees.size(), total = first + points.size();
+  for (size_t k = 0; k < points.size(); ++k) {
+    ForestTree tree;
+    tree.pointer = scatter.pointer();
+    tree.id = padded_id(first + k, total);
+    uint64_t state = (seed * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k) + 0x5ca77e4ull);  // the tree's stream
+    double pick = uniform01(state) * total_weight;
+    tree.variant = 0;
+    while (tree.variant + 1 < forest.variants.size() &&
+           (pick >= forest.variants[tree.variant].weight || forest.variants[tree.variant].weight == 0)) {
+      pick -= forest.variants[tree.variant].weight;
+      ++tree.variant;
+    }
+    tree.rotation = rotation[0] + uniform01(state) * (rotation[1] - rotation[0]);
+    tree.scale = scale[0] + uniform01(state) * (scale[1] - scale[0]);
+    tree.seed = splitmix64(state) & kSeedMask;
+    tree.position = Eigen::Vector3d(points[k].x(), 0, points[k].y());
+    forest.trees.push_back(std::move(tree));
+  }
+}
+
+}  // namespace
+
+Forest read_forest(SceneObject section, const ForestDefaults& defaults) {
+  Forest forest;
+  // Keys with defaults first: adding a key to this object moves its members, and the sections
+  // read below keep pointers into them.
+  forest.spacing = section.number("spacing", 0, Range::non_negative());
+  forest.variants = read_variants(section, defaults);
+  std::vector<SceneObject> listed;
+  if (section.has("trees")) listed = section.array_of_objects("trees");
+  else section.declare("trees");
+  long long scatter_count = 0;
+  std::optional<SceneObject> scatter;
+  if (section.has("scatter")) {
+    scatter = section.object("scatter");
+    scatter_count = scatter->integer("count", 0, 0, 1'000'000);
+  } else {
+    section.declare("scatter");
+  }
+  const size_t total = listed.size() + static_cast<size_t>(scatter_count);
+  if (total == 0)
+    section.fail("trees", "a forest with no trees: list trees in /forest/trees or give /forest/scatter/count >= 1");
+
+  for (size_t i = 0; i < listed.size(); ++i)
+    forest.trees.push_back(read_listed_tree(listed[i], i, total, forest.variants, defaults.seed));
+  std::vector<Eigen::Vector2d> ground;
+  for (const ForestTree& tree : forest.trees) ground.emplace_back(tree.position.x(), tree.position.z());
+  if (const auto pair = closer_than(ground, forest.spacing)) {
+    const auto [a, b] = *pair;
+    listed[b].fail("position", number_text((ground[a] - ground[b]).norm()) + " m from " + forest.trees[a].pointer +
+                                   " on the ground, closer than /forest/spacing = " + number_text(forest.spacing) +
+                                   " m: move one of them or lower the spacing");
+  }
+  if (scatter && scatter_count > 0) scatter_trees(*scatter, scatter_count, forest, defaults.seed);
+
+  std::unordered_map<std::string, size_t> ids;
+  for (size_t i = 0; i < forest.trees.size(); ++i) {
+    const auto [it, inserted] = ids.emplace(forest.trees[i].id, i);
+    if (!inserted)
+      section.fail("trees", "two trees have the id \"" + it->first + "\" (" + forest.trees[it->second].pointer +
+                                " and " + forest.trees[i].pointer + "): ids name the trees' files, give each its own");
+  }
+  return forest;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,242 @@
+#!/usr/bin/python3
+"""Forest bakes end to end (docs/farm.md), on configs/forest-demo.json:
+
+  shards  the forest baked in one process equals the union of its shards baked separately,
+          every output file byte for byte, and farm gather writes the same forest.json
+  resume  a shard killed (SIGKILL) in the middle of a tree and run again with --resume skips
+          the finished trees, resumes the tree in progress and gives the same files
+  plan    farm plan --json: every tree in one task, tasks balanced by cost
+  submit  farm submit --engine slurm against a fake sbatch on PATH (records its arguments,
+          prints a job id, runs the job at once): the scripts, the dependency, --wait, the bake;
+          and --engine script run as a plain shell script
+
+usage: forest_bake.py TREEANIM CASE      (exit 0 pass, 1 fail)
+"""
+import filecmp
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENE = os.path.join(HERE, "..", "..", "configs", "forest-demo.json")
+
+
+class Failed(Exception):
+    pass
+
+
+def run(treeanim, *args, env=None, check=True):
+    done = subprocess.run([treeanim, *args], capture_output=True, text=True, env=env)
+    if check and done.returncode != 0:
+        raise Failed("%s exited %d: %s" % (" ".join(args), done.returncode, done.stderr[-2000:]))
+    return done
+
+
+def output_files(folder):
+    """Every tree's output file below folder (relative), not the manifest, parts, checkpoints or farm scripts."""
+    found = []
+    for root, dirs, names in os.walk(folder):
+        dirs[:] = [d for d in dirs if d not in ("checkpoints", "forest.parts", "farm")]
+        found += [os.path.relpath(os.path.join(root, n), folder) for n in names
+                  if ".tmp-" not in n and n != "forest.json"]
+    return sorted(found)
+
+
+def same_outputs(reference, other, manifest=True):
+    files = output_files(reference)
+    if len(files) < 32:
+        raise Failed("the reference holds only %d files" % len(files))
+    if files != output_files(other):
+        raise Failed("different files: %s vs %s" % (files, output_files(other)))
+    names = files + (["forest.json"] if manifest else [])
+    for name in names:
+        if not filecmp.cmp(os.path.join(reference, name), os.path.join(other, name), shallow=False):
+            raise Failed("%s differs between %s and %s" % (name, reference, other))
+
+
+def case_shards(treeanim, tmp):
+    one = os.path.join(tmp, "one")
+    run(treeanim, "run", SCENE, "-o", one, "-q")
+    shards = os.path.join(tmp, "shards")
+    for i in range(3):
+        run(treeanim, "run", SCENE, "-o", shards, "-q", "--shard", "%d/3" % i)
+    if os.path.exists(os.path.join(shards, "forest.json")):
+        raise Failed("a shard wrote forest.json; only farm gather does")
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards)
+    if "all 16 trees complete" not in done.stdout:
+        raise Failed("gather said: %s" % done.stdout)
+    same_outputs(one, shards)
+    manifest = json.load(open(os.path.join(one, "forest.json")))
+    trees = manifest["trees"]
+    if len(trees) != 16 or len({t["variant"] for t in trees}) != 3:
+        raise Failed("the manifest lists %d trees of %d variants" % (len(trees), len({t["variant"] for t in trees})))
+    for tree in trees:
+        if not all(os.path.isfile(os.path.join(one, f)) for o in tree["outputs"] for f in o["files"]):
+            raise Failed("the manifest names files that are not there: %s" % tree["outputs"])
+        if tree["bounds"]["min"][1] < -0.5 or tree["bounds"]["max"][1] <= 0:
+            raise Failed("tree %s: bounds %s" % (tree["id"], tree["bounds"]))
+        x, z = tree["position"][0], tree["position"][2]
+        lo, hi = tree["bounds"]["min"], tree["bounds"]["max"]
+        if not (lo[0] <= x <= hi[0] and lo[2] <= z <= hi[2]):
+            raise Failed("tree %s at %s lies outside its world bounds %s" % (tree["id"], tree["position"], tree["bounds"]))
+    # A removed file makes the gather fail, naming the tree and what to do.
+    os.remove(os.path.join(shards, trees[3]["outputs"][0]["files"][0]))
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--tasks", "3", check=False)
+    if done.returncode != 4 or trees[3]["id"] not in done.stderr or "--shard I/3" not in done.stderr:
+        raise Failed("gather with a missing file: exit %d, %s" % (done.returncode, done.stderr))
+
+
+def tree_in_progress(out):
+    """The id of a tree with checkpoints, none past frame 200 of 240, and no part yet (baking), else None."""
+    folder = os.path.join(out, "checkpoints")
+    for tree in (os.listdir(folder) if os.path.isdir(folder) else []):
+        if os.path.exists(os.path.join(out, "forest.parts", tree + ".json")):
+            continue
+        names = os.listdir(os.path.join(folder, tree)) if os.path.isdir(os.path.join(folder, tree)) else []
+        frames = [int(n[len("checkpoint-"):-len(".h5")]) for n in names
+                  if n.startswith("checkpoint-") and n.endswith(".h5")]
+        if frames and max(frames) <= 200:
+            return tree
+    return None
+
+
+def case_resume(treeanim, tmp):
+    longer = ["--set", "time.frames=240", "--set", "time.substeps=8"]
+    reference = os.path.join(tmp, "reference")
+    run(treeanim, "run", SCENE, "-o", reference, "-q", *longer)
+    out = os.path.join(tmp, "killed")
+    shard = ["--shard", "0/2", "--checkpoint-every", "20"]
+    process = subprocess.Popen([treeanim, "run", SCENE, "-o", out, "-q", *shard, *longer],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parts = os.path.join(out, "forest.parts")
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        done_trees = len(os.listdir(parts)) if os.path.isdir(parts) else 0
+        if done_trees >= 2 and tree_in_progress(out):
+            process.send_signal(signal.SIGKILL)
+            break
+        if process.poll() is not None:
+            raise Failed("the shard ended (exit %s) before it could be killed mid-tree" % process.returncode)
+        time.sleep(0.0005)
+    process.wait()
+    if process.returncode != -signal.SIGKILL:
+        raise Failed("expected the shard to die of SIGKILL, got exit %s" % process.returncode)
+    finished = len(os.listdir(parts))
+    done = run(treeanim, "run", SCENE, "-o", out, *shard, "--resume", *longer)
+    if done.stdout.count("complete, skipped") != finished:
+        raise Failed("%d trees were complete, the resumed shard skipped %d:\n%s"
+                     % (finished, done.stdout.count("complete, skipped"), done.stdout))
+    if "resuming at frame" not in done.stderr:
+        raise Failed("the tree in progress did not resume from its checkpoint:\n%s" % done.stderr[-3000:])
+    run(treeanim, "run", SCENE, "-o", out, "-q", "--shard", "1/2", *longer)
+    run(treeanim, "farm", "gather", SCENE, "-o", out, *longer)
+    same_outputs(reference, out)
+
+
+def case_plan(treeanim, tmp):
+    plan_file = os.path.join(tmp, "plan.json")
+    run(treeanim, "farm", "plan", SCENE, "--tasks", "5", "--json", plan_file)
+    plan = json.load(open(plan_file))
+    ids = sorted(i for task in plan["tasks"] for i in task["trees"])
+    manifest_ids = sorted(t["id"] for t in json.load(open(os.path.join(HERE, "..", "..", "configs",
+                                                                         "forest-demo.json")))["forest"]["trees"])
+    if len(ids) != 16 or len(set(ids)) != 16 or not set(manifest_ids) <= set(ids):
+        raise Failed("the plan's tasks hold %s" % ids)
+    costs = [task["vertex_steps"] for task in plan["tasks"]]
+    if len(costs) != 5 or max(costs) > 1.35 * sum(costs) / 5:
+        raise Failed("unbalanced tasks: %s" % costs)
+    if not plan["total"]["core_hours"] > 0 or not plan["total"]["bytes"] > 0:
+        raise Failed("no estimate: %s" % plan["total"])
+
+
+FAKE_SBATCH = r'''#!/usr/bin/python3
+# A stand-in for Slurm's sbatch: records its arguments and the script, prints a job id
+# (--parsable), and runs the job at once: an array task by task, then (with --wait) returns
+# the job's exit status.
+import json, os, re, shutil, subprocess, sys
+log = os.environ["FAKE_SBATCH_LOG"]
+calls = open(log).read().splitlines() if os.path.exists(log) else []
+job = 1000 + len(calls)
+script = sys.argv[-1]
+shutil.copy(script, "%s.%d" % (log, job))
+with open(log, "a") as f:
+    f.write(json.dumps(sys.argv[1:]) + "\n")
+print(job, flush=True)
+text = open(script).read()
+array = re.search(r"^#SBATCH --array=0-(\d+)$", text, re.M)
+status = 0
+for task in range(int(array.group(1)) + 1 if array else 1):
+    env = dict(os.environ, SLURM_ARRAY_TASK_ID=str(task)) if array else dict(os.environ)
+    status = subprocess.run(["bash", script], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode or status
+sys.exit(status if "--wait" in sys.argv else 0)
+'''
+
+
+def case_submit(treeanim, tmp):
+    reference = os.path.join(tmp, "reference")
+    run(treeanim, "run", SCENE, "-o", reference, "-q")
+    bin_dir = os.path.join(tmp, "bin")
+    os.makedirs(bin_dir)
+    with open(os.path.join(bin_dir, "sbatch"), "w") as f:
+        f.write(FAKE_SBATCH)
+    os.chmod(os.path.join(bin_dir, "sbatch"), 0o755)
+    log = os.path.join(tmp, "sbatch.log")
+    env = dict(os.environ, PATH=bin_dir + ":" + os.environ["PATH"], FAKE_SBATCH_LOG=log)
+    out = os.path.join(tmp, "farm-out")
+    # Relative paths, from another folder: the scripts must name everything absolutely.
+    done = subprocess.run([treeanim, "farm", "submit", os.path.relpath(SCENE, tmp), "--engine", "slurm", "--tasks",
+                           "4", "-o", "farm-out", "--wait"], cwd=tmp, capture_output=True, text=True, env=env)
+    if done.returncode != 0:
+        raise Failed("farm submit --wait: exit %d\n%s%s" % (done.returncode, done.stdout, done.stderr))
+    calls = [json.loads(line) for line in open(log)]
+    if len(calls) != 2 or calls[0][0] != "--parsable" or calls[1][:3] != ["--parsable", "--dependency=afterany:1000",
+                                                                          "--wait"]:
+        raise Failed("sbatch was called with %s" % calls)
+    array, gather = open(log + ".1000").read(), open(log + ".1001").read()
+    exe = os.path.realpath(treeanim)
+    for needed in ["#SBATCH --array=0-3", "#SBATCH --requeue", "#SBATCH --output=%s/farm/logs/task-%%a.log" % out,
+                   "'%s' run '%s' --shard \"$SLURM_ARRAY_TASK_ID/4\" -o '%s' --checkpoint-every 3 --resume"
+                   % (exe, os.path.realpath(SCENE), out)]:
+        if needed not in array:
+            raise Failed("the array script lacks %r:\n%s" % (needed, array))
+    if "'%s' farm gather '%s' -o '%s' --tasks 4" % (exe, os.path.realpath(SCENE), out) not in gather:
+        raise Failed("the gather script:\n%s" % gather)
+    for name in ["forest-demo.sbatch", "forest-demo-gather.sbatch"]:
+        if not os.path.isfile(os.path.join(out, "farm", name)):
+            raise Failed("%s was not kept in %s/farm" % (name, out))
+    if [n for n in os.listdir(os.path.join(out, "farm")) if ".tmp-" in n]:
+        raise Failed("temporaries left in %s/farm: %s" % (out, os.listdir(os.path.join(out, "farm"))))
+    same_outputs(reference, out)
+
+    # --engine script: the same work as a plain shell script, same relative outputs.
+    plain = os.path.join(tmp, "plain")
+    run(treeanim, "farm", "submit", SCENE, "--engine", "script", "--tasks", "3", "-o", plain)
+    done = subprocess.run(["bash", os.path.join(plain, "farm", "forest-demo.sh")], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise Failed("the plain script exited %d: %s" % (done.returncode, done.stderr))
+    same_outputs(reference, plain)
+
+
+CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit}
+
+
+def main():
+    treeanim, case = os.path.abspath(sys.argv[1]), sys.argv[2]
+    tmp = tempfile.mkdtemp(prefix="treeanim-forest-%d-" % os.getpid())
+    try:
+        CASES[case](treeanim, tmp)
+    except Failed as failure:
+        print("FAIL %s: %s" % (case, failure))
+        sys.exit(1)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("ok %s" % case)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,160 @@
+// /forest (docs/scene.md "forest"): scatter determinism and spacing, listed trees, the one-tree
+// scene of each tree, and the refusals with their JSON pointers.
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "scene/forest_layout.h"
+#include "scene/scene.h"
+
+namespace treeanim {
+namespace {
+
+Scene load(const std::string& forest, const std::string& outputs = "[]") {
+  return load_scene_text(R"({"lsystem": {"axiom": "F", "iterations": 0}, "forest": )" + forest +
+                             R"(, "outputs": )" + outputs + "}",
+                         "f.json", "/scenes", {});
+}
+
+std::string error_of(const std::string& forest, const std::string& outputs = "[]") {
+  try {
+    load(forest, outputs);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+double nearest_pair(const std::vector<Eigen::Vector2d>& points) {
+  double nearest = 1e300;
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t j = 0; j < i; ++j) nearest = std::min(nearest, (points[i] - points[j]).norm());
+  return nearest;
+}
+
+TEST(ForestLayout, ScatterIsDeterministicAndKeepsTheSpacing) {
+  const ScatterArea area{{-20, -10}, {20, 10}};
+  const std::vector<Eigen::Vector2d> fixed{{0, 0}};
+  const auto a = scatter_points(42, 100, area, 2.0, 1000, fixed);
+  const auto b = scatter_points(42, 100, area, 2.0, 1000, fixed);
+  const auto c = scatter_points(43, 100, area, 2.0, 1000, fixed);
+  ASSERT_EQ(a.size(), 100u);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  auto all = a;
+  all.push_back(fixed.front());
+  EXPECT_GE(nearest_pair(all), 2.0);
+  for (const auto& p : a) {
+    EXPECT_TRUE(p.x() >= -20 && p.x() <= 20 && p.y() >= -10 && p.y() <= 10) << p.transpose();
+  }
+}
+
+TEST(ForestLayout, AFullAreaStopsAtWhatFits) {
+  // A 4 m square holds at most 9 points 2 m apart (plus boundary luck): never 100.
+  const auto placed = scatter_points(1, 100, {{0, 0}, {4, 4}}, 2.0, 200, {});
+  EXPECT_LT(placed.size(), 100u);
+  EXPECT_GE(placed.size(), 3u);
+  EXPECT_GE(nearest_pair(placed), 2.0);
+}
+
+TEST(ForestLayout, CloserThanNamesThePair) {
+  const auto pair = closer_than({{0, 0}, {10, 0}, {10.5, 0}}, 1.0);
+  ASSERT_TRUE(pair);
+  EXPECT_EQ(pair->first, 1u);
+  EXPECT_EQ(pair->second, 2u);
+  EXPECT_FALSE(closer_than({{0, 0}, {10, 0}, {10.5, 0}}, 0.4));
+}
+
+TEST(Forest, ListedAndScatteredTrees) {
+  const Scene scene = load(R"({"spacing": 1, "variants": [{"name": "a", "weight": 1}, {"name": "b", "weight": 3,
+      "lsystem": {"axiom": "FF", "iterations": 0}}], "trees": [{"id": "hero", "variant": "b", "position": [1, 0, 2],
+      "rotation": 30, "scale": 2, "seed": 5}, {}], "scatter": {"count": 40, "min": [-10, -10], "max": [10, 10],
+      "seed": 3}})",
+                           R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
+  const Forest& forest = *scene.forest;
+  ASSERT_EQ(forest.trees.size(), 42u);
+  EXPECT_EQ(forest.trees[0].id, "hero");
+  EXPECT_EQ(forest.trees[0].variant, 1u);
+  EXPECT_EQ(forest.trees[0].seed, 5u);
+  EXPECT_EQ(forest.trees[1].id, "0001");  // padded index
+  EXPECT_EQ(forest.trees[1].variant, 0u);  // the first variant
+  EXPECT_EQ(forest.trees[41].id, "0041");
+  size_t b = 0;
+  for (size_t t = 2; t < 42; ++t) {
+    b += forest.trees[t].variant;
+    EXPECT_GE(forest.trees[t].rotation, 0);
+    EXPECT_LT(forest.trees[t].rotation, 360);
+    EXPECT_EQ(forest.trees[t].position.y(), 0);
+  }
+  EXPECT_GT(b, 20u);  // weight 3 of 4
+  EXPECT_LT(b, 40u);
+  // The same scene places the same trees.
+  const Scene again = load(scene.resolved["forest"].dump(), R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
+  for (size_t t = 0; t < 42; ++t) {
+    EXPECT_EQ(again.forest->trees[t].position, forest.trees[t].position);
+    EXPECT_EQ(again.forest->trees[t].seed, forest.trees[t].seed);
+  }
+}
+
+TEST(Forest, TreeSceneIsTheTreesOwnScene) {
+  const Scene scene = load(R"({"variants": [{"name": "a"}, {"name": "b", "lsystem": {"axiom": "FF", "iterations": 0},
+      "tree": {"ring_sides": 5}}], "trees": [{"id": "x"}, {"id": "y", "variant": "b", "scale": 2, "seed": 9}]})",
+                           R"([{"format": "hdf5", "path": "t/{tree}/{tree}.h5"}])");
+  const Scene y = tree_scene(scene, 1);
+  EXPECT_EQ(y.outputs[0].path, "t/y/y.h5");
+  EXPECT_EQ(y.lsystem.axiom, "FF");
+  EXPECT_EQ(y.lsystem.seed, 9u);
+  EXPECT_EQ(y.tree.ring_sides, 5);
+  EXPECT_EQ(y.tree.scale, 2.0);
+  EXPECT_EQ(y.tree.trunk_radius, 0.2);
+  EXPECT_FALSE(y.forest);
+  ASSERT_EQ(y.resolved["forest"]["trees"].size(), 1u);
+  EXPECT_EQ(y.resolved["forest"]["trees"][0]["id"], "y");
+  EXPECT_EQ(y.resolved["forest"]["variants"][0]["name"], "b");
+  // Its resolved scene is a scene again: the forest of that one tree.
+  const Scene reloaded = load_scene_text(y.resolved.dump(), "y.json", "/scenes", {});
+  const Scene y2 = tree_scene(reloaded, 0);
+  EXPECT_EQ(y2.resolved.dump(), y.resolved.dump());
+  EXPECT_EQ(tree_scene(scene, 0).lsystem.axiom, "F");
+}
+
+TEST(Forest, Refusals) {
+  EXPECT_EQ(error_of(R"({"trees": []})"),
+            "f.json: /forest/trees: a forest with no trees: list trees in /forest/trees or give "
+            "/forest/scatter/count >= 1");
+  EXPECT_EQ(error_of(R"({"spacing": 2, "trees": [{"position": [5, 9, 0]}, {"position": [1, 0, 0.5]},
+      {"position": [0.5, 0, 1]}]})"),
+            "f.json: /forest/trees/2/position: 0.707107 m from /forest/trees/1 on the ground, closer than "
+            "/forest/spacing = 2 m: move one of them or lower the spacing");
+  EXPECT_NE(error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
+                .find("f.json: /forest/scatter/count: placed "),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
+                .find(" of 50 trees in the area with /forest/spacing 2 m (100 darts each)"),
+            std::string::npos);
+  EXPECT_EQ(error_of(R"({"trees": [{"variant": "oak"}]})"),
+            "f.json: /forest/trees/0/variant: expected one of the variants' names (\"default\"), got \"oak\"");
+  EXPECT_EQ(error_of(R"({"trees": [{"id": "a"}, {"id": "a"}]})"),
+            "f.json: /forest/trees: two trees have the id \"a\" (/forest/trees/0 and /forest/trees/1): ids name the "
+            "trees' files, give each its own");
+  EXPECT_EQ(error_of(R"({"trees": [{"id": "../x"}]})"),
+            "f.json: /forest/trees/0/id: expected an id of 1 to 64 letters, digits, '_', '-' or '.' (not first), got "
+            "\"../x\"");
+  EXPECT_EQ(error_of(R"({"trees": [{}, {}]})", R"([{"format": "hdf5", "path": "bake.h5"}])"),
+            "f.json: /outputs/0/path: the forest has 2 trees and this path no {tree}: every tree would write the same "
+            "file; put the tree's id in it, e.g. \"trees/{tree}.h5\"");
+  EXPECT_EQ(error_of(R"({"trees": [{}], "sprcing": 1})"), "f.json: /forest/sprcing: unknown key (did you mean /forest/spacing?)");
+}
+
+TEST(Forest, OneTreeSceneRefusesThePlaceholder) {
+  try {
+    load_scene_text(R"({"lsystem": {"axiom": "F"}, "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]})", "s.json",
+                    "/scenes", {});
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "s.json: /outputs/0/path: {tree} stands for the id of a tree of a /forest, and "
+                                     "this scene has no /forest: remove it from the path");
+  }
+}
+
+}  // namespace
+}  // namespace treeanim
