@@ -57,6 +57,7 @@ def skip_or_fail_without_slurm(test):
 
 
 def _raise_exit(signum, frame):
+    print("slurm_cluster: %s: stopping the cluster" % signal.Signals(signum).name, file=sys.stderr)
     raise SystemExit(128 + signum)
 
 
@@ -85,11 +86,14 @@ def _job_name(record):
 
 class SlurmCluster:
     """Starts scripts/slurm-local in `folder` (default a per-process folder in /tmp, removed at
-    the end) and stops it on exit; SIGTERM and SIGINT stop it too."""
+    the end) and stops it on exit; SIGTERM and SIGINT stop it too, and so does the end of
+    `limit` seconds (SIGALRM): keep it below ctest's TIMEOUT, whose SIGKILL would leave the
+    daemons running."""
 
-    def __init__(self, folder=None, timeout=60):
+    def __init__(self, folder=None, timeout=60, limit=None):
         self.folder = folder or "/tmp/treeanim-slurm-test-%d" % os.getpid()
         self.timeout = timeout
+        self.limit = limit
         self.remove = folder is None
         self.env = dict(os.environ, SLURM_CONF=os.path.join(self.folder, "slurm.conf"))
         self.script_env = dict(self.env, SLURM_LOCAL_DIR=self.folder, SLURM_LOCAL_TIMEOUT=str(timeout))
@@ -104,7 +108,10 @@ class SlurmCluster:
                 "slurmd": os.path.join(self.folder, "run", "slurmd.pid")}
 
     def __enter__(self):
-        self.previous_handlers = {s: signal.signal(s, _raise_exit) for s in (signal.SIGTERM, signal.SIGINT)}
+        self.previous_handlers = {s: signal.signal(s, _raise_exit)
+                                  for s in (signal.SIGTERM, signal.SIGINT, signal.SIGALRM)}
+        if self.limit:
+            signal.alarm(self.limit)
         start = time.monotonic()
         try:
             self.script("start")
@@ -154,6 +161,7 @@ class SlurmCluster:
             if left:
                 raise SlurmError("scripts/slurm-local stop left %s running (killed)" % left)
         finally:
+            signal.alarm(0)
             for s, handler in getattr(self, "previous_handlers", {}).items():
                 signal.signal(s, handler)
             if self.remove:
@@ -188,19 +196,20 @@ class SlurmCluster:
         """sbatch --parsable ARGUMENTS => the job id (str)."""
         return self.run("sbatch", "--parsable", *arguments).strip().split(";")[0]
 
-    def jobs(self, job):
+    def jobs(self, job=None):
         """The records of a job or array (`scontrol show -o job JOB`), pending tasks not yet split
-        off included => {JOBID_TASK or JOBID: {key: value}}."""
-        out = self.run("scontrol", "show", "-o", "job", str(job))
+        off included; every job of the cluster when job is None (what `treeanim farm submit`
+        submitted) => {JOBID_TASK or JOBID: {key: value}}."""
+        out = self.run("scontrol", "show", "-o", "job", *([] if job is None else [str(job)]))
         return {_job_name(r): r for r in map(_record, out.splitlines()) if "JobId" in r}
 
-    def states(self, job):
+    def states(self, job=None):
         """{JOBID_TASK or JOBID: JobState}."""
         return {name: r["JobState"] for name, r in self.jobs(job).items()}
 
-    def wait(self, job, timeout=300):
-        """Waits until every record of the job (every task of an array) is in a final state =>
-        jobs(job); SlurmError with the states on timeout."""
+    def wait(self, job=None, timeout=300):
+        """Waits until every record of the job (every task of an array; every job when job is
+        None) is in a final state => jobs(job); SlurmError with the states on timeout."""
         deadline = time.monotonic() + timeout
         while True:
             records = self.jobs(job)

@@ -72,14 +72,16 @@ def check(cluster, work):
         starts = len(lines(os.path.join(work, "log.%d" % i)))
         expected = 2 if i == REQUEUED else 1
         if starts != expected or int(record["Restarts"]) != expected - 1:
-            raise Failed("%s started %d times (Restarts=%s), expected %d" % (name, starts, record["Restarts"], expected))
+            raise Failed("%s started %d times (Restarts=%s), expected %d"
+                         % (name, starts, record["Restarts"], expected))
         if lines(os.path.join(work, "out.%d" % i)) != ["task %d done" % i]:
             raise Failed("%s: out.%d is not its output" % (name, i))
     if gathered["JobState"] != "COMPLETED":
         raise Failed("the dependent job %s ended %s" % (dependent, gathered["JobState"]))
     last_end = max(tasks[name]["EndTime"] for name in names)  # ISO times sort as text
     if gathered["StartTime"] < last_end:
-        raise Failed("the dependent job started at %s, before the last task ended (%s)" % (gathered["StartTime"], last_end))
+        raise Failed("the dependent job started at %s, before the last task ended (%s)"
+                     % (gathered["StartTime"], last_end))
     if lines(os.path.join(work, "gathered")) != ["out.%d" % i for i in range(TASKS)]:
         raise Failed("the dependent job saw %s" % lines(os.path.join(work, "gathered")))
     return elapsed
@@ -89,7 +91,7 @@ def main():
     slurm_cluster.skip_or_fail_without_slurm("slurm_smoke")
     work = tempfile.mkdtemp(prefix="treeanim-slurm-smoke-%d-" % os.getpid())
     try:
-        with slurm_cluster.SlurmCluster() as cluster:
+        with slurm_cluster.SlurmCluster(limit=240) as cluster:  # ctest's TIMEOUT is 300 s
             elapsed = check(cluster, work)
             pids = dict(cluster.pids)
         left = [name for name, pid in pids.items() if slurm_cluster.alive(pid)]
