@@ -138,7 +138,11 @@ class SlurmCluster:
 
     def stop(self, failed=False):
         """Stops the daemons (the script, then SIGKILL by process id for any left) and checks that
-        they are gone; prints the logs' ends when `failed`; removes the folder if it is ours."""
+        they are gone; prints the logs' ends when `failed`; removes the folder if it is ours.
+        A signal now would cut the stop short: they are ignored until it ends."""
+        signal.alarm(0)
+        for s in getattr(self, "previous_handlers", {}):
+            signal.signal(s, signal.SIG_IGN)
         try:
             if failed:
                 self.print_logs()
@@ -161,7 +165,6 @@ class SlurmCluster:
             if left:
                 raise SlurmError("scripts/slurm-local stop left %s running (killed)" % left)
         finally:
-            signal.alarm(0)
             for s, handler in getattr(self, "previous_handlers", {}).items():
                 signal.signal(s, handler)
             if self.remove:
