@@ -4,7 +4,7 @@
 
 namespace treeanim {
 
-void set_air_time(const WindField& wind, double t, AirSample& air) { wind.sample_time(t, air); }
+void set_air_time(const WindField& wind, double t, double step, AirSample& air) { wind.sample_time(t, step, air); }
 
 template <typename Real>
 void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,

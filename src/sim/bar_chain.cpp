@@ -8,11 +8,12 @@
 
 namespace treeanim {
 
-BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus) {
+BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus, double yield_strain) {
   const size_t C = tree.cluster_count();
   BarChain chain;
   chain.cluster_joint.setZero(3, C);
   chain.cluster_compliance.assign(C, 0);
+  chain.cluster_max_turn.assign(C, std::numeric_limits<double>::infinity());
   std::vector<int64_t> first(C, -1);  // each cluster's first segment
   for (size_t s = tree.segment_cluster.size(); s-- > 0;)
     if (tree.segment_cluster[s] < C) first[tree.segment_cluster[s]] = static_cast<int64_t>(s);
@@ -37,11 +38,10 @@ BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus) {
   for (size_t c = 0; c < C; ++c) {
     if (tree.cluster_kind[c] == kClusterLeaf) continue;
     chain.cluster_compliance[c] = half[c];
-    const int32_t p = tree.cluster_parent[c];
-    if (p < 0) continue;
     // It continues its parent's axis when its base ring was built for the parent's segment
     // (a lateral has a base ring of its own).
-    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+    const int32_t p = tree.cluster_parent[c];
+    for (uint32_t s = tree.cluster_offsets[c]; p >= 0 && s < tree.cluster_offsets[c + 1]; ++s) {
       const int32_t segment = tree.vertex_segment[tree.cluster_members[s]];
       if (segment >= 0 && size_t(segment) < tree.segment_cluster.size() &&
           tree.segment_cluster[segment] == static_cast<uint32_t>(p)) {
@@ -49,8 +49,23 @@ BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus) {
         break;
       }
     }
+    const double r = tree.cluster_radius[c];
+    if (r > 0) chain.cluster_max_turn[c] = chain.cluster_compliance[c] * yield_strain * youngs_modulus * std::numbers::pi * r * r * r / 4;
   }
   return chain;
+}
+
+double tree_reach(const TreeModel& tree, const BarChain& chain) {
+  const size_t C = tree.cluster_count();
+  std::vector<double> path(C, 0);  // (C) m, from the root's joint to the cluster's joint
+  double reach = 0;
+  for (size_t c = 0; c < C; ++c) {
+    const int32_t p = tree.cluster_parent[c];
+    if (p >= 0) path[c] = path[p] + (chain.cluster_joint.col(c) - chain.cluster_joint.col(p)).norm();
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s)
+      reach = std::max(reach, path[c] + (tree.rest_positions.col(tree.cluster_members[s]) - chain.cluster_joint.col(c)).norm());
+  }
+  return reach;
 }
 
 std::vector<double> limb_frequencies(const TreeModel& tree, const BarChain& chain) {

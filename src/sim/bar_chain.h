@@ -13,13 +13,23 @@ namespace treeanim {
 struct BarChain {
   Eigen::Matrix3Xd cluster_joint;          // (3 x C) m, rest point the cluster turns about: its base (a leaf: its shared vertex)
   std::vector<double> cluster_compliance;  // (C) rad/(N m) of the cluster's joint; 0 for leaves (set by the solver)
+  // (C) rad, the joint's largest turn: where the wood at its surface reaches the yield strain
+  // (a leaf: a quarter turn, set by the solver). Beyond it the joint turns no further, as a
+  // plastic hinge would: a gale folds a limb as far as wood bends, not round in circles.
+  std::vector<double> cluster_max_turn;
 };
 
-// Tree model + Young's modulus (Pa) => the joints and the branch joints' compliances. A
-// cluster's flexibility L / (E I) is split between the joints at its two ends (the
-// trapezoidal rule, second order in the cluster length): a joint that continues its parent's
-// axis has half of each, a lateral's base or the clamped root half of its own.
-BarChain build_bar_chain(const TreeModel& model, double youngs_modulus);
+// Tree model + Young's modulus (Pa) + yield strain => the joints and the branch joints'
+// compliances and largest turns. A cluster's flexibility L / (E I) is split between the
+// joints at its two ends (the trapezoidal rule, second order in the cluster length): a joint
+// that continues its parent's axis has half of each, a lateral's base or the clamped root
+// half of its own. The yield moment of a cluster of radius r is strain E pi r^3 / 4.
+BarChain build_bar_chain(const TreeModel& model, double youngs_modulus, double yield_strain);
+
+// Tree model + chain => the tree's reach (m): the longest path from a root cluster's joint to a
+// vertex along the chain of joints. No connected pose moves a vertex farther than twice
+// that from rest.
+double tree_reach(const TreeModel& model, const BarChain& chain);
 
 // Tree model + chain => per cluster (C), rad/s, the first frequency of the limb hanging from
 // its joint, clamped there: Rayleigh's quotient w^2 = sum(m g.u) / sum(m |u|^2) over the limb's

@@ -89,12 +89,14 @@ void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachm
 // One kernel over every vertex, in parallel blocks => the lowest vertex whose values are not
 // finite and (`check_runaway`) the lowest attached one farther than the runaway limit.
 // Without sleeping islands every free vertex reads its mean correction from one row
-// (anchors: the zero row, with factors that keep them still); otherwise, and when a frame
-// starts from the state, each block is gathered lane by lane.
+// (anchors: the zero row, with factors that keep them still), which the first pass of a step
+// averages (`first_pass`); otherwise, and when a frame starts from the state, each block is
+// gathered lane by lane.
 template <typename Real, typename Kernel>
 std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                                                 SimState& state, StepScratch<Real>& scratch, bool load_state,
-                                                bool with_pull, bool any_asleep, bool check_runaway, Kernel kernel) {
+                                                bool with_pull, bool first_pass, bool any_asleep, bool check_runaway,
+                                                Kernel kernel) {
   const TreeModel& tree = model.tree;
   StepPrediction<Real>& prediction = state.prediction<Real>();
   uint32_t bad = kNone, runaway = kNone;
@@ -103,7 +105,7 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     const auto [first, last] =
         balanced_range(tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     const bool direct = !load_state && !any_asleep;
-    if (direct && with_pull) average_shared_pulls(model, attachment, scratch, first, last);
+    if (direct && with_pull && first_pass) average_shared_pulls(model, attachment, scratch, first, last);
     const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
                                   scratch.member_correction.col(2).data()};
     VertexBlock<Real> block;
@@ -113,14 +115,15 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
       if (direct) {
         in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
               model.vertex_drag.data() + begin, model.vertex_damping.data() + begin,
-              model.vertex_half_damping.data() + begin, attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}};
+              model.vertex_half_damping.data() + begin, attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
         std::fill(block.moving, block.moving + n, uint8_t(1));
       } else {
         gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
         in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
-              block.half_damping, block.global, block.flying, {}};
+              block.half_damping, block.global, block.flying, {}, nullptr};
       }
       for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
+      in.kicked = model.vertex_shape_kick.data() + begin;
       if (!kernel(begin, n, in, block)) continue;
       // Rare: find the first vertex at fault, as the scalar tests would.
       for (int k = 0; k < n; ++k) {
@@ -148,7 +151,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
   // 4. Correct the matched step (or load the state), and measure the drag of the next one.
   auto [bad, runaway] = for_vertex_blocks(
-      model, attachment, state, scratch, load, !load, any_asleep, end,
+      model, attachment, state, scratch, load, !load, true, any_asleep, end,
       [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
         if (model.store_drag_force)
           return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
@@ -163,8 +166,8 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   };
   if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
   if (runaway != kNone) {
-    char distances[96];
-    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m)",
+    char distances[160];
+    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m, its reach along the branches or its extent)",
                   prediction.offset.row(runaway).template cast<double>().norm(), std::sqrt(model.runaway_distance2) / 2);
     throw SimulationError(where(runaway) + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
@@ -174,7 +177,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   // state's velocities are taken at its time: the first kick from them is half a step's.
   const Real kick = load ? Real(0.5) : Real(1);
   if (model.beam) compute_static_offsets(model, attachment, state, scratch);
-  bad = for_vertex_blocks(model, attachment, state, scratch, false, false, any_asleep, false,
+  bad = for_vertex_blocks(model, attachment, state, scratch, false, !load, false, any_asleep, false,
                           [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
                             return predict_block(model, attachment, scratch, prediction, begin, n, in, kick, block);
                           }).first;
@@ -185,7 +188,8 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
 template <typename Real>
 void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                         StepScratch<Real>& scratch, long long frame) {
-  set_air_time(model.wind, state.time, scratch.air);
+  set_air_time(model.wind, state.time, model.h, scratch.air);
+  scratch.member_correction.setZero();  // no step was matched: no shape kick (a rare pass)
 #pragma omp parallel for schedule(static) if (model.parallel)
   for (size_t c = 0; c < model.C; ++c)
     if (cluster_awake(model, attachment, state, c)) sample_cluster_air(model, attachment, state, scratch, c);

@@ -31,6 +31,7 @@ struct VertexInputs {
   const Real *drag, *damping, *half_damping, *global;
   const uint8_t* flying;
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
+  const uint8_t* kicked;  // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
 };
 
 template <typename Real>
@@ -80,7 +81,7 @@ template <bool kEnd, bool kForce, typename Real>
 inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
                           const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-  const Real inv_h = static_cast<Real>(1.0 / model.h), step = static_cast<Real>(model.h);
+  const Real inv_h = static_cast<Real>(1.0 / model.h);
   const Real half_inv_h = static_cast<Real>(0.5 / model.h);
   const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
                         scratch.cluster_air.col(2).data()};
@@ -97,21 +98,25 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
     const uint32_t row = in.pull_row[k];
+    const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
     const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
-    const Real ux = offset[0][k] + px, uy = offset[1][k] + py, uz = offset[2][k] + pz;
-    const Real vx = velocity[0][k] + px * inv_h, vy = velocity[1][k] + py * inv_h, vz = velocity[2][k] + pz * inv_h;
+    const Real ux = offset[0][k] + px * now, uy = offset[1][k] + py * now, uz = offset[2][k] + pz * now;
+    const Real vx = velocity[0][k] + px * now * inv_h, vy = velocity[1][k] + py * now * inv_h,
+               vz = velocity[2][k] + pz * now * inv_h;
     offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
     velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
     if constexpr (kForce) {
       // The drag at the step's start, from the velocity there: half a step of damping and of
       // the last goal's pull after the staggered v (second order; docs/solver.md "One step").
       const uint32_t c = air_cluster[k];
-      const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h;
-      const Real rx = air[0][c] - (vx * half - pull_back * (ux - in.goal[0][k]));
-      const Real ry = air[1][c] - (vy * half - pull_back * (uy - in.goal[1][k]));
-      const Real rz = air[2][c] - (vz * half - pull_back * (uz - in.goal[2][k]));
-      const Real kuh = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * step;
-      const Real scale = kuh / std::sqrt(1 + Real(0.25) * kuh * kuh) * static_cast<Real>(mass[k]) * inv_h;
+      const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
+      const Real rx = air[0][c] - (vx * half - pull_back * (ux - in.goal[0][k]) + shape * px);
+      const Real ry = air[1][c] - (vy * half - pull_back * (uy - in.goal[1][k]) + shape * py);
+      const Real rz = air[2][c] - (vz * half - pull_back * (uz - in.goal[2][k]) + shape * pz);
+      // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
+      // the free-flight average over the step (drag_share) would understate it ever more as
+      // the step grows (a leaf in a gale at a 0.25 s step: 16x).
+      const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * static_cast<Real>(mass[k]);
       force[0][k] = rx * scale;
       force[1][k] = ry * scale;
       force[2][k] = rz * scale;
@@ -135,11 +140,11 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
                           const VertexInputs<Real>& in, Real kick, VertexBlock<Real>& block) {
   const double h = model.h;
   const Real inv_h = static_cast<Real>(1.0 / h) * kick, step = static_cast<Real>(h), half_step = static_cast<Real>(h / 2);
-  // The drag moves an attached vertex itself only without the beam (per_step stiffness);
-  // with it, the drag acts through the goal. A flying leaf always feels it.
+  // The drag moves an attached vertex itself only without the beam (no global term); with
+  // it, the drag acts through the goal. A flying leaf always feels it.
   const Real direct = model.beam ? Real(0) : Real(1);
   // The global term: a kick toward the goal with the beam, else a projection of the prediction.
-  const Real kicked = model.beam ? Real(1) : Real(0), projected = Real(1) - kicked;
+  const Real kicked = model.kick ? Real(1) : Real(0), projected = Real(1) - kicked;
   const Real inv_step = static_cast<Real>(1.0 / h);
   const Eigen::Vector3d& gravity = model.options.gravity;
   const Real gravity_step[3] = {static_cast<Real>(gravity.x() * h) * kick, static_cast<Real>(gravity.y() * h) * kick,
@@ -166,14 +171,16 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     Real vx = velocity[0][k] * half, vy = velocity[1][k] * half, vz = velocity[2][k] * half;
     Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
-    vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]);
-    vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]);
-    vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]);
+    const uint32_t row = in.pull_row[k];
+    const Real shape = static_cast<Real>(in.kicked[k]) * inv_h;
+    vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][row];
+    vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][row];
+    vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][row];
     share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx = (vx + (ax - vx) * share) * half, vy = (vy + (ay - vy) * share) * half, vz = (vz + (az - vz) * share) * half;
     Real px = ux + step * vx, py = uy + step * vy, pz = uz + step * vz;
-    // Without the beam, Eq. 8 as the paper writes it: the global rate moves the predicted
-    // position toward rest, a projection that no wind or step can overshoot.
+    // With per_step stiffness, Eq. 8 as the paper writes it: the global rate moves the
+    // predicted position toward its goal, a projection that no wind or step can overshoot.
     const Real project = in.global[k] * projected;
     const Real ex = project * (in.goal[0][k] - px), ey = project * (in.goal[1][k] - py), ez = project * (in.goal[2][k] - pz);
     px += ex, py += ey, pz += ez;

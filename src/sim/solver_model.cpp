@@ -1,5 +1,6 @@
 // Precompute (libigl's split of a solver into precompute + solve): TreeModel + options =>
 // SolverModel, whose Attachment has every leaf attached; and the per-step scratch.
+#include <numbers>
 #include <numeric>
 
 #include "common/errors.h"
@@ -108,10 +109,16 @@ double leaf_compliance(const SolverModel<Real>& m, const WindOptions& wind, uint
 // The bar chain of the beam (bar_chain.h), each leaf's petiole compliance added.
 template <typename Real>
 void precompute_beam(SolverModel<Real>& m, const WindOptions& wind) {
-  m.chain = build_bar_chain(m.tree, m.options.youngs_modulus);
+  m.vertex_shape_kick.assign(m.V, 0);
+  if (!m.beam) return;
+  if (m.kick)
+    for (size_t v = 0; v < m.V; ++v) m.vertex_shape_kick[v] = m.tree.vertex_leaf[v] < 0 ? 1 : 0;
+  m.chain = build_bar_chain(m.tree, m.options.youngs_modulus, m.options.yield_strain);
   for (size_t c = 0; c < m.C; ++c)
-    if (m.tree.cluster_kind[c] == kClusterLeaf)
+    if (m.tree.cluster_kind[c] == kClusterLeaf) {
       m.chain.cluster_compliance[c] = leaf_compliance(m, wind, static_cast<uint32_t>(c));
+      m.chain.cluster_max_turn[c] = std::numbers::pi / 2;
+    }
 }
 
 // Clusters sharing a non-anchored vertex => one island (anchors hold, they do not couple).
@@ -159,10 +166,12 @@ template <typename Real>
 SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const WindOptions& w, double dt, int n)
     : tree(t), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n), V(t.vertex_count()), C(t.cluster_count()),
       M(t.membership_count()), L(t.leaf_count()), I(0), detach_enabled(o.leaf_detach_force > 0 && t.leaf_count() > 0),
-      beam(o.stiffness == StiffnessMode::kPhysical && o.global_matching), store_drag_force(detach_enabled || beam),
+      beam(o.global_matching), kick(beam && o.stiffness == StiffnessMode::kPhysical),
+      store_drag_force(detach_enabled || beam),
       parallel(t.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
-  const double size = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
+  const double extent = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
+  const double size = std::max(extent, tree_reach(t, build_bar_chain(t, o.youngs_modulus, o.yield_strain)));
   const bool anchored = std::any_of(t.vertex_anchored.begin(), t.vertex_anchored.end(), [](auto a) { return a != 0; });
   runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
   Attachment<Real>& a = all_attached;

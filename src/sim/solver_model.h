@@ -74,15 +74,19 @@ struct SolverModel {
   double frame_dt;                         // s
   int substeps;
   double h;                                // s, one substep
-  // m^2: (2 x the largest extent of the rest mesh)^2. An attached vertex of an anchored tree
-  // farther than that from rest means the tree came apart (docs/solver.md, "Runaway").
+  // m^2: (2 x the tree's size)^2, its size the larger of the rest mesh's extent and its reach
+  // along the branches (tree_reach). An attached vertex of an anchored tree farther than that
+  // from rest means the tree came apart (docs/solver.md, "Runaway").
   // Infinite without anchors (a free body may travel) and for a single-point model.
   double runaway_distance2;
   size_t V, C, M, L, I;
   bool detach_enabled;                     // leaf_detach_force > 0 and the tree has leaves
-  // Physical stiffness with the global term: it pulls toward the static deflection of the
-  // clusters as a beam (beam_statics.cpp), and the drag acts on branches through it.
+  // The global term on: it pulls toward the static deflection of the clusters as a beam
+  // (beam_statics.cpp), and the drag acts on attached vertices only through it.
   bool beam;
+  // Physical stiffness with the beam: the global term, and a branch's local term, are kicks
+  // of the step (second order); otherwise both move the predicted positions (the paper's Eq. 7, 8).
+  bool kick;
   bool store_drag_force;                   // the prediction keeps each vertex's drag (detachment, beam)
   // Threads only pay off above a few thousand memberships; below, the fork/join costs more
   // than the work (results are identical either way).
@@ -98,6 +102,9 @@ struct SolverModel {
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
   std::vector<Real> vertex_damping;        // (V) velocity factor per step
   std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step
+  // (V) 1: a branch vertex with the beam, whose mean correction is a kick of the next step;
+  // 0: a projection (leaves, the per_step stiffness)
+  std::vector<uint8_t> vertex_shape_kick;
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending

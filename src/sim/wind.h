@@ -41,8 +41,10 @@ class WindField {
   double gust_amplitude(double t) const;
   // x (m) => the spatial phase terms sin/cos(k_j . x + phi_j) of every phase, into (phases) arrays.
   void spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const;
-  // t => the terms every point shares at t (mean, gust vector, turbulence amplitude, temporal phases).
-  void sample_time(double t, AirSample& air) const;
+  // t, window (s) => the terms every point shares at t (mean, gust vector, turbulence
+  // amplitude, temporal phases), each wave averaged over the window about t: a step of length
+  // `window` feels the waves it resolves and not those it would alias (0: the values at t).
+  void sample_time(double t, double window, AirSample& air) const;
   // Spatial phases of x + the terms at t => the air velocity at (x, t) (m/s).
   Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air) const;
   // x (m), t => the air velocity (m/s); the two calls above for a single point.

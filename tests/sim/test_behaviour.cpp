@@ -130,7 +130,7 @@ TEST(Behaviour, LimbFrequencyHasAFloor) {
 TEST(Behaviour, DetachedLeavesFallAndNeverComeBack) {
   const TreeModel model = testing::small_tree(6);
   HsmOptions options;
-  options.leaf_detach_force = 0.55;  // N: a 6 cm leaf lets go in the strongest gusts
+  options.leaf_detach_force = 0.9;  // N: a 6 cm leaf lets go in the strongest gusts
   Simulator sim(model, options, gust_then_calm(20, 1.0, 1.2), 1.0 / 24, 4);
   SimState state = sim.initial_state(0);
   std::vector<uint8_t> attached = state.leaf_attached;
@@ -171,11 +171,9 @@ TEST(Behaviour, NoDetachmentByDefault) {
   for (uint8_t a : state.leaf_attached) EXPECT_EQ(a, 1);
 }
 
-TEST(Behaviour, LeafDragDoesNotBendItsBranch) {
-  // A leaf turns about its petiole and does not load its branch (docs/solver.md, "Leaves"):
-  // the branch vertices move the same with and without drag on the leaves, to the bit. When
-  // the petiole vertex still counted in its branch's fit, a share alpha_b of the leaf's drag
-  // came through, so that the branch's shape depended on the step.
+TEST(Behaviour, LeafDragBendsItsBranch) {
+  // A leaf's drag loads its branch through the bar chain, as it loads a real one: the branch
+  // vertices bend farther with drag on the leaves than without, and the leaves feel it too.
   const TreeModel model = testing::small_tree(6);
   WindOptions wind = gust_then_calm(12, 2, 2.5);
   std::vector<Eigen::Matrix3Xd> bakes;
@@ -186,13 +184,17 @@ TEST(Behaviour, LeafDragDoesNotBendItsBranch) {
     for (int f = 1; f <= 36; ++f) sim.advance_frame(state, f);
     bakes.push_back(state.positions);
   }
-  double leaf_difference = 0;
+  double with_leaves = 0, without = 0, leaf_difference = 0;
   for (size_t v = 0; v < model.vertex_count(); ++v) {
-    const double difference = (bakes[0].col(v) - bakes[1].col(v)).norm();
-    if (model.vertex_leaf[v] < 0) EXPECT_EQ(difference, 0.0) << "branch vertex " << v;
-    else leaf_difference = std::max(leaf_difference, difference);
+    if (model.vertex_leaf[v] < 0) {
+      with_leaves = std::max(with_leaves, (bakes[0].col(v) - model.rest_positions.col(v)).norm());
+      without = std::max(without, (bakes[1].col(v) - model.rest_positions.col(v)).norm());
+    } else {
+      leaf_difference = std::max(leaf_difference, (bakes[0].col(v) - bakes[1].col(v)).norm());
+    }
   }
-  EXPECT_GT(leaf_difference, 1e-3);  // the leaves themselves do feel their drag
+  EXPECT_GT(with_leaves, 1.2 * without);
+  EXPECT_GT(leaf_difference, 1e-3);
 }
 
 TEST(Behaviour, SleepingBakeMatchesTheFullBake) {
@@ -336,27 +338,22 @@ std::pair<double, double> substep_spread(const TreeModel& model, const HsmOption
 }
 
 TEST(Behaviour, SubstepCountDoesNotChangeThePhysicalMotion) {
-  // Physical stiffness: the same motion at 4 to 32 substeps (within 5% of the sway). The
-  // paper's per-step rates make the tree stiffer with every doubling instead (> 30%).
+  // Physical stiffness: the same motion at 4 to 32 substeps (within 1% of the sway).
   const TreeModel model = grown_tree(5, 0, 4);
   const auto [physical_spread, physical_sway] = substep_spread(model, HsmOptions{});
   EXPECT_GT(physical_sway, 0.005);
-  EXPECT_LT(physical_spread, 0.05 * physical_sway);
-  HsmOptions per_step;
-  per_step.stiffness = StiffnessMode::kPerStep;
-  const auto [paper_spread, paper_sway] = substep_spread(model, per_step);
-  EXPECT_GT(paper_spread, 0.3 * paper_sway);
+  EXPECT_LT(physical_spread, 0.01 * physical_sway);
 }
 
-TEST(Behaviour, ConvergesAtFirstOrderInTheStep) {
-  // With physical stiffness the error against a converged small-step bake (512
-  // substeps) falls as h, order 0.8-1.2 (scripts/bench-accuracy measures the same on larger
-  // trees), here on a young tree with leaves in a turbulent 5 m/s wind that starts at once.
+TEST(Behaviour, ConvergesAtSecondOrderInTheStep) {
+  // With physical stiffness the error against a converged small-step bake (512 substeps)
+  // falls as h^2, order 1.7-2.3 (scripts/bench-accuracy measures the same on larger trees),
+  // here on a young tree with leaves in a turbulent 5 m/s wind that starts at once.
   const TreeModel model = grown_tree(4, 2, 4);
   WindOptions wind;  // 5 m/s from frame 0, with the default turbulence
   wind.keys = {{0, 5, {1, 0, 0.2}, 0}};
   std::vector<Eigen::Matrix3Xd> bakes;  // frames side by side, per substep count
-  const std::vector<int> substeps = {8, 16, 32, 512};
+  const std::vector<int> substeps = {2, 4, 8, 512};
   for (int n : substeps) {
     Simulator sim(model, HsmOptions{}, wind, 1.0 / 24, n);
     SimState state = sim.initial_state(0);
@@ -367,8 +364,8 @@ TEST(Behaviour, ConvergesAtFirstOrderInTheStep) {
     }
     bakes.push_back(frames);
   }
-  // The measure: mass-weighted RMS error over all frames and vertices, over the
-  // reference's mass-weighted RMS displacement.
+  // docs/benchmarks.md's measure: mass-weighted RMS error over all frames and vertices, over
+  // the reference's mass-weighted RMS displacement.
   Eigen::RowVectorXd weight(bakes.back().cols());
   for (Eigen::Index c = 0; c < weight.size(); ++c) weight[c] = std::sqrt(model.vertex_mass[c % model.vertex_count()]);
   const Eigen::Matrix3Xd reference = bakes.back().array().rowwise() * weight.array();
@@ -380,10 +377,10 @@ TEST(Behaviour, ConvergesAtFirstOrderInTheStep) {
   }
   for (size_t k = 0; k + 1 < error.size(); ++k) {
     const double order = std::log2(error[k] / error[k + 1]);
-    EXPECT_GT(order, 0.8) << substeps[k] << " -> " << substeps[k + 1] << " substeps";
-    EXPECT_LT(order, 1.2) << substeps[k] << " -> " << substeps[k + 1] << " substeps";
+    EXPECT_GT(order, 1.7) << substeps[k] << " -> " << substeps[k + 1] << " substeps";
+    EXPECT_LT(order, 2.3) << substeps[k] << " -> " << substeps[k + 1] << " substeps";
   }
-  EXPECT_LT(error[1], 0.01);  // 16 substeps, the default
+  EXPECT_LT(error[1], 0.01);  // 4 substeps, the default
 }
 
 }  // namespace
