@@ -21,7 +21,7 @@ struct TimeOptions {
   double fps = 24;          // frames per second
   long long frames = 120;   // frames simulated (and written)
   long long start = 0;      // index of the first frame; frame k is at time k / fps
-  int substeps = 16;        // solver steps per frame (<= 1% error with the default hsm, docs/benchmarks.md)
+  int substeps = 2;         // solver steps per frame (<= 1% error with the default hsm, docs/benchmarks.md)
   bool loop = false;        // a seamless loop: periodic wind, warm-up, one period baked
 };
 

@@ -1,0 +1,113 @@
+// The bar chain against Euler-Bernoulli (docs/solver.md, "Bending"): the cantilever of
+// configs/cantilever.json grown through the L-system and the tree builder, in a steady wind
+// (its static deflection along the span) and plucked (its first frequency). The builder
+// tapers the last segment to half the radius (a tip), which the uniform beam does not have:
+// it takes a few per cent of the load off the tip.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "lsystem/lsystem.h"
+#include "sim/simulator.h"
+#include "tree/build_tree_model.h"
+
+namespace treeanim {
+namespace {
+
+constexpr double kLength = 2, kRadius = 0.02, kModulus = 8e9, kDensity = 700;
+
+// A straight branch of kLength in `segments` segments, radius kRadius, its base anchored.
+TreeModel cantilever(int segments) {
+  LsystemOptions lsystem;
+  lsystem.axiom = "!(" + std::to_string(2 * kRadius) + ")";
+  for (int s = 0; s < segments; ++s) lsystem.axiom += "F(" + std::to_string(kLength / segments) + ")";
+  lsystem.iterations = 0;
+  TreeOptions tree;
+  tree.ring_sides = 8;
+  tree.wood_density = kDensity;
+  GrowthStats stats;
+  return build_tree_model(grow_skeleton(lsystem, &stats), tree);
+}
+
+HsmOptions cantilever_options(double damping_ratio) {
+  HsmOptions options;
+  options.youngs_modulus = kModulus;
+  options.damping_ratio = damping_ratio;
+  options.max_frequency = 120;
+  options.max_limb_frequency = 120;
+  options.sleep = false;
+  return options;
+}
+
+// Bake => mean displacement along x of the ring vertices at height s (m).
+double deflection_at(const TreeModel& model, const SimState& state, double s) {
+  double sum = 0;
+  int count = 0;
+  for (size_t v = 0; v < model.vertex_count(); ++v)
+    if (std::abs(model.rest_positions(1, v) - s) < 1e-6) {
+      sum += state.positions(0, v) - model.rest_positions(0, v);
+      ++count;
+    }
+  return count ? sum / count : std::nan("");
+}
+
+TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
+  // Uniform drag load q = 1/2 rho Cd (2r) U^2 on a clamped-free beam:
+  // delta(x) = q L^4 (x^4 - 4x^3 + 6x^2) / (24 E I), x = s / L. Settled with critical damping.
+  const double U = 15;
+  WindOptions wind;
+  wind.turbulence_intensity = 0;
+  wind.keys = {{0, 0, {1, 0, 0}, 0}, {0.2, U, {1, 0, 0}, 0}};
+  const double q = 0.5 * wind.air_density * wind.branch_drag_coefficient * 2 * kRadius * U * U;
+  const double EI = kModulus * std::numbers::pi * std::pow(kRadius, 4) / 4;
+  for (int segments : {8, 16}) {
+    const TreeModel model = cantilever(segments);
+    Simulator sim(model, cantilever_options(1.0), wind, 1.0 / 240, 4);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 480; ++f) sim.advance_frame(state, f);
+    for (double x : {0.25, 0.5, 0.75, 1.0}) {
+      const double expected = q * std::pow(kLength, 4) * (x * x * x * x - 4 * x * x * x + 6 * x * x) / (24 * EI);
+      const double measured = deflection_at(model, state, x * kLength);
+      std::printf("%d segments, x = %.2f L: %.3f mm, Euler-Bernoulli %.3f mm\n", segments, x, 1e3 * measured,
+                  1e3 * expected);
+      EXPECT_NEAR(measured, expected, 0.10 * expected) << segments << " segments, x = " << x;
+    }
+  }
+}
+
+TEST(Beam, PluckedCantileverSwaysAtItsFirstFrequency) {
+  // f1 = 1.8751^2 / (2 pi L^2) sqrt(E I / (rho A)), within 10 %: a 0.3 s gust, then free
+  // vibration, timed by the zero crossings of the tip's deflection over 2 s.
+  WindOptions wind;
+  wind.turbulence_intensity = 0;
+  wind.keys = {{0, 0, {1, 0, 0}, 0}, {0.02, 15, {1, 0, 0}, 0}, {0.3, 15, {1, 0, 0}, 0}, {0.32, 0, {1, 0, 0}, 0}};
+  const double f1 = std::pow(1.8751040687, 2) / (2 * std::numbers::pi * kLength * kLength) *
+                    std::sqrt(kModulus * kRadius * kRadius / 4 / kDensity);
+  for (int segments : {8, 16}) {
+    const TreeModel model = cantilever(segments);
+    Simulator sim(model, cantilever_options(0.02), wind, 1.0 / 240, 4);
+    SimState state = sim.initial_state(0);
+    double last = 0, first_crossing = -1, last_crossing = -1;
+    int crossings = 0;
+    for (int f = 1; f <= 240 * 3; ++f) {
+      sim.advance_frame(state, f);
+      if (state.time < 0.5) continue;
+      const double tip = deflection_at(model, state, kLength);
+      if (last != 0 && (tip > 0) != (last > 0)) {
+        if (first_crossing < 0) first_crossing = state.time;
+        last_crossing = state.time;
+        ++crossings;
+      }
+      last = tip;
+    }
+    ASSERT_GE(crossings, 10);
+    const double measured = (crossings - 1) / (2 * (last_crossing - first_crossing));
+    std::printf("%d segments: %.3f Hz, Euler-Bernoulli %.3f Hz\n", segments, measured, f1);
+    EXPECT_NEAR(measured, f1, 0.10 * f1) << segments << " segments";
+  }
+}
+
+}  // namespace
+}  // namespace treeanim
