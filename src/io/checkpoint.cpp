@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kFormat = "treeanim-checkpoint";
-constexpr int32_t kFormatVersion = 1;
+constexpr int32_t kFormatVersion = 2;  // 2: the prediction keeps its goal offsets
 
 // A variable-length UTF-8 string type, or -1.
 hid_t make_string_type() {
