@@ -84,10 +84,12 @@ def case_shards(treeanim, tmp):
         lo, hi = tree["bounds"]["min"], tree["bounds"]["max"]
         if not (lo[0] <= x <= hi[0] and lo[2] <= z <= hi[2]):
             raise Failed("tree %s at %s lies outside its world bounds %s" % (tree["id"], tree["position"], tree["bounds"]))
-    # A removed file makes the gather fail, naming the tree and what to do.
+    # A removed file makes the gather fail, naming the tree and what to do: the command that bakes
+    # it again, with the --set the forest was gathered with (this one leaves the scene as it is).
     os.remove(os.path.join(shards, trees[3]["outputs"][0]["files"][0]))
-    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--tasks", "3", check=False)
-    if done.returncode != 4 or trees[3]["id"] not in done.stderr or "--shard I/3" not in done.stderr:
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--tasks", "3", "--set", "time.frames=24", check=False)
+    rerun = "treeanim run '%s' --shard I/3 -o '%s' --set 'time.frames=24' --resume" % (SCENE, shards)
+    if done.returncode != 4 or trees[3]["id"] not in done.stderr or rerun not in done.stderr:
         raise Failed("gather with a missing file: exit %d, %s" % (done.returncode, done.stderr))
 
 
