@@ -35,8 +35,10 @@ class SlurmError(Exception):
 
 
 def missing_programs():
-    """The Slurm and munge programs not on PATH (and a reason when not root) => list of str."""
-    missing = [p for p in PROGRAMS if shutil.which(p) is None]
+    """The Slurm and munge programs not on PATH or in the sbin folders (where scripts/slurm-local
+    looks too), and a reason when not root => list of str."""
+    path = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/sbin"])
+    missing = [p for p in PROGRAMS if shutil.which(p, path=path) is None]
     if os.geteuid() != 0:
         missing.append("root (the daemons switch users)")
     return missing
