@@ -12,11 +12,9 @@ usage: forest_requeue.py TREEANIM      (exit 0 pass, 1 fail, 77 skipped: no Slur
 import json
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -122,39 +120,30 @@ def check_resumed(out, complete, baking):
     return sorted(skipped), int(resumed.group(1))
 
 
-def main():
-    slurm_cluster.skip_or_fail_without_slurm("forest_requeue")
-    treeanim = os.path.abspath(sys.argv[1])
-    tmp = tempfile.mkdtemp(prefix="treeanim-forest-requeue-%d-" % os.getpid())
-    try:
-        trees = task_trees(treeanim, tmp)
-        farm = os.path.join(tmp, "farm-out")
-        with slurm_cluster.SlurmCluster(limit=LIMIT) as cluster:
-            records, complete, baking, farm_seconds = bake_on_slurm(treeanim, cluster, farm, trees)
-            check_jobs(records)
-        skipped, frame = check_resumed(farm, complete, baking)
-        with open(os.path.join(farm, "forest.json")) as f:
-            listed = sorted(t["id"] for t in json.load(f)["trees"])
-        if listed != sorted(t for task in trees for t in task):
-            raise Failed("forest.json lists %s, the plan %s" % (listed, trees))
-        one = os.path.join(tmp, "one")
-        began = time.monotonic()
-        # One thread, as each task: a thread count changes no byte, and the cores are the cluster's.
-        forest_bake.run(treeanim, "run", forest_bake.SCENE, "-o", one, "-q", "--threads", "1", *LONGER)
-        one_seconds = time.monotonic() - began
-        forest_bake.same_outputs(one, farm)
-        print("forest_requeue: %d trees in %d tasks on Slurm in %.1f s (one process: %.1f s); task %d requeued "
-              "with %s complete and %s in progress, ran again: skipped %s, resumed %s at frame %d; every file "
-              "and forest.json bit-identical" % (len(listed), TASKS, farm_seconds, one_seconds, REQUEUED,
-                                                  sorted(complete), baking, skipped, baking, frame))
-    except (Failed, slurm_cluster.SlurmError) as error:
-        print("forest_requeue: FAIL: %s" % error)
-        return 1
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    print("forest_requeue: ok")
-    return 0
+def bake_and_compare(treeanim, tmp):
+    """The test in folder `tmp` => its summary line."""
+    trees = task_trees(treeanim, tmp)
+    farm = os.path.join(tmp, "farm-out")
+    with slurm_cluster.SlurmCluster(limit=LIMIT) as cluster:
+        records, complete, baking, farm_seconds = bake_on_slurm(treeanim, cluster, farm, trees)
+        check_jobs(records)
+    skipped, frame = check_resumed(farm, complete, baking)
+    with open(os.path.join(farm, "forest.json")) as f:
+        listed = sorted(t["id"] for t in json.load(f)["trees"])
+    if listed != sorted(t for task in trees for t in task):
+        raise Failed("forest.json lists %s, the plan %s" % (listed, trees))
+    one = os.path.join(tmp, "one")
+    began = time.monotonic()
+    # One thread, as each task: a thread count changes no byte, and the cores are the cluster's.
+    forest_bake.run(treeanim, "run", forest_bake.SCENE, "-o", one, "-q", "--threads", "1", *LONGER)
+    one_seconds = time.monotonic() - began
+    forest_bake.same_outputs(one, farm)
+    return ("%d trees in %d tasks on Slurm in %.1f s (one process: %.1f s); task %d requeued with %s complete and "
+            "%s in progress, ran again: skipped %s, resumed %s at frame %d; every file and forest.json bit-identical"
+            % (len(listed), TASKS, farm_seconds, one_seconds, REQUEUED, sorted(complete), baking, skipped, baking,
+               frame))
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    treeanim = os.path.abspath(sys.argv[1])
+    sys.exit(slurm_cluster.run_test("forest_requeue", lambda work: bake_and_compare(treeanim, work), (Failed,)))
