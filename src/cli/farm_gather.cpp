@@ -5,6 +5,7 @@
 #include "cli/commands.h"
 #include "cli/forest_manifest.h"
 #include "cli/forest_tasks.h"
+#include "cli/shell_words.h"
 #include "common/errors.h"
 
 namespace treeanim {
@@ -29,7 +30,6 @@ int farm_gather_command(const FarmRequest& request) {
   for (size_t m = 0; m < report.missing.size(); ++m) by_task[task_of[report.missing[m]]].push_back(m);
   std::fprintf(stderr, "treeanim: %zu of %zu trees are not complete; %s not written\n", report.missing.size(),
                forest.trees.size(), forest_manifest_path(request.out_dir).string().c_str());
-  const std::string out = request.out_dir.empty() ? "" : " -o '" + request.out_dir.string() + "'";
   for (const auto& [task, missing] : by_task) {
     if (request.tasks > 0) {
       std::fprintf(stderr, "  task %zu of %zu", task, request.tasks);
@@ -42,14 +42,18 @@ int farm_gather_command(const FarmRequest& request) {
   }
   std::string failed;
   for (const auto& entry : by_task) failed += (failed.empty() ? "" : " ") + std::to_string(entry.first);
+  // The rerun bakes what was submitted: the same output folder and the same --set.
+  const std::string scene_word = shell_word(request.scene.string());
+  const std::string rest = (request.out_dir.empty() ? "" : " -o " + shell_word(request.out_dir.string())) +
+                           set_arguments(request.overrides) + " --resume";
   if (request.tasks > 0)
     std::fprintf(stderr, "what to do: read the logs above, then run each failed task I again (it resumes), for I "
-                         "in %s:\n  treeanim run '%s' --shard I/%zu%s --resume\nand gather again.\n",
-                 failed.c_str(), request.scene.string().c_str(), request.tasks, out.c_str());
+                         "in %s:\n  treeanim run %s --shard I/%zu%s\nand gather again.\n",
+                 failed.c_str(), scene_word.c_str(), request.tasks, rest.c_str());
   else
-    std::fprintf(stderr, "what to do: bake the missing trees again (treeanim run '%s'%s --resume bakes only "
-                         "those), then gather again.\n",
-                 request.scene.string().c_str(), out.c_str());
+    std::fprintf(stderr, "what to do: bake the missing trees again (treeanim run %s%s bakes only those), then gather "
+                         "again.\n",
+                 scene_word.c_str(), rest.c_str());
   return kExitOutput;
 }
 

@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "cli/forest_tasks.h"
 #include "cli/run_program.h"
+#include "cli/shell_words.h"
 #include "common/errors.h"
 #include "io/staged_files.h"
 #include "io/text_output.h"
@@ -18,13 +19,6 @@ namespace treeanim {
 namespace fs = std::filesystem;
 
 namespace {
-
-// text => one shell word with the same bytes.
-std::string quoted(const std::string& text) {
-  std::string word = "'";
-  for (char c : text) word += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return word + "'";
-}
 
 // Everything the scripts name, absolute.
 struct FarmJob {
@@ -42,15 +36,15 @@ struct FarmJob {
 
 // The command of task `index` (a shell expression, e.g. "$SLURM_ARRAY_TASK_ID").
 std::string task_command(const FarmJob& job, const std::string& index) {
-  return quoted(job.treeanim.string()) + " run " + quoted(job.scene.string()) + " --shard \"" + index + "/" +
-         std::to_string(job.tasks) + "\" -o " + quoted(job.out.string()) + " --checkpoint-every " +
+  return shell_word(job.treeanim.string()) + " run " + shell_word(job.scene.string()) + " --shard \"" + index + "/" +
+         std::to_string(job.tasks) + "\" -o " + shell_word(job.out.string()) + " --checkpoint-every " +
          std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) + job.overrides;
 }
 
 std::string gather_command(const FarmJob& job) {
-  return quoted(job.treeanim.string()) + " farm gather " + quoted(job.scene.string()) + " -o " +
-         quoted(job.out.string()) + " --tasks " + std::to_string(job.tasks) + " --logs " +
-         quoted(job.logs.string()) + job.overrides;
+  return shell_word(job.treeanim.string()) + " farm gather " + shell_word(job.scene.string()) + " -o " +
+         shell_word(job.out.string()) + " --tasks " + std::to_string(job.tasks) + " --logs " +
+         shell_word(job.logs.string()) + job.overrides;
 }
 
 std::string header(const FarmJob& job, const std::string& what) {
@@ -82,7 +76,7 @@ std::string plain_script(const FarmJob& job) {
   text += "# usage: " + job.name + ".sh [TASK | gather]: task TASK (0 to " + std::to_string(job.tasks - 1) +
           "), the gather, or without\n# an argument every task in turn and then the gather. A queue runs one "
           "task per job, then the gather.\nset -u\n";
-  text += "logs=" + quoted(job.logs.string()) + "\nmkdir -p \"$logs\"\n";
+  text += "logs=" + shell_word(job.logs.string()) + "\nmkdir -p \"$logs\"\n";
   text += "task() {\n  " + task_command(job, "$1") + " >> \"$logs/task-$1.log\" 2>&1\n}\n";
   text += "gather() {\n  " + gather_command(job) + " 2>&1 | tee -a \"$logs/gather.log\"\n  return \"${PIPESTATUS[0]}\"\n}\n";
   text += "case \"${1:-all}\" in\n"
@@ -212,7 +206,7 @@ int farm_submit_command(const FarmRequest& request) {
   job.checkpoint_every =
       request.checkpoint_every > 0 ? request.checkpoint_every : std::max(1LL, (scene.time.frames + 7) / 8);
   job.cpus = request.cpus_per_task;
-  for (const std::string& assignment : request.overrides) job.overrides += " --set " + quoted(assignment);
+  job.overrides = set_arguments(request.overrides);
 
   if (request.engine == "slurm") return submit_to_slurm(job, request);
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");

@@ -11,7 +11,7 @@ namespace treeanim {
 
 // Seconds of one core per vertex and substep of a bake, measured on the reference machine
 // (docs/farm.md "Measured here"): converts estimated costs into CPU-hours.
-inline constexpr double kSecondsPerVertexStep = 5.3e-8;
+inline constexpr double kSecondsPerVertexStep = 8.6e-8;
 
 // What one tree of each variant costs, from one model per variant (the first tree of it): the
 // vertex count does not depend on a tree's scale, and only a stochastic grammar's seed changes it.

@@ -16,6 +16,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -35,8 +36,10 @@ class SlurmError(Exception):
 
 
 def missing_programs():
-    """The Slurm and munge programs not on PATH (and a reason when not root) => list of str."""
-    missing = [p for p in PROGRAMS if shutil.which(p) is None]
+    """The Slurm and munge programs not on PATH or in the sbin folders (where scripts/slurm-local
+    looks too), and a reason when not root => list of str."""
+    path = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/sbin"])
+    missing = [p for p in PROGRAMS if shutil.which(p, path=path) is None]
     if os.geteuid() != 0:
         missing.append("root (the daemons switch users)")
     return missing
@@ -54,6 +57,23 @@ def skip_or_fail_without_slurm(test):
     print("%s: FAIL: missing %s (run scripts/setup test as root, or set %s=1 to skip)"
           % (test, ", ".join(missing), SKIP_VARIABLE))
     sys.exit(1)
+
+
+def run_test(name, check, failures=()):
+    """A farm test's main: skips or fails without Slurm, then check(work) in a per-process
+    temporary folder (removed at the end) => 0 after printing check's summary line, or 1 after
+    printing what failed (a SlurmError or one of `failures`)."""
+    skip_or_fail_without_slurm(name)
+    work = tempfile.mkdtemp(prefix="treeanim-%s-%d-" % (name, os.getpid()))
+    try:
+        print("%s: %s" % (name, check(work)))
+    except (SlurmError, *failures) as error:
+        print("%s: FAIL: %s" % (name, error))
+        return 1
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print("%s: ok" % name)
+    return 0
 
 
 def _raise_exit(signum, frame):

@@ -7,9 +7,7 @@ stopped by their process ids and must be gone.
 usage: slurm_smoke.py      (exit 0 pass, 1 fail, 77 skipped: no Slurm and TREEANIM_FARM_SKIP_OK=1)
 """
 import os
-import shutil
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -87,26 +85,17 @@ def check(cluster, work):
     return elapsed
 
 
-def main():
-    slurm_cluster.skip_or_fail_without_slurm("slurm_smoke")
-    work = tempfile.mkdtemp(prefix="treeanim-slurm-smoke-%d-" % os.getpid())
-    try:
-        with slurm_cluster.SlurmCluster(limit=240) as cluster:  # ctest's TIMEOUT is 300 s
-            elapsed = check(cluster, work)
-            pids = dict(cluster.pids)
-        left = [name for name, pid in pids.items() if slurm_cluster.alive(pid)]
-        if left:
-            raise Failed("still running after stop: %s" % left)
-        print("slurm_smoke: cluster started in %.1f s; %d tasks, one requeued, and the dependent job ran in %.1f s;"
-              " daemons %s stopped in %.1f s" % (cluster.start_seconds, TASKS, elapsed, pids, cluster.stop_seconds))
-    except (Failed, slurm_cluster.SlurmError) as error:
-        print("slurm_smoke: FAIL: %s" % error)
-        return 1
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    print("slurm_smoke: ok")
-    return 0
+def smoke(work):
+    """The test in folder `work` => its summary line."""
+    with slurm_cluster.SlurmCluster(limit=240) as cluster:  # ctest's TIMEOUT is 300 s
+        elapsed = check(cluster, work)
+        pids = dict(cluster.pids)
+    left = [name for name, pid in pids.items() if slurm_cluster.alive(pid)]
+    if left:
+        raise Failed("still running after stop: %s" % left)
+    return ("cluster started in %.1f s; %d tasks, one requeued, and the dependent job ran in %.1f s; daemons %s "
+            "stopped in %.1f s" % (cluster.start_seconds, TASKS, elapsed, pids, cluster.stop_seconds))
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(slurm_cluster.run_test("slurm_smoke", smoke, (Failed,)))

@@ -84,23 +84,33 @@ def case_shards(treeanim, tmp):
         lo, hi = tree["bounds"]["min"], tree["bounds"]["max"]
         if not (lo[0] <= x <= hi[0] and lo[2] <= z <= hi[2]):
             raise Failed("tree %s at %s lies outside its world bounds %s" % (tree["id"], tree["position"], tree["bounds"]))
-    # A removed file makes the gather fail, naming the tree and what to do.
+    # A removed file makes the gather fail, naming the tree and what to do: the command that bakes
+    # it again, with the --set the forest was gathered with (this one leaves the scene as it is).
     os.remove(os.path.join(shards, trees[3]["outputs"][0]["files"][0]))
-    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--tasks", "3", check=False)
-    if done.returncode != 4 or trees[3]["id"] not in done.stderr or "--shard I/3" not in done.stderr:
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--tasks", "3", "--set", "time.frames=24", check=False)
+    rerun = "treeanim run '%s' --shard I/3 -o '%s' --set 'time.frames=24' --resume" % (SCENE, shards)
+    if done.returncode != 4 or trees[3]["id"] not in done.stderr or rerun not in done.stderr:
         raise Failed("gather with a missing file: exit %d, %s" % (done.returncode, done.stderr))
 
 
-def tree_in_progress(out):
-    """The id of a tree with checkpoints, none past frame 200 of 240, and no part yet (baking), else None."""
+def listed(folder):
+    """The names in folder; none if it is not there (a bake removes a finished tree's checkpoints)."""
+    try:
+        return os.listdir(folder)
+    except (FileNotFoundError, NotADirectoryError):
+        return []
+
+
+def tree_in_progress(out, last=200, trees=None):
+    """The id of a tree (of `trees`, default any) with checkpoints, none past frame `last`, and no
+    part yet (baking), else None."""
     folder = os.path.join(out, "checkpoints")
-    for tree in (os.listdir(folder) if os.path.isdir(folder) else []):
-        if os.path.exists(os.path.join(out, "forest.parts", tree + ".json")):
+    for tree in listed(folder):
+        if (trees is not None and tree not in trees) or os.path.exists(os.path.join(out, "forest.parts", tree + ".json")):
             continue
-        names = os.listdir(os.path.join(folder, tree)) if os.path.isdir(os.path.join(folder, tree)) else []
-        frames = [int(n[len("checkpoint-"):-len(".h5")]) for n in names
+        frames = [int(n[len("checkpoint-"):-len(".h5")]) for n in listed(os.path.join(folder, tree))
                   if n.startswith("checkpoint-") and n.endswith(".h5")]
-        if frames and max(frames) <= 200:
+        if frames and max(frames) <= last:
             return tree
     return None
 
