@@ -54,7 +54,6 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
                        (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
-    block.damping[k] = still ? Real(1) : model.vertex_damping[v];
     block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
     block.flying[k] = still ? 0 : attachment.vertex_flying[v];
@@ -114,13 +113,13 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
       VertexInputs<Real> in;
       if (direct) {
         in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
-              model.vertex_drag.data() + begin, model.vertex_damping.data() + begin,
-              model.vertex_half_damping.data() + begin, attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
+              model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
+              attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
         std::fill(block.moving, block.moving + n, uint8_t(1));
       } else {
         gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
-        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.damping,
-              block.half_damping, block.global, block.flying, {}, nullptr};
+        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
+              block.global, block.flying, {}, nullptr};
       }
       for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
       in.kicked = model.vertex_shape_kick.data() + begin;

@@ -28,7 +28,7 @@ template <typename Real>
 struct VertexInputs {
   const Real* pull[3];
   const uint32_t* pull_row;
-  const Real *drag, *damping, *half_damping, *global;
+  const Real *drag, *half_damping, *global;
   const uint8_t* flying;
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
   const uint8_t* kicked;  // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
@@ -39,10 +39,9 @@ struct VertexBlock {
   uint8_t moving[kVertexBlock];            // 1: the vertex steps; 0: anchored, asleep, no cluster
   Real pull[3][kVertexBlock];              // m, mean correction of its clusters, per axis
   // Per-step factors of each vertex; a vertex that does not move gets those of a still
-  // point (damping 1, no drag, no pull, no fall), which map its u = 0, v = 0 onto themselves
+  // point (no damping, drag, pull or fall), which map its u = 0, v = 0 onto themselves
   // exactly, so that the loops need no branch.
   Real drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
-  Real damping[kVertexBlock];              // velocity factor per step
   Real half_damping[kVertexBlock];         // velocity factor per half step
   Real global[kVertexBlock];               // global rate per step
   uint8_t flying[kVertexBlock];            // 1 on a flying leaf

@@ -106,14 +106,14 @@ double leaf_compliance(const SolverModel<Real>& m, const WindOptions& wind, uint
   return moment > 0 ? m.options.leaf_turn / moment : 0;
 }
 
-// The bar chain of the beam (bar_chain.h), each leaf's petiole compliance added.
+// With the beam: which vertices take their shape correction as a kick, and each leaf's
+// petiole compliance and quarter-turn limit added to the bar chain (built in the constructor).
 template <typename Real>
 void precompute_beam(SolverModel<Real>& m, const WindOptions& wind) {
   m.vertex_shape_kick.assign(m.V, 0);
   if (!m.beam) return;
   if (m.kick)
     for (size_t v = 0; v < m.V; ++v) m.vertex_shape_kick[v] = m.tree.vertex_leaf[v] < 0 ? 1 : 0;
-  m.chain = build_bar_chain(m.tree, m.options.youngs_modulus, m.options.yield_strain);
   for (size_t c = 0; c < m.C; ++c)
     if (m.tree.cluster_kind[c] == kClusterLeaf) {
       m.chain.cluster_compliance[c] = leaf_compliance(m, wind, static_cast<uint32_t>(c));
@@ -171,7 +171,8 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
       parallel(t.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   const double extent = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
-  const double size = std::max(extent, tree_reach(t, build_bar_chain(t, o.youngs_modulus, o.yield_strain)));
+  chain = build_bar_chain(t, o.youngs_modulus, o.yield_strain);
+  const double size = std::max(extent, tree_reach(t, chain));
   const bool anchored = std::any_of(t.vertex_anchored.begin(), t.vertex_anchored.end(), [](auto a) { return a != 0; });
   runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
   Attachment<Real>& a = all_attached;
@@ -181,7 +182,6 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   const StepRates rates = compute_step_rates(tree, options, h);
   cluster_alpha = rates.cluster_alpha;
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
-  vertex_damping.assign(rates.vertex_damping.begin(), rates.vertex_damping.end());
   vertex_half_damping.resize(V);
   for (size_t v = 0; v < V; ++v) vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
   precompute_drag(*this, w);

@@ -100,8 +100,7 @@ struct SolverModel {
   // cluster feels is a function of its world position
   std::vector<double> cluster_phase_sin, cluster_phase_cos;
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
-  std::vector<Real> vertex_damping;        // (V) velocity factor per step
-  std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step
+  std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step (the step's damping is two)
   // (V) 1: a branch vertex with the beam, whose mean correction is a kick of the next step;
   // 0: a projection (leaves, the per_step stiffness)
   std::vector<uint8_t> vertex_shape_kick;
