@@ -26,9 +26,8 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
   // 100:1 aspect), so where the second-order model is convex we take the Newton step with
   // its Hessian (tr(M) I - sym(M)), M = A R^T, instead; Müller's step stays the fallback far
   // from the optimum (e.g. an inverted cluster). A is normalised by the caller (order 1 for
-  // any cluster size), so the constants are scale-free. 1e-9 rad is far below any visible
-  // angle and above round-off, so a settled cluster stops after one iteration; a step is at
-  // most 1 rad (trust region) so noise in a degenerate direction cannot spin a cluster.
+  // any cluster size), so the constants are scale-free. A step is at most 1 rad (trust
+  // region) so noise in a degenerate direction cannot spin a cluster.
   constexpr double kEps = 1e-9;
   constexpr double kMaxStep = 1.0;
   int iteration = 0;
@@ -37,10 +36,12 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
     const Eigen::Vector3d torque =
         R.col(0).cross(A.col(0)) + R.col(1).cross(A.col(1)) + R.col(2).cross(A.col(2));
     const double trace = R.col(0).dot(A.col(0)) + R.col(1).dot(A.col(1)) + R.col(2).dot(A.col(2));
-    // Converged (cheap test first): the gradient step is below 1e-12 rad, so even the Newton
-    // step about the long axis of a 1000:1 cluster is below 1e-9 rad.
+    // Converged (cheap test first) only where the gradient is at round-off (1e-15 of the
+    // trace): any larger step is taken, however small, since a warm-started cluster's pose
+    // changes by O(h^2) a step (a leaf kicked at rate (wh)^2), which a coarser threshold
+    // would freeze, an error growing as the step shrinks (docs/solver.md, "Rotation").
     const double scale = std::abs(trace) + kEps;
-    if (!(torque.squaredNorm() >= 1e-24 * scale * scale)) break;
+    if (!(torque.squaredNorm() > 1e-30 * scale * scale)) break;
     // H = tr(M)(1 + eps) I - sym(M), M = A R^T: symmetric, so six cofactors give its
     // determinant, Sylvester's leading minors and the Newton step adj(H) torque / det(H).
     const Eigen::Matrix3d M = A * R.transpose();
@@ -63,7 +64,7 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
       omega = torque * (1.0 / scale);
     }
     double angle = omega.norm();
-    if (!(angle >= kEps)) break;  // also stops on NaN: the caller checks the result
+    if (!std::isfinite(angle)) break;  // the caller checks the result
     if (angle > kMaxStep) {
       omega *= kMaxStep / angle;
       angle = kMaxStep;
@@ -71,8 +72,9 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
     q = increment(omega, angle) * q;
     q.normalize();
     // Newton converges quadratically: after a step below 1e-6 rad the error left is of the
-    // order of 1e-12 rad, what the test above would find, so that test is not repeated.
-    if (newton && angle < 1e-6) {
+    // order of 1e-12 rad, what the test above would find, so that test is not repeated; a
+    // gradient step below 1e-9 rad has nowhere left to go.
+    if (angle < kEps || (newton && angle < 1e-6)) {
       ++iteration;
       break;
     }

@@ -202,7 +202,7 @@ void WindField::sample_time(double t, double window, AirSample& air) const {
     // The wave's rate here, db/dt, and its mean over the window: a box filter's response
     // 1 - (rate window)^2 / 24 to second order, as a Gaussian without the box's negative lobes.
     const double rate = (mode_omega[j] - mode_wave.col(j).dot(air.mean)) * window;
-    const double kept = getenv("NOAA") ? 1.0 : std::exp(-rate * rate / 24);
+    const double kept = std::exp(-rate * rate / 24);
     air.sin_b[j] = kept * std::sin(b);
     air.cos_b[j] = kept * std::cos(b);
   }
