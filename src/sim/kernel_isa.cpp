@@ -16,13 +16,15 @@ KernelIsa widest_supported() {
   return KernelIsa::kPortable;
 }
 
+// The portable loops unless TREEANIM_ISA names a wider set the CPU runs: on the machines
+// measured the wider sets were slower (docs/solver.md, "Instruction sets").
 KernelIsa pick() {
-  const KernelIsa widest = widest_supported();
   const char* asked = std::getenv("TREEANIM_ISA");
-  if (!asked) return widest;
+  if (!asked) return KernelIsa::kPortable;
+  const KernelIsa widest = widest_supported();
   for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
     if (std::string(asked) == kernel_isa_name(isa)) return isa < widest ? isa : widest;
-  return widest;
+  return KernelIsa::kPortable;
 }
 
 }  // namespace

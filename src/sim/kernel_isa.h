@@ -9,9 +9,8 @@ namespace treeanim {
 
 enum class KernelIsa { kPortable, kAvx2, kAvx512 };
 
-// The widest set this CPU runs (x86-64: AVX-512F, else AVX2, else the baseline SSE2), or a
-// narrower one named by the environment variable TREEANIM_ISA (portable, avx2, avx512; a
-// wider one than the CPU runs is not taken). Read on the first call.
+// The baseline (x86-64: SSE2), or the set named by the environment variable TREEANIM_ISA
+// (portable, avx2, avx512), narrowed to what this CPU runs. Read on the first call.
 KernelIsa kernel_isa();
 // => "portable", "avx2" or "avx512".
 const char* kernel_isa_name(KernelIsa isa);
