@@ -12,6 +12,7 @@
 #include "cli/signals.h"
 #include "common/errors.h"
 #include "io/outputs.h"
+#include "sim/kernel_isa.h"
 #include "sim/simulator.h"
 #include "treeanim_version.h"
 
@@ -67,9 +68,9 @@ TreeBakeResult bake_tree(const Scene& scene, const RunRequest& request, const Tr
       request.frames ? parse_frame_range(*request.frames, first, last) : std::pair{first, last};
   const PreparedTree tree = prepare_tree(scene);
   if (verbose)
-    std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters\n",
+    std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters; solver loops: %s\n",
                  tree.grow_seconds, tree.model_seconds, tree.model.vertex_count(),
-                 tree.model.cluster_count());
+                 tree.model.cluster_count(), kernel_isa_name(kernel_isa()));
 
   BakeInfo info;
   info.scene_json = scene.resolved.dump(2);

@@ -23,75 +23,114 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
 }  // namespace
 
 template <typename Real>
-void compute_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                            SimState& state, StepScratch<Real>& scratch) {
+void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                       StepScratch<Real>& scratch) {
   const TreeModel& tree = model.tree;
-  StepPrediction<Real>& prediction = state.prediction<Real>();
+  const StepPrediction<Real>& prediction = state.prediction<Real>();
   const size_t C = model.C;
   // 1. Per cluster: its members' share of the loads, and their moment about its joint. The
   // arms are those of the rest pose: the goal is then a linear function of the loads, with a
   // potential, where arms of the current pose made it a follower load that chased a bent
   // limb round in circles (docs/solver.md, "Bending"); the yield turn bounds large loads.
+  // Each thread sums the clusters whose vertices it corrected (balanced_range), in its cache.
+  // Written out on raw arrays, f = F_v / k_v and moment += (x0 - joint) x f as Eigen
+  // evaluates them, operation for operation.
   const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
-#pragma omp parallel for schedule(static) if (model.parallel)
-  for (size_t c = 0; c < C; ++c) {
-    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+  const Real *fx = prediction.drag_force.col(0).data(), *fy = prediction.drag_force.col(1).data(),
+             *fz = prediction.drag_force.col(2).data();
+  const double* rest = tree.rest_positions.data();
+  const uint32_t* members = tree.cluster_members.data();
+  const uint8_t* active = attachment.member_active.data();
+  const Real* inv_count = attachment.vertex_inv_count.data();
+  const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+  for (size_t c = first; c < last; ++c) {
+    double force_x = 0, force_y = 0, force_z = 0, moment_x = 0, moment_y = 0, moment_z = 0;
+    const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
     if (!attachment.cluster_flying[c])
       for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
-        if (!attachment.member_active[s]) continue;
-        const uint32_t v = tree.cluster_members[s];
-        const Eigen::Vector3d f = prediction.drag_force.row(v).transpose().template cast<double>() *
-                                  double(attachment.vertex_inv_count[v]);
-        force += f;
-        moment += (tree.rest_positions.col(v) - joint.col(c)).cross(f);
+        if (!active[s]) continue;
+        const uint32_t v = members[s];
+        const double share = double(inv_count[v]);
+        const double gx = double(fx[v]) * share, gy = double(fy[v]) * share, gz = double(fz[v]) * share;
+        force_x += gx, force_y += gy, force_z += gz;
+        const double ax = rest[3 * size_t(v)] - jx, ay = rest[3 * size_t(v) + 1] - jy, az = rest[3 * size_t(v) + 2] - jz;
+        moment_x += ay * gz - az * gy, moment_y += az * gx - ax * gz, moment_z += ax * gy - ay * gx;
       }
-    scratch.cluster_load.col(c) = force;
-    scratch.cluster_moment.col(c) = moment;
+    scratch.cluster_load.col(c) = Eigen::Vector3d(force_x, force_y, force_z);
+    scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_x, moment_y, moment_z);
   }
+#pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
+#pragma omp single
   for (size_t c = C; c-- > 0;) {
     const int32_t p = tree.cluster_parent[c];
     if (p < 0 || attachment.cluster_flying[c]) continue;
     scratch.cluster_load.col(p) += scratch.cluster_load.col(c);
     scratch.cluster_moment.col(p) += scratch.cluster_moment.col(c) + (joint.col(c) - joint.col(p)).cross(scratch.cluster_load.col(c));
   }
-  // 3. Parents before children: each joint turns by its compliance times its moment, and the
-  // turns accumulate from the root.
+  // 3. Parents before children: each joint turns by its compliance times its moment (in
+  // parallel: the sines and cosines), and the turns accumulate from the root (one thread).
+#pragma omp for schedule(static)
   for (size_t c = 0; c < C; ++c) {
-    const int32_t p = tree.cluster_parent[c];
-    Eigen::Map<Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
     Eigen::Vector3d theta = model.chain.cluster_compliance[c] * scratch.cluster_moment.col(c);
     const double angle = theta.norm(), largest = model.chain.cluster_max_turn[c];
     if (angle > largest) theta *= largest / angle;
-    const Eigen::Matrix3d turn = rotation_of(theta);
+    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
+  }
+#pragma omp single
+  for (size_t c = 0; c < C; ++c) {
+    const int32_t p = tree.cluster_parent[c];
+    Eigen::Map<Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
     if (p < 0 || attachment.cluster_flying[c]) {
-      R = turn;
       scratch.cluster_static_joint.col(c) = joint.col(c);
       continue;
     }
+    const Eigen::Matrix3d turn = R;
     const Eigen::Map<const Eigen::Matrix3d> parent(&scratch.cluster_static_rotation(0, p));
     scratch.cluster_static_joint.col(c) =
         scratch.cluster_static_joint.col(p) + parent * (joint.col(c) - joint.col(p));
     R = turn * parent;
   }
-  // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest.
-#pragma omp parallel for schedule(static) if (model.parallel)
-  for (size_t v = 0; v < model.V; ++v) {
-    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-    const Eigen::Vector3d x0 = tree.rest_positions.col(v);
-    for (uint32_t s = tree.vertex_cluster_offsets[v]; s < tree.vertex_cluster_offsets[v + 1]; ++s) {
-      const uint32_t slot = tree.vertex_memberships[s], c = model.member_cluster[slot];
-      if (!attachment.member_active[slot]) continue;
-      const Eigen::Map<const Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
-      offset += R * (x0 - joint.col(c)) + scratch.cluster_static_joint.col(c) - x0;
+}
+
+template <typename Real>
+void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end) {
+  const TreeModel& tree = model.tree;
+  // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest:
+  // R (x0 - joint) + static joint - x0, written out on raw arrays as Eigen evaluates it.
+  const double *rest = tree.rest_positions.data(), *joint = model.chain.cluster_joint.data();
+  const double *rotation = scratch.cluster_static_rotation.data(), *moved = scratch.cluster_static_joint.data();
+  const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
+  const uint32_t* member_cluster = model.member_cluster.data();
+  const uint8_t* active = attachment.member_active.data();
+  Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
+  for (size_t v = begin; v < end; ++v) {
+    double ox = 0, oy = 0, oz = 0;
+    const double x = rest[3 * v], y = rest[3 * v + 1], z = rest[3 * v + 2];
+    for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+      const uint32_t slot = memberships[s];
+      if (!active[slot]) continue;
+      const size_t c = member_cluster[slot];
+      const double* R = rotation + 9 * c;  // column-major
+      const double dx = x - joint[3 * c], dy = y - joint[3 * c + 1], dz = z - joint[3 * c + 2];
+      ox += (((R[0] * dx + R[3] * dy) + R[6] * dz) + moved[3 * c]) - x;
+      oy += (((R[1] * dx + R[4] * dy) + R[7] * dz) + moved[3 * c + 1]) - y;
+      oz += (((R[2] * dx + R[5] * dy) + R[8] * dz) + moved[3 * c + 2]) - z;
     }
-    prediction.goal.row(v) = (offset * double(attachment.vertex_inv_count[v])).transpose().template cast<Real>();
+    const double share = double(attachment.vertex_inv_count[v]);
+    gx[v] = static_cast<Real>(ox * share), gy[v] = static_cast<Real>(oy * share), gz[v] = static_cast<Real>(oz * share);
   }
 }
 
-template void compute_static_offsets(const SolverModel<float>&, const Attachment<float>&, SimState&,
-                                     StepScratch<float>&);
-template void compute_static_offsets(const SolverModel<double>&, const Attachment<double>&, SimState&,
-                                     StepScratch<double>&);
+#define TREEANIM_BEAM_STATICS(Real)                                                                               \
+  template void deflect_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,              \
+                                  StepScratch<Real>&);                                                              \
+  template void write_static_offsets(const SolverModel<Real>&, const Attachment<Real>&, const StepScratch<Real>&, \
+                                     StepPrediction<Real>&, size_t, size_t);
+TREEANIM_BEAM_STATICS(float)
+TREEANIM_BEAM_STATICS(double)
+#undef TREEANIM_BEAM_STATICS
 
 }  // namespace treeanim

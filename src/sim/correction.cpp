@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/errors.h"
+#include "sim/kernel_isa.h"
 #include "sim/prediction.h"
 #include "sim/solver_step.h"
 
@@ -68,15 +69,14 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
   }
 }
 
-// The corrected vertices (prediction) => the state's positions and velocities, in double;
-// a vertex that does not move keeps its values.
+// The corrected vertices [first, last) (prediction) => the state's positions and velocities,
+// in double; a vertex that does not move keeps its values.
 template <typename Real>
 void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                 bool any_asleep) {
+                 bool any_asleep, size_t first, size_t last) {
   const TreeModel& tree = model.tree;
   const StepPrediction<Real>& prediction = state.prediction<Real>();
-#pragma omp parallel for schedule(static) if (model.parallel)
-  for (size_t v = 0; v < model.V; ++v) {
+  for (size_t v = first; v < last; ++v) {
     const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
                        (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
     if (still) continue;
@@ -85,54 +85,50 @@ void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachm
   }
 }
 
-// One kernel over every vertex, in parallel blocks => the lowest vertex whose values are not
-// finite and (`check_runaway`) the lowest attached one farther than the runaway limit.
+// One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
+// values are not finite and (`check_runaway`) the lowest attached one farther than the
+// runaway limit. `before` runs on each block's range first.
 // Without sleeping islands every free vertex reads its mean correction from one row
 // (anchors: the zero row, with factors that keep them still), which the first pass of a step
 // averages (`first_pass`); otherwise, and when a frame starts from the state, each block is
 // gathered lane by lane.
-template <typename Real, typename Kernel>
+template <typename Real, typename Before, typename Kernel>
 std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                                                SimState& state, StepScratch<Real>& scratch, bool load_state,
-                                                bool with_pull, bool first_pass, bool any_asleep, bool check_runaway,
-                                                Kernel kernel) {
-  const TreeModel& tree = model.tree;
+                                                SimState& state, StepScratch<Real>& scratch, size_t first,
+                                                size_t last, bool load_state, bool with_pull, bool first_pass,
+                                                bool any_asleep, bool check_runaway, Before before, Kernel kernel) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   uint32_t bad = kNone, runaway = kNone;
-#pragma omp parallel if (model.parallel) reduction(min : bad, runaway)
-  {
-    const auto [first, last] =
-        balanced_range(tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    const bool direct = !load_state && !any_asleep;
-    if (direct && with_pull && first_pass) average_shared_pulls(model, attachment, scratch, first, last);
-    const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
-                                  scratch.member_correction.col(2).data()};
-    VertexBlock<Real> block;
-    for (size_t begin = first; begin < last; begin += kVertexBlock) {
-      const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
-      VertexInputs<Real> in;
-      if (direct) {
-        in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
-              model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
-              attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
-        std::fill(block.moving, block.moving + n, uint8_t(1));
-      } else {
-        gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
-        in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
-              block.global, block.flying, {}, nullptr};
-      }
-      for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
-      in.kicked = model.vertex_shape_kick.data() + begin;
-      if (!kernel(begin, n, in, block)) continue;
-      // Rare: find the first vertex at fault, as the scalar tests would.
-      for (int k = 0; k < n; ++k) {
-        if (!block.moving[k]) continue;
-        const uint32_t v = static_cast<uint32_t>(begin + k);
-        if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite()) bad = std::min(bad, v);
-        if (check_runaway && !attachment.vertex_flying[v] &&
-            prediction.offset.row(v).template cast<double>().squaredNorm() > model.runaway_distance2)
-          runaway = std::min(runaway, v);
-      }
+  const bool direct = !load_state && !any_asleep;
+  if (direct && with_pull && first_pass) average_shared_pulls(model, attachment, scratch, first, last);
+  const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
+                                scratch.member_correction.col(2).data()};
+  VertexBlock<Real> block;
+  for (size_t begin = first; begin < last; begin += kVertexBlock) {
+    const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
+    before(begin, begin + n);
+    VertexInputs<Real> in;
+    if (direct) {
+      in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
+            model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
+            attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
+      std::fill(block.moving, block.moving + n, uint8_t(1));
+    } else {
+      gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
+      in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
+            block.global, block.flying, {}, nullptr};
+    }
+    for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
+    in.kicked = model.vertex_shape_kick.data() + begin;
+    if (!kernel(begin, n, in, block)) continue;
+    // Rare: find the first vertex at fault, as the scalar tests would.
+    for (int k = 0; k < n; ++k) {
+      if (!block.moving[k]) continue;
+      const uint32_t v = static_cast<uint32_t>(begin + k);
+      if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite()) bad = std::min(bad, v);
+      if (check_runaway && !attachment.vertex_flying[v] &&
+          prediction.offset.row(v).template cast<double>().squaredNorm() > model.runaway_distance2)
+        runaway = std::min(runaway, v);
     }
   }
   return {bad, runaway};
@@ -140,7 +136,9 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
 
 }  // namespace
 
-// kLastStep also writes positions and velocities to the state.
+// One parallel region: the correction (and load) pass; after a barrier, the state (kLastStep)
+// and the bar chain's passes; the prediction, each block's goals first. A failure found by a
+// pass stops every thread after it; the exceptions are thrown outside the region.
 template <typename Real>
 bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
@@ -148,16 +146,52 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
   const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
-  // 4. Correct the matched step (or load the state), and measure the drag of the next one.
-  auto [bad, runaway] = for_vertex_blocks(
-      model, attachment, state, scratch, load, !load, true, any_asleep, end,
-      [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-        if (model.store_drag_force)
-          return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
-                     : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
-        return end ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
-                   : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
-      });
+  // The state's velocities are taken at its time: the first kick from them is half a step's.
+  const Real kick = load ? Real(0.5) : Real(1);
+  uint32_t bad = kNone, runaway = kNone, bad_prediction = kNone;
+  auto nothing = [](size_t, size_t) {};
+#pragma omp parallel if (model.parallel)
+  {
+    const auto [first, last] =
+        balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    // 4. Correct the matched step (or load the state), and measure the drag of the next one.
+    const auto [my_bad, my_runaway] = with_kernel_isa([&] {
+      return for_vertex_blocks(
+          model, attachment, state, scratch, first, last, load, !load, true, any_asleep, end, nothing,
+          [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+            if (model.store_drag_force)
+              return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                         : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
+            return end ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
+                       : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
+          });
+    });
+    if (my_bad != kNone || my_runaway != kNone) {
+#pragma omp critical(treeanim_correction_failure)
+      bad = std::min(bad, my_bad), runaway = std::min(runaway, my_runaway);
+    }
+#pragma omp barrier
+    if (bad == kNone && runaway == kNone) {
+      if (end) write_state(model, attachment, state, any_asleep, first, last);
+      // 1. The static deflection under that drag, and the prediction of the next step.
+      if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
+      auto goals = [&](size_t begin, size_t stop) {
+        if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
+      };
+      const uint32_t my_bad_prediction = with_kernel_isa([&] {
+        return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !load, false, any_asleep,
+                                 false, goals,
+                                 [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+                                   return predict_block(model, attachment, scratch, prediction, begin, n, in, kick,
+                                                        block);
+                                 });
+      }).first;
+      if (my_bad_prediction != kNone) {
+#pragma omp critical(treeanim_correction_failure)
+        bad_prediction = std::min(bad_prediction, my_bad_prediction);
+      }
+    }
+  }
   // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
   auto where = [&](uint32_t v) {
     return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
@@ -171,16 +205,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
     throw SimulationError(where(runaway) + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
   }
-  if (end) write_state(model, attachment, state, any_asleep);
-  // 1. The static deflection under that drag, and the prediction of the next step. The
-  // state's velocities are taken at its time: the first kick from them is half a step's.
-  const Real kick = load ? Real(0.5) : Real(1);
-  if (model.beam) compute_static_offsets(model, attachment, state, scratch);
-  bad = for_vertex_blocks(model, attachment, state, scratch, false, !load, false, any_asleep, false,
-                          [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                            return predict_block(model, attachment, scratch, prediction, begin, n, in, kick, block);
-                          }).first;
-  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
+  if (bad_prediction != kNone) throw SimulationError(where(bad_prediction) + "non-finite position or velocity");
   return any_asleep;
 }
 

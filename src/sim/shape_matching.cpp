@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/errors.h"
+#include "sim/kernel_isa.h"
 #include "sim/rotation.h"
 #include "sim/solver_step.h"
 
@@ -110,12 +111,14 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
 #pragma omp parallel if (model.parallel) reduction(min : bad)
   {
     const auto [first, last] = balanced_range(model.tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    for (size_t c = first; c < last; ++c) {
-      if (!cluster_awake(model, attachment, state, c)) continue;
-      if (attachment.cluster_pin_slot[c] == kNone && !match_cluster(model, attachment, state, scratch, c, nullptr))
-        bad = std::min(bad, static_cast<uint32_t>(c));
-      sample_cluster_air(model, attachment, state, scratch, c);
-    }
+    with_kernel_isa([&] {
+      for (size_t c = first; c < last; ++c) {
+        if (!cluster_awake(model, attachment, state, c)) continue;
+        if (attachment.cluster_pin_slot[c] == kNone && !match_cluster(model, attachment, state, scratch, c, nullptr))
+          bad = std::min(bad, static_cast<uint32_t>(c));
+        sample_cluster_air(model, attachment, state, scratch, c);
+      }
+    });
     if (!model.pinned_leaf_clusters.empty()) {
 #pragma omp barrier
       match_attached_leaves(model, attachment, state, scratch, bad);

@@ -37,11 +37,18 @@ void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& 
                         StepScratch<Real>& scratch, long long frame);
 
 // --- beam_statics.cpp ---
-// The step's drag (prediction.drag_force) and positions, the clusters' fits => each vertex's
-// offset in the tree's static deflection under those loads (prediction.goal).
+// Called by every thread of a parallel region (or outside one), after the step's drag
+// (prediction.drag_force) is complete: the loads per cluster, summed and turned along the
+// cluster tree => each cluster's turn and joint in the tree's static deflection
+// (scratch.cluster_static_rotation, cluster_static_joint), complete for every thread on return.
 template <typename Real>
-void compute_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                            StepScratch<Real>& scratch);
+void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                       StepScratch<Real>& scratch);
+// The deflected chain => vertices [begin, end)'s offsets from rest in it (prediction.goal).
+template <typename Real>
+void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end);
 
 // --- shape_matching.cpp ---
 // Predicted positions => rotations, shifts and per-membership corrections of every awake

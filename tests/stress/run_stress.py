@@ -5,7 +5,7 @@
   run_stress.py --treeanim BIN ctest-cases          every case marked "ctest"
   run_stress.py --treeanim BIN all-cases            every case
   run_stress.py --treeanim BIN random N [--seed S]  N scenes of scripts/stress-scenes
-  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4 (double and float)
+  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4, TREEANIM_ISA (double and float)
 
 A bake passes when treeanim exits 0 and its HDF5 holds only finite positions with every
 attached vertex closer to its rest position than twice the tree's size (the larger of the
@@ -18,6 +18,7 @@ never wilder). Prints one line per case; exit 1 on any failure.
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -30,14 +31,16 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
 
-def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300):
-    """One `treeanim run` => (exit code, stderr, seconds)."""
-    args = [binary, "run", scene, "-o", out_dir, "--quiet", *extra]
+def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300, isa=None):
+    """One `treeanim run` (isa: TREEANIM_ISA, the solver loops' instruction set) => (exit code, stderr, seconds)."""
+    args = [binary, "run", scene, "-o", out_dir, *(() if "--verbose" in extra else ("--quiet",)), *extra]
     for key, value in sets.items():
         args += ["--set", f"{key}={json.dumps(value)}"]
     env = dict(os.environ)
     if threads:
         env["OMP_NUM_THREADS"] = str(threads)
+    if isa:
+        env["TREEANIM_ISA"] = isa
     start = time.perf_counter()
     done = subprocess.run(args, env=env, capture_output=True, text=True, timeout=timeout)
     return done.returncode, done.stderr.strip(), time.perf_counter() - start
@@ -237,7 +240,8 @@ def run_random(binary, count, seed):
 
 def run_determinism(binary):
     """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, at 1, 2 and 4
-    threads, with the solver in double and in float."""
+    threads with the portable solver loops and at 1 and 2 with each wider instruction set this
+    CPU runs (TREEANIM_ISA, docs/solver.md "Instruction sets"), the solver in double and float."""
     texts = []
     for precision in ("double", "float"):
         digests = {}
@@ -245,16 +249,24 @@ def run_determinism(binary):
             sets = {"time.frames": 8, "outputs": [{"format": "hdf5", "path": "out.h5"}],
                     "wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
                     "hsm.leaf_detach_force": 0.3, "hsm.precision": precision}
-            for threads in (1, 2, 4):
-                code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets, threads=threads)
+            runs = [("portable", 1), ("portable", 2), ("portable", 4), ("avx2", 1), ("avx2", 2), ("avx512", 1),
+                    ("avx512", 2)]
+            for isa, threads in runs:
+                code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets,
+                                        extra=("--verbose",), threads=threads, isa=isa)
                 if code != 0:
-                    return False, f"{precision}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
+                    return False, f"{precision}, {isa}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
+                ran = re.search(r"solver loops: (\w+)", err)
+                if not ran:
+                    return False, f"no 'solver loops:' in the verbose log: {err}"
                 with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
-                    digests[threads] = f["/frames/positions"][()].tobytes()
-        if not digests[1] == digests[2] == digests[4]:
-            return False, f"DIFFERENT /frames/positions for 1, 2, 4 threads ({precision})"
-        texts.append(f"{precision} ({len(digests[1])} bytes)")
-    return True, "identical /frames/positions for 1, 2, 4 threads: " + ", ".join(texts)
+                    digests[(ran.group(1), threads)] = f["/frames/positions"][()].tobytes()
+        if len(set(digests.values())) != 1:
+            return False, f"DIFFERENT /frames/positions across {sorted(digests)} ({precision})"
+        texts.append(f"{precision} ({len(next(iter(digests.values())))} bytes)")
+    sets_run = sorted({isa for isa, _ in digests})
+    return True, f"identical /frames/positions for 1, 2, 4 threads and the loops in {', '.join(sets_run)}: " + \
+        ", ".join(texts)
 
 
 def report(name, passed, text):

@@ -1,0 +1,46 @@
+#include "sim/kernel_isa.h"
+
+#include <cstdlib>
+#include <string>
+
+namespace treeanim {
+
+namespace {
+
+KernelIsa widest_supported() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return KernelIsa::kAvx512;
+  if (__builtin_cpu_supports("avx2")) return KernelIsa::kAvx2;
+#endif
+  return KernelIsa::kPortable;
+}
+
+// The portable loops unless TREEANIM_ISA names a wider set the CPU runs: on the machines
+// measured the wider sets were slower (docs/solver.md, "Instruction sets").
+KernelIsa pick() {
+  const char* asked = std::getenv("TREEANIM_ISA");
+  if (!asked) return KernelIsa::kPortable;
+  const KernelIsa widest = widest_supported();
+  for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
+    if (std::string(asked) == kernel_isa_name(isa)) return isa < widest ? isa : widest;
+  return KernelIsa::kPortable;
+}
+
+}  // namespace
+
+KernelIsa kernel_isa() {
+  static const KernelIsa isa = pick();
+  return isa;
+}
+
+const char* kernel_isa_name(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::kAvx512: return "avx512";
+    case KernelIsa::kAvx2: return "avx2";
+    case KernelIsa::kPortable: break;
+  }
+  return "portable";
+}
+
+}  // namespace treeanim
