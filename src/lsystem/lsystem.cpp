@@ -28,6 +28,18 @@ void check_overrides(const LsystemOptions& options, const Grammar& grammar) {
   }
 }
 
+// A view file's surface => its leaf shape, with quads per patch from the scene, else the view
+// line, else the file's PRECISION, else cpfg's default 5.
+LeafShape view_surface_shape(const ViewSurface& v, std::optional<int> scene_precision) {
+  constexpr int kDefaultQuads = 5;
+  const std::array<int, 2> quads = scene_precision ? std::array<int, 2>{*scene_precision, *scene_precision}
+                                                   : v.precision.value_or(v.surface.precision.value_or(std::array<int, 2>{kDefaultQuads, kDefaultQuads}));
+  LeafShape shape = surface_shape(v.surface, v.id, v.scale, quads[0], quads[1]);
+  if (shape.triangles.empty())
+    throw InputError(v.where + ": the surface '" + std::string(1, v.id) + "' has no area (every patch collapses to a line or a point)");
+  return shape;
+}
+
 }  // namespace
 
 ViewSettings load_view(const LsystemOptions& options) {
@@ -75,6 +87,7 @@ TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& gra
   if (view.tropism_elasticity) turtle.tropism_elasticity = *view.tropism_elasticity;
   if (options.tropism) turtle.tropism = *options.tropism;
   if (options.tropism_elasticity) turtle.tropism_elasticity = *options.tropism_elasticity;
+  for (const ViewSurface& v : view.surfaces) turtle.surfaces.push_back(view_surface_shape(v, options.surface_precision));
   return turtle;
 }
 

@@ -70,6 +70,9 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
   if (options.tropism && options.tropism->norm() == 0.0)
     section.fail_expected("tropism", "a non-zero direction [x, y, z]");
   options.tropism_elasticity = section.optional_number("tropism_elasticity");
+  if (auto n = section.optional_integer("surface_precision", 1, 10)) options.surface_precision = static_cast<int>(*n);
+  if (options.surface_precision && !options.view)
+    section.fail("surface_precision", "the precision of surfaces goes with a view file that names them (/lsystem/view)");
   return options;
 }
 

@@ -25,6 +25,7 @@ struct LsystemOptions {
   std::optional<double> width_factor;            // overrides "width factor:" ('!' without a parameter)
   std::optional<Eigen::Vector3d> tropism;        // overrides T of "tropism:"
   std::optional<double> tropism_elasticity;      // overrides e of "tropism:"
+  std::optional<int> surface_precision;          // quads per patch along s and t of every view-file surface (1 ... 10)
   std::string inline_name = "<scene>/lsystem";   // names inline rules in messages (+ "/axiom", "/productions/3")
 };
 

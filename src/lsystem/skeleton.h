@@ -20,7 +20,7 @@ struct Skeleton {
   std::vector<uint32_t> segment_id;            // (S) stable id: index of the drawing module in the derived string
   std::vector<int32_t> segment_material;       // (S) material index from ' and ,
 
-  // --- leaves (L): 'L' / '~' modules and '{ . }' polygons ---
+  // --- leaves (L): 'L' / '~' modules, '{ . }' polygons, spheres and circles ---
   std::vector<int32_t> leaf_segment;           // (L) attachment segment; -1 if drawn before any segment
   std::vector<Eigen::Vector3d> leaf_position;  // (L) scene units, the petiole base
   std::vector<Eigen::Vector3d> leaf_heading;   // (L) unit turtle H at the leaf
@@ -28,7 +28,9 @@ struct Skeleton {
   std::vector<Eigen::Vector3d> leaf_up;        // (L) unit turtle U (leaf normal)
   std::vector<double> leaf_scale;              // (L) first parameter of the leaf module, 1 without one
   std::vector<uint32_t> leaf_polygon_offsets;  // (L+1) CSR into polygon_points; an empty range = default leaf shape
-  std::vector<Eigen::Vector3d> polygon_points; // (P) '{ . }' outline vertices, scene units, world positions
+  std::vector<Eigen::Vector3d> polygon_points; // (P) scene units, world positions: '{ . }' outlines and shape vertices
+  std::vector<uint32_t> leaf_triangle_offsets; // (L+1) CSR into leaf_triangles; a non-empty range = the leaf is that mesh
+  std::vector<uint32_t> leaf_triangles;        // (T*3) ids into the leaf's own polygon_points range; front faces U
 
   size_t segment_count() const { return segment_start.size(); }
   size_t leaf_count() const { return leaf_position.size(); }

@@ -213,17 +213,38 @@ class Turtle {
   bool has_param(size_t i) const { return word_.param_offsets[i] != word_.param_offsets[i + 1]; }
   double first_param(size_t i) const { return word_.params[word_.param_offsets[i]]; }
 
-  // '~' at i: a leaf of the default shape. cpfg writes a predefined surface as '~' and its id
-  // letter ("~l(s)", two modules here): the letter's parameter is then the scale. => the last
-  // module used.
+  // '~' at i: a leaf. cpfg writes a predefined surface as '~' and its id letter ("~l(s)" or
+  // "~l(sx,sy,sz)", two modules here, the parameters on the letter): the view file's surface of
+  // that letter, else a leaf of the default shape scaled by s. => the last module used.
   size_t surface(size_t i) {
     const size_t n = word_.size();
     if (!has_param(i) && i + 1 < n && std::isalpha(static_cast<unsigned char>(word_.symbols[i + 1]))) {
-      add_leaf(s_, has_param(i + 1) ? first_param(i + 1) : 1.0, {});
+      const std::span<const double> p = word_.params_of(i + 1);
+      const auto& shapes = settings_.surfaces;
+      const auto shape = std::find_if(shapes.begin(), shapes.end(), [&](const LeafShape& v) { return v.id == word_.symbols[i + 1]; });
+      if (shape == shapes.end()) add_leaf(s_, p.empty() ? 1.0 : p[0], {});
+      else draw_surface(*shape, p);
       return i + 1;
     }
     add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {});
     return i;
+  }
+
+  // A view-file surface scaled by p (none: 1; one: uniform; three: along -L, H, U), then the
+  // turtle moves to its end point (CPFG manual 6.7.1). A zero scale draws nothing, as in cpfg.
+  void draw_surface(const LeafShape& shape, std::span<const double> p) {
+    const Vector3d scale = p.empty() ? Vector3d(1, 1, 1) : p.size() < 3 ? Vector3d(p[0], p[0], p[0]) : Vector3d(p[0], p[1], p[2]);
+    const double volume = scale.prod();
+    if (!(volume != 0.0) || !std::isfinite(volume)) return;
+    add_shape_leaf(s_, shape, scale);
+    s_.position += leaf_vector(s_, shape.end.cwiseProduct(scale));
+  }
+
+  // A sphere (@O) or circle (@o, @c) of diameter d: a small leaf of that shape on the current
+  // segment. Without a parameter (the line width) it rounds a joint or a tip, which the branch
+  // mesh closes already, and is left out (docs/turtle.md).
+  void draw_organ(const LeafShape& shape, std::span<const double> p) {
+    if (!p.empty() && p[0] > 0 && std::isfinite(p[0])) add_shape_leaf(s_, shape, Vector3d::Constant(p[0]));
   }
 
   // '?' and its letter (cpfg's query modules, CPFG manual 6.9): ?P ?H ?U ?L take the turtle's
@@ -247,9 +268,9 @@ class Turtle {
   }
 
   // '@' and the letter after it (cpfg's two-character modules, CPFG manual 6): @v rolls L
-  // horizontal, @M(x,y,z) moves to a point, @R(hx,hy,hz[,ux,uy,uz]) sets the heading, @O(r) (a
-  // sphere) becomes a leaf of scale r, @Gs ... @Ge (a generalised cylinder) makes 'f' draw;
-  // circles (@o @c), textures (@T*), @Gc and the rest draw nothing. => the last module used.
+  // horizontal, @M(x,y,z) moves to a point, @R(hx,hy,hz[,ux,uy,uz]) sets the heading, @O(d) (a
+  // sphere) and @o(d) @c(d) (circles) become small leaves, @Gs ... @Ge (a generalised cylinder)
+  // makes 'f' draw; textures (@T*), @Gc and the rest draw nothing. => the last module used.
   size_t at_command(size_t i) {
     if (i + 1 >= word_.size()) return i;
     const size_t c = i + 1;
@@ -262,9 +283,9 @@ class Turtle {
           return c + 1;
         }
         break;
-      case 'O':  // a sphere: a leaf of the default shape scaled by its radius
-        add_leaf(s_, p.empty() ? 1.0 : p[0], {});
-        break;
+      case 'O': draw_organ(sphere_shape(), p); break;
+      case 'o':  // a circle in the screen's plane: a baked tree has no screen, so it lies in HL as @c
+      case 'c': draw_organ(disc_shape(), p); break;
       case 'M':
         if (p.size() >= 3) s_.position = Vector3d(p[0], p[1], p[2]);
         break;
@@ -331,14 +352,44 @@ class Turtle {
   // turtle state, scale, outline (empty: default leaf shape) => one leaf on the state's segment.
   void add_leaf(const State& at, double scale, std::span<const Vector3d> outline) {
     Skeleton& k = out_;
+    add_leaf_frame(at, scale);
+    k.polygon_points.insert(k.polygon_points.end(), outline.begin(), outline.end());
+    close_leaf();
+  }
+
+  // turtle state, shape, scale along the leaf frame's x y z => one leaf on the state's segment:
+  // the shape's points placed in the world, its triangles (wound the other way when the scale
+  // mirrors it).
+  void add_shape_leaf(const State& at, const LeafShape& shape, const Vector3d& scale) {
+    Skeleton& k = out_;
+    add_leaf_frame(at, scale.x());
+    for (const Vector3d& p : shape.points) k.polygon_points.push_back(at.position + leaf_vector(at, p.cwiseProduct(scale)));
+    const bool mirrored = scale.prod() < 0;
+    for (size_t t = 0; t < shape.triangles.size(); t += 3)
+      k.leaf_triangles.insert(k.leaf_triangles.end(), {shape.triangles[t], shape.triangles[t + (mirrored ? 2 : 1)],
+                                                       shape.triangles[t + (mirrored ? 1 : 2)]});
+    close_leaf();
+  }
+
+  // v in the leaf frame (+x = -L, +y = H, +z = U) => the same vector in the world.
+  static Vector3d leaf_vector(const State& at, const Vector3d& v) {
+    return -v.x() * at.left + v.y() * at.heading + v.z() * at.up;
+  }
+
+  // A leaf's base, frame and scale; close_leaf() ends its points and triangles.
+  void add_leaf_frame(const State& at, double scale) {
+    Skeleton& k = out_;
     k.leaf_segment.push_back(at.segment);
     k.leaf_position.push_back(at.position);
     k.leaf_heading.push_back(at.heading);
     k.leaf_left.push_back(at.left);
     k.leaf_up.push_back(at.up);
     k.leaf_scale.push_back(scale);
-    k.polygon_points.insert(k.polygon_points.end(), outline.begin(), outline.end());
+  }
+  void close_leaf() {
+    Skeleton& k = out_;
     k.leaf_polygon_offsets.push_back(static_cast<uint32_t>(k.polygon_points.size()));
+    k.leaf_triangle_offsets.push_back(static_cast<uint32_t>(k.leaf_triangles.size()));
   }
 
   // '}': the innermost open polygon becomes a leaf based at its '{' if it has an area
@@ -380,6 +431,8 @@ class Turtle {
     k.leaf_scale.reserve(leaves);
     k.leaf_polygon_offsets.reserve(leaves + 1);
     k.leaf_polygon_offsets.push_back(0);
+    k.leaf_triangle_offsets.reserve(leaves + 1);
+    k.leaf_triangle_offsets.push_back(0);
   }
 
   const ModuleString& word_;

@@ -2,7 +2,9 @@
 // The 3D turtle (lpfg conventions, DESIGN.md): module string => Skeleton.
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
+#include "lsystem/leaf_shapes.h"
 #include "lsystem/module_string.h"
 #include "lsystem/skeleton.h"
 
@@ -16,6 +18,7 @@ struct TurtleSettings {
   std::optional<double> width_increment;      // cpfg view file: '#' adds it, '!' without a parameter subtracts it
   Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
   double tropism_elasticity = 0.0;            // e; 0 = no tropism
+  std::vector<LeafShape> surfaces;            // the view file's surfaces: ~id draws the one of its letter
 };
 
 // Initial frame H=(0,1,0) L=(-1,0,0) U=(0,0,1) at the origin; +(90)F(1) ends at (-1,0,0),

@@ -98,6 +98,32 @@ std::vector<double> sample_spline(const std::vector<Eigen::Vector2d>& control) {
   return out;
 }
 
+// "id file.s scale [i j] [texture]" of the view file's line `line` => the surface with its
+// file read, or nothing when that file does not exist (cpfg then leaves the surface out).
+std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, size_t line, const std::string& rest) {
+  const std::string name = view.string();
+  std::istringstream in(rest);
+  std::string id, file;
+  in >> id >> file;
+  if (id.size() != 1) fail(name, line, "expected a one-letter surface id after 'surface:'");
+  if (file.empty()) fail(name, line, "expected 'surface: id file.s scale' (the file name after the id)");
+  ViewSurface out;
+  out.id = id[0];
+  out.where = name + ":" + std::to_string(line + 1) + ":1";
+  if (!(in >> out.scale) || !std::isfinite(out.scale))
+    fail(name, line, "expected 'surface: id file.s scale' (a number after the file name)");
+  if (out.scale <= 0) out.scale = 1.0;  // as cpfg
+  std::vector<double> more;
+  for (double v; more.size() < 2 && in >> v;) more.push_back(v);
+  if (more.size() == 2 && more[0] >= 1 && more[1] >= 1)  // a single number is a texture; 0 0 leaves it to the file
+    out.precision = std::array<int, 2>{static_cast<int>(std::min(more[0], 10.0)), static_cast<int>(std::min(more[1], 10.0))};
+  const std::filesystem::path target = view.parent_path() / file;
+  std::error_code ec;
+  if (!std::filesystem::exists(target, ec)) return std::nullopt;
+  out.surface = read_surface_file(target);
+  return out;
+}
+
 }  // namespace
 
 SampledFunction parse_function(const std::string& name, const std::vector<std::string>& lines, size_t* pos) {
@@ -152,11 +178,11 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       }
       if (e != std::string::npos) view.tropism_elasticity = number(name, i, rest.substr(e + 2), "E");
     } else if (key == "surface") {
-      std::istringstream in(rest);
-      std::string id;
-      in >> id;
-      if (id.size() != 1) fail(name, i, "expected a one-letter surface id after 'surface:'");
-      view.surfaces.push_back(id[0]);
+      std::optional<ViewSurface> surface = read_surface_line(path, i, rest);
+      const auto same_id = [&](const ViewSurface& v) { return surface && v.id == surface->id; };
+      // cpfg keeps the first surface of an id and leaves out one whose file does not exist.
+      if (surface && std::none_of(view.surfaces.begin(), view.surfaces.end(), same_id))
+        view.surfaces.push_back(std::move(*surface));
     } else if (key == "function" || key == "function set") {
       std::istringstream in(rest);
       std::string file;

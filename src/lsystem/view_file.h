@@ -8,8 +8,18 @@
 #include <vector>
 
 #include "lsystem/expression.h"
+#include "lsystem/surface_file.h"
 
 namespace treeanim {
+
+// "surface: id file.s scale [i j] [texture]" (CPFG manual 8.1.5) with its file read.
+struct ViewSurface {
+  char id = 0;                                  // the letter of ~id
+  BezierSurface surface;                        // the .s file, found beside the view file
+  double scale = 1.0;                           // the surface's SIZE is drawn this long (scene units)
+  std::optional<std::array<int, 2>> precision;  // "i j": quads per patch along s, t (clamped to 1 ... 10)
+  std::string where;                            // "view.v:7:1", to place errors about this surface
+};
 
 struct ViewSettings {
   std::optional<double> angle;                // "angle increment: a" or 360 / "angle factor: n"
@@ -17,7 +27,7 @@ struct ViewSettings {
   std::optional<double> width_increment;      // "line width increment: d": '#' adds, '!' subtracts
   std::optional<Eigen::Vector3d> tropism;     // "tropism: T: x,y,z ..."
   std::optional<double> tropism_elasticity;   // "... E: e" or "initial elasticity: e"
-  std::vector<char> surfaces;                 // "surface: id file.s ...": ids drawn by ~id as leaves
+  std::vector<ViewSurface> surfaces;          // "surface:" lines whose file exists, in order: drawn by ~id as leaves
   std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
 };
 

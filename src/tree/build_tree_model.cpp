@@ -45,17 +45,24 @@ void check_skeleton(const Skeleton& sk) {
                            sk.segment_continues_parent.size() == S;
   const bool leaves_ok = sk.leaf_segment.size() == L && sk.leaf_heading.size() == L &&
                          sk.leaf_left.size() == L && sk.leaf_up.size() == L &&
-                         sk.leaf_scale.size() == L && sk.leaf_polygon_offsets.size() >= L + (L > 0);
+                         sk.leaf_scale.size() == L && sk.leaf_polygon_offsets.size() >= L + (L > 0) &&
+                         sk.leaf_triangle_offsets.size() >= L + (L > 0);
   if (!segments_ok || !leaves_ok) throw InputError("skeleton: array sizes disagree");
   if (S == 0 && L == 0) throw InputError("the grammar draws nothing: no segment (F, G) and no leaf (L, ~, { . })");
   for (size_t s = 0; s < S; ++s)
     if (sk.segment_parent[s] < -1 || sk.segment_parent[s] >= int32_t(s))
       throw InputError("skeleton: segment_parent[" + std::to_string(s) + "] is not an earlier segment");
-  for (size_t l = 0; l < L; ++l)
+  for (size_t l = 0; l < L; ++l) {
+    const uint32_t points = sk.leaf_polygon_offsets[l + 1] - sk.leaf_polygon_offsets[l];
+    const uint32_t t0 = sk.leaf_triangle_offsets[l], t1 = sk.leaf_triangle_offsets[l + 1];
+    const bool triangles_ok = t1 >= t0 && t1 <= sk.leaf_triangles.size() && (t1 - t0) % 3 == 0 &&
+                              std::all_of(sk.leaf_triangles.begin() + t0, sk.leaf_triangles.begin() + t1,
+                                          [&](uint32_t v) { return v < points; });
     if (sk.leaf_segment[l] < -1 || sk.leaf_segment[l] >= int32_t(S) ||
         sk.leaf_polygon_offsets[l + 1] < sk.leaf_polygon_offsets[l] ||
-        sk.leaf_polygon_offsets[l + 1] > sk.polygon_points.size())
-      throw InputError("skeleton: leaf " + std::to_string(l) + " has a bad segment or polygon range");
+        sk.leaf_polygon_offsets[l + 1] > sk.polygon_points.size() || !triangles_ok)
+      throw InputError("skeleton: leaf " + std::to_string(l) + " has a bad segment, polygon or triangle range");
+  }
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// Leaf meshes: the default quad, a custom mesh read with assimp, or the grammar's '{ . }' outlines.
+// Leaf meshes: the default quad, a custom mesh read with assimp, the grammar's '{ . }' outlines,
+// or the meshes the turtle placed (cpfg surfaces, spheres, circles).
 #include <Eigen/Geometry>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -6,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
 
 #include "common/errors.h"
 #include "tree/tree_build_steps.h"
@@ -13,15 +15,24 @@
 namespace treeanim {
 namespace {
 
-// Leaf l uses its '{ . }' outline when it has a polygon (fewer than 3 points enclose no area and
-// fall back to the instanced shape).
+uint32_t point_count(const Skeleton& skeleton, size_t l) {
+  return skeleton.leaf_polygon_offsets[l + 1] - skeleton.leaf_polygon_offsets[l];
+}
+
+// Leaf l's mesh triangles (0: it has none).
+uint32_t mesh_triangles(const Skeleton& skeleton, size_t l) {
+  return (skeleton.leaf_triangle_offsets[l + 1] - skeleton.leaf_triangle_offsets[l]) / 3;
+}
+
+// Leaf l uses its '{ . }' outline when it has a polygon and no triangles (fewer than 3 points
+// enclose no area and fall back to the instanced shape).
 uint32_t outline_points(const Skeleton& skeleton, size_t l) {
-  const uint32_t n = skeleton.leaf_polygon_offsets[l + 1] - skeleton.leaf_polygon_offsets[l];
-  return n >= 3 ? n : 0;
+  const uint32_t n = point_count(skeleton, l);
+  return n >= 3 && mesh_triangles(skeleton, l) == 0 ? n : 0;
 }
 
 // Area of a triangle mesh given as positions (3 x n) and triangles => m^2.
-double mesh_area(const Eigen::Matrix3Xd& p, const std::vector<uint32_t>& triangles) {
+double mesh_area(const Eigen::Matrix3Xd& p, std::span<const uint32_t> triangles) {
   double area = 0;
   for (size_t t = 0; t < triangles.size(); t += 3) {
     const Eigen::Vector3d a = p.col(triangles[t]);
@@ -112,8 +123,8 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
 size_t leaf_vertex_count(const Skeleton& skeleton, const LeafTemplate& shape) {
   size_t n = 0;
   for (size_t l = 0; l < skeleton.leaf_count(); ++l) {
-    const uint32_t outline = outline_points(skeleton, l);
-    n += outline ? outline : size_t(shape.positions.cols());
+    const bool own = outline_points(skeleton, l) || mesh_triangles(skeleton, l);
+    n += own ? point_count(skeleton, l) : size_t(shape.positions.cols());
   }
   return n;
 }
@@ -121,8 +132,8 @@ size_t leaf_vertex_count(const Skeleton& skeleton, const LeafTemplate& shape) {
 size_t leaf_triangle_count(const Skeleton& skeleton, const LeafTemplate& shape) {
   size_t n = 0;
   for (size_t l = 0; l < skeleton.leaf_count(); ++l) {
-    const uint32_t outline = outline_points(skeleton, l);
-    n += outline ? outline - 2 : shape.triangles.size() / 3;
+    const uint32_t outline = outline_points(skeleton, l), mesh = mesh_triangles(skeleton, l);
+    n += outline ? outline - 2 : mesh ? mesh : shape.triangles.size() / 3;
   }
   return n;
 }
@@ -149,20 +160,17 @@ void write_instance(const Skeleton& skeleton, const TreeOptions& options, const 
   for (uint32_t i : shape.triangles) *tri++ = first + i;
 }
 
-// Outline of leaf l (n >= 3 points) fan-triangulated from its first point, wound so that its
-// front faces the turtle's U. => area (m^2); attachment = the point nearest the leaf position.
-double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
-                     uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
+// The n world points of leaf l (scene units) => vertices from `first` (m), UVs the leaf-plane
+// coordinates (m). => the vertex nearest the leaf position (the attachment).
+uint32_t write_points(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
+                      uint32_t first, TreeModel& model) {
   const uint32_t p0 = skeleton.leaf_polygon_offsets[l];
   const Eigen::Vector3d origin = skeleton.leaf_position[l] * options.scale;
   const Eigen::Matrix3d to_leaf = leaf_frame(skeleton, l).transpose();
-  Eigen::Vector3d newell = Eigen::Vector3d::Zero();
   double nearest = std::numeric_limits<double>::infinity();
-  attachment = first;
+  uint32_t attachment = first;
   for (uint32_t i = 0; i < n; ++i) {
     const Eigen::Vector3d p = skeleton.polygon_points[p0 + i] * options.scale;
-    const Eigen::Vector3d q = skeleton.polygon_points[p0 + (i + 1) % n] * options.scale;
-    newell += p.cross(q);
     model.rest_positions.col(first + i) = p;
     const Eigen::Vector3d local = to_leaf * (p - origin);
     model.uvs.col(first + i) = Eigen::Vector2f(float(local.x()), float(local.y()));
@@ -172,6 +180,17 @@ double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_
       attachment = first + i;
     }
   }
+  return attachment;
+}
+
+// Outline of leaf l (n >= 3 points) fan-triangulated from its first point, wound so that its
+// front faces the turtle's U. => area (m^2); attachment = the point nearest the leaf position.
+double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
+                     uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
+  attachment = write_points(skeleton, options, l, n, first, model);
+  Eigen::Vector3d newell = Eigen::Vector3d::Zero();
+  for (uint32_t i = 0; i < n; ++i)
+    newell += model.rest_positions.col(first + i).cross(model.rest_positions.col(first + (i + 1) % n));
   const bool flip = newell.dot(skeleton.leaf_up[l]) < 0;
   for (uint32_t i = 1; i + 1 < n; ++i) {
     *tri++ = first;
@@ -179,6 +198,17 @@ double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_
     *tri++ = first + (flip ? i : i + 1);
   }
   return 0.5 * newell.norm();
+}
+
+// Mesh of leaf l (n points, its own triangles, wound by the turtle). => area (m^2), the sum of
+// its triangles (a closed shape counts its whole surface); attachment as for an outline.
+double write_mesh(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
+                  uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
+  attachment = write_points(skeleton, options, l, n, first, model);
+  const std::span<const uint32_t> own(skeleton.leaf_triangles.data() + skeleton.leaf_triangle_offsets[l],
+                                      skeleton.leaf_triangle_offsets[l + 1] - skeleton.leaf_triangle_offsets[l]);
+  for (uint32_t i : own) *tri++ = first + i;
+  return mesh_area(model.rest_positions.middleCols(first, n), own);
 }
 
 }  // namespace
@@ -196,11 +226,13 @@ LeafMeshes build_leaf_meshes(const Skeleton& skeleton, const TreeOptions& option
   for (size_t l = 0; l < L; ++l) {
     leaves.vertex_offsets[l] = next;
     const uint32_t outline = outline_points(skeleton, l);
-    if (outline) {
-      leaves.area[l] = write_outline(skeleton, options, l, outline, next, tri, leaves.attachment[l], model);
-      const Eigen::Matrix2Xf uv = model.uvs.middleCols(next, outline);
+    if (outline || mesh_triangles(skeleton, l)) {
+      const uint32_t n = point_count(skeleton, l);
+      leaves.area[l] = outline ? write_outline(skeleton, options, l, n, next, tri, leaves.attachment[l], model)
+                               : write_mesh(skeleton, options, l, n, next, tri, leaves.attachment[l], model);
+      const Eigen::Matrix2Xf uv = model.uvs.middleCols(next, n);
       leaves.length[l] = double(uv.row(1).maxCoeff() - uv.row(1).minCoeff());
-      next += outline;
+      next += n;
     } else {
       write_instance(skeleton, options, shape, l, next, tri, model);
       const double s = skeleton.leaf_scale[l];

@@ -108,6 +108,30 @@ TEST_F(Cli, InfoJsonGivesExactSkeletonCounts) {
   for (const char* key : {"clusters", "memberships", "mass_kg"}) EXPECT_TRUE(info["model"].contains(key));
 }
 
+// A cpfg object (tests/data/cpfg): plant.v names leaf.s for ~l, a 3 x 2-quad patch of 12 points
+// and 12 triangles; four leaves on a stem of two segments (25 vertices, 40 triangles).
+TEST_F(Cli, ViewFileSurfaceIsTheLeafShapeAndBakes) {
+  const std::string object = std::string(TREEANIM_SOURCE_DIR) + "/tests/data/cpfg/";
+  const fs::path scene = write("plant.json", R"({"lsystem": {"grammar": ")" + object + R"(plant.l", "view": ")" + object +
+                                                 R"(plant.v"}, "time": {"frames": 3, "substeps": 1},
+    "wind": {"keys": [{"time": 0, "speed": 6, "direction": [1, 0, 0]}]},
+    "outputs": [{"format": "hdf5", "path": "bake.h5"}]})");
+  Result r = run("info --json " + scene.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto info = nlohmann::json::parse(r.out);
+  EXPECT_EQ(info["skeleton"]["leaves"], 4);
+  EXPECT_EQ(info["model"]["leaf_clusters"], 4);
+  EXPECT_EQ(info["mesh"]["vertices"], 25 + 4 * 12);
+  EXPECT_EQ(info["mesh"]["triangles"], 40 + 4 * 12);
+  r = run("info --json " + scene.string() + " --set lsystem.surface_precision=1");  // one quad a patch
+  ASSERT_EQ(r.code, 0) << r.err;
+  info = nlohmann::json::parse(r.out);
+  EXPECT_EQ(info["mesh"]["vertices"], 25 + 4 * 4);
+  r = run("run " + scene.string() + " -o " + (dir_ / "out").string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out/bake.h5"));
+}
+
 TEST_F(Cli, SetOverridesASceneValue) {
   const fs::path scene = write("line.json", kLine);
   const Result r = run("info --json " + scene.string() + " --set lsystem.axiom=FFFFF");

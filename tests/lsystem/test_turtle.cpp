@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "lsystem/surface_file.h"
 #include "lsystem/turtle.h"
 
 namespace treeanim {
@@ -323,13 +324,96 @@ TEST(Turtle, CpfgWidthStepsByTheViewIncrement) {
   EXPECT_EQ(draw("F#F!F", settings).segment_width, (std::vector<double>{3.0, 4.0, 4.0 * settings.width_factor}));
 }
 
-// '~' with an id letter ("~l(s)") and '@O(r)' are leaves of the default shape; circles draw nothing.
-TEST(Turtle, CpfgSurfacesAndSpheresAreDefaultLeaves) {
-  const Skeleton k = draw("~l(4)F~l(2)F~(3)@O(0.5)@o(1)@c(1)~");
-  EXPECT_EQ(k.leaf_scale, (std::vector<double>{4.0, 2.0, 3.0, 0.5, 1.0}));
-  EXPECT_EQ(k.leaf_segment, (std::vector<int32_t>{-1, 0, 1, 1, 1}));
-  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>(6, 0)));
+// '~' with an id letter ("~l(s)") that no view-file surface has is a leaf of the default shape
+// (view-file surfaces, spheres and circles: test_leaf_shapes.cpp).
+TEST(Turtle, CpfgSurfacesWithoutAViewSurfaceAreDefaultLeaves) {
+  const Skeleton k = draw("~l(4)F~l(2)F~(3)~");
+  EXPECT_EQ(k.leaf_scale, (std::vector<double>{4.0, 2.0, 3.0, 1.0}));
+  EXPECT_EQ(k.leaf_segment, (std::vector<int32_t>{-1, 0, 1, 1}));
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>(5, 0)));
+  EXPECT_EQ(k.leaf_triangle_offsets, (std::vector<uint32_t>(5, 0)));
   EXPECT_EQ(k.segment_count(), 2u);
+}
+
+// A view file's surface 'l': tests/data/cpfg/leaf.s, a flat 3 x 3 square with its contact point
+// at a corner, drawn 1.5 long (3 x 2 quads: 12 points).
+TurtleSettings with_test_surface() {
+  TurtleSettings settings;
+  const BezierSurface leaf = read_surface_file(std::string(TREEANIM_SOURCE_DIR) + "/tests/data/cpfg/leaf.s");
+  settings.surfaces.push_back(surface_shape(leaf, 'l', 1.5, 3, 2));
+  return settings;
+}
+
+// Leaf l's points (world) => their offsets from the leaf position in the leaf's (L, H, U).
+std::vector<Vector3d> offsets_in_frame(const Skeleton& k, size_t l) {
+  std::vector<Vector3d> out;
+  for (uint32_t p = k.leaf_polygon_offsets[l]; p < k.leaf_polygon_offsets[l + 1]; ++p) {
+    const Vector3d d = k.polygon_points[p] - k.leaf_position[l];
+    out.emplace_back(d.dot(k.leaf_left[l]), d.dot(k.leaf_heading[l]), d.dot(k.leaf_up[l]));
+  }
+  return out;
+}
+
+// Twice the leaf's area as a vector: its front's direction.
+Vector3d front_of(const Skeleton& k, size_t l) {
+  const Vector3d* p = k.polygon_points.data() + k.leaf_polygon_offsets[l];
+  Vector3d n = Vector3d::Zero();
+  for (uint32_t t = k.leaf_triangle_offsets[l]; t < k.leaf_triangle_offsets[l + 1]; t += 3)
+    n += (p[k.leaf_triangles[t + 1]] - p[k.leaf_triangles[t]]).cross(p[k.leaf_triangles[t + 2]] - p[k.leaf_triangles[t]]);
+  return n;
+}
+
+// ~l(2): the contact point at the turtle, the surface twice its view size, the file's x along L,
+// its heading along H, its front toward U; then the turtle stands at the end point.
+TEST(Turtle, ViewSurfaceIsPlacedByTheTurtleFrame) {
+  const Skeleton k = draw("F+(30)&(20)~l(2)F", with_test_surface());
+  ASSERT_EQ(k.leaf_count(), 1u);
+  EXPECT_EQ(k.leaf_segment[0], 0);
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0, 12}));
+  EXPECT_EQ(k.leaf_triangle_offsets, (std::vector<uint32_t>{0, 36}));
+  const std::vector<Vector3d> d = offsets_in_frame(k, 0);
+  expect_near(d[0], Vector3d::Zero());  // the contact point
+  Vector3d lo = d[0], hi = d[0];
+  for (const Vector3d& v : d) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  expect_near(lo, Vector3d::Zero(), 1e-12);
+  expect_near(hi, Vector3d(3, 3, 0), 1e-12);  // 1.5 x 1.5 scaled by 2, toward +L and +H
+  EXPECT_NEAR(front_of(k, 0).dot(k.leaf_up[0]), 2 * 9.0, 1e-9);
+  expect_near(k.segment_start[1], k.leaf_position[0] + 3 * k.leaf_heading[0], 1e-12);  // the end point
+}
+
+TEST(Turtle, ViewSurfaceScalesPerAxisMirrorsAndSkipsZero) {
+  const Skeleton k = draw("~l(2,1,1)~l(1,1,-1)~l(0)F", with_test_surface());
+  ASSERT_EQ(k.leaf_count(), 2u);  // a zero scale draws nothing, as in cpfg
+  Vector3d hi = Vector3d::Zero();
+  for (const Vector3d& v : offsets_in_frame(k, 0)) hi = hi.cwiseMax(v);
+  expect_near(hi, Vector3d(3, 1.5, 0), 1e-12);
+  EXPECT_GT(front_of(k, 0).dot(k.leaf_up[0]), 0.0);
+  EXPECT_LT(front_of(k, 1).dot(k.leaf_up[1]), 0.0);  // mirrored through the HL plane: its front faces -U
+  // Each surface moved the turtle by its end point, 1.5 along H; ~l(0) did not move it.
+  expect_near(k.segment_start[0], Vector3d(0, 3, 0), 1e-12);
+}
+
+// @O(d) a sphere, @c(d) @o(d) circles: small leaves of the sphere and disc shapes; without a
+// parameter they round a joint and are left out.
+TEST(Turtle, SpheresAndCirclesAreSmallLeavesUnlessTheyRoundAJoint) {
+  const Skeleton k = draw("F@O(2)F@c(0.5)[@o(1)]@O@c@o", {});
+  ASSERT_EQ(k.leaf_count(), 3u);
+  EXPECT_EQ(k.leaf_segment, (std::vector<int32_t>{0, 1, 1}));
+  EXPECT_EQ(k.leaf_polygon_offsets, (std::vector<uint32_t>{0, 6, 15, 24}));
+  EXPECT_EQ(k.leaf_triangle_offsets, (std::vector<uint32_t>{0, 24, 48, 72}));
+  const std::vector<Vector3d> sphere = offsets_in_frame(k, 0);
+  for (const Vector3d& v : sphere) EXPECT_NEAR(v.norm(), 1.0, 1e-12);
+  expect_near(sphere[0], Vector3d(0, -1, 0));  // the pole facing back along H: its attachment
+  const std::vector<Vector3d> circle = offsets_in_frame(k, 1);
+  expect_near(circle[0], Vector3d::Zero());  // the centre: its attachment
+  for (size_t p = 1; p < circle.size(); ++p) {
+    EXPECT_NEAR(circle[p].norm(), 0.25, 1e-12);
+    EXPECT_NEAR(circle[p].z(), 0.0, 1e-12);  // in the HL plane
+  }
+  EXPECT_GT(front_of(k, 1).dot(k.leaf_up[1]), 0.0);
 }
 
 TEST(Turtle, CpfgRollMoveAndHeading) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -33,6 +34,10 @@ class ViewFile : public ::testing::Test {
     std::ofstream(dir_ / name) << text;
     return dir_ / name;
   }
+  // The test surface of tests/data/cpfg (one flat patch), copied in as `name`.
+  void write_surface(const std::string& name) const {
+    fs::copy_file(fs::path(TREEANIM_SOURCE_DIR) / "tests/data/cpfg/leaf.s", dir_ / name);
+  }
   std::string error_of(const std::string& view_text) const {
     try {
       read_view_file(write("plant.v", view_text));
@@ -52,6 +57,7 @@ const char* kLinear = "fver 1 1\nname: grow\nsamples: 5\nflip: off\nrange: 0, 1\
                       "0 0\n0.333333 0.333333\n0.666667 0.666667\n1 1\n";
 
 TEST_F(ViewFile, ReadsTheSettingsThatShapeTheTreeAndPassesRenderingOnes) {
+  write_surface("leaf.s");  // petal.s is missing: cpfg leaves that surface out
   const ViewSettings v = read_view_file(write("plant.v",
                                               "maximum depth: 10\nAngle increment: 22.5\ninitial color: 3\n"
                                               "initial line width: 0.4\nline width increment: 0.05\n"
@@ -63,8 +69,29 @@ TEST_F(ViewFile, ReadsTheSettingsThatShapeTheTreeAndPassesRenderingOnes) {
   ASSERT_TRUE(v.tropism);
   EXPECT_EQ(*v.tropism, Eigen::Vector3d(0, -1, 0));
   EXPECT_EQ(v.tropism_elasticity, 0.2);
-  EXPECT_EQ(v.surfaces, (std::vector<char>{'l', 'p'}));
+  ASSERT_EQ(v.surfaces.size(), 1u);
+  EXPECT_EQ(v.surfaces[0].id, 'l');
+  EXPECT_EQ(v.surfaces[0].scale, 1.0);
+  EXPECT_FALSE(v.surfaces[0].precision);
+  EXPECT_EQ(v.surfaces[0].surface.patches.size(), 1u);
+  EXPECT_EQ(v.surfaces[0].where, (dir_ / "plant.v").string() + ":8:1");
   EXPECT_TRUE(v.functions.empty());
+}
+
+// "surface: id file.s scale [i j] [texture]" (CPFG manual 8.1.5), read as cpfg reads it.
+TEST_F(ViewFile, SurfaceLinesTakeScalePrecisionAndTheFirstOfAnId) {
+  write_surface("leaf.s");
+  const ViewSettings v = read_view_file(write("plant.v", "surface: a leaf.s 2 4 6\nsurface: b leaf.s 0 3\n"
+                                                         "surface: c leaf.s 1.5 20 0.5 7\nsurface: a leaf.s 9\n"
+                                                         "surface: d leaf.s 1 0 0\n"));
+  ASSERT_EQ(v.surfaces.size(), 4u);
+  EXPECT_EQ(v.surfaces[0].scale, 2.0);
+  EXPECT_EQ(v.surfaces[0].precision, (std::array<int, 2>{4, 6}));
+  EXPECT_EQ(v.surfaces[1].scale, 1.0);      // a scale <= 0 is 1, as in cpfg
+  EXPECT_FALSE(v.surfaces[1].precision);    // one number after the scale is a texture
+  EXPECT_FALSE(v.surfaces[2].precision);    // a count below 1 leaves the precision to the file
+  EXPECT_EQ(v.surfaces[3].id, 'd');         // the second 'a' is left out: the first of an id counts
+  EXPECT_FALSE(v.surfaces[3].precision);    // "0 0" leaves it to the file
 }
 
 TEST_F(ViewFile, AngleFactorDividesTheCircleAndWidthsInPixelsAreLeftOut) {
@@ -102,6 +129,11 @@ TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: expected 'T: x,y,z' (non-zero) after 'tropism:'");
   EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: expected a number after 'E:'");
   EXPECT_EQ(error_of("surface: leaf leaf.s 1\n"), "plant.v:1:1: expected a one-letter surface id after 'surface:'");
+  EXPECT_EQ(error_of("surface: l\n"), "plant.v:1:1: expected 'surface: id file.s scale' (the file name after the id)");
+  EXPECT_EQ(error_of("surface: l leaf.s big\n"), "plant.v:1:1: expected 'surface: id file.s scale' (a number after the file name)");
+  write("broken.s", "0 1 0 1 0 0\nCONTACT POINT X: 0 Y: 0\n");
+  EXPECT_EQ(error_of("surface: l broken.s 1\n"),
+            "broken.s:2:24: expected 'CONTACT POINT  X: x Y: y Z: z', got the end of the file");
   EXPECT_EQ(error_of("function: none.func\n"), "none.func: cannot read the function file (no such file)");
   write("bad.func", "fver 1 1\nname: f\npoints: 2\n0 0\n1\n");
   EXPECT_EQ(error_of("\n\nfunction: bad.func\n"), "bad.func:5:1: expected a point 'x y'");

@@ -1,4 +1,4 @@
-// Leaves: default quad, '{ . }' outlines, custom meshes through assimp.
+// Leaves: default quad, '{ . }' outlines, custom meshes through assimp, the turtle's meshes.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -71,6 +71,30 @@ TEST(TreeLeaves, PolygonOutlineIsFanTriangulatedFacingUp) {
   EXPECT_EQ(leaf_triangles, 3u);
   EXPECT_GT(leaf_normal(m, 0).dot(b.sk.leaf_up[0]), 0);
   EXPECT_EQ(m.leaf_attachment_vertex[0], vs[0]);  // nearest the leaf position (0, 1, 0)
+}
+
+// A mesh the turtle placed (a cpfg surface, sphere or circle): its points and triangles as they
+// are, its area the triangles' sum, its attachment the point at the leaf position.
+TEST(TreeLeaves, TurtleMeshKeepsItsTrianglesAndAttachesAtTheLeafPosition) {
+  test::SkeletonBuilder b;
+  const int s = b.segment({0, 0, 0}, {0, 1, 0}, -1, false);
+  const Eigen::Vector3d h(0, 1, 0), left(-1, 0, 0);  // U = (0, 0, 1)
+  // A unit square standing on the leaf position (its second point), two triangles facing U.
+  const std::vector<Eigen::Vector3d> points = {{-0.5, 1, 0}, {0, 1, 0}, {0.5, 1, 0}, {0.5, 2, 0}, {-0.5, 2, 0}};
+  b.leaf(s, {0, 1, 0}, h, left, 1.0, points, {0, 2, 3, 0, 3, 4});
+  TreeOptions o;
+  o.scale = 2.0;
+  const TreeModel m = build_tree_model(b.sk, o);
+  const auto vs = leaf_vertices(m, 0);
+  ASSERT_EQ(vs.size(), 5u);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(Eigen::Vector3d(m.rest_positions.col(vs[i])), 2.0 * points[i]);
+  size_t leaf_triangles = 0;
+  for (size_t t = 0; t < m.triangle_count(); ++t) leaf_triangles += m.vertex_leaf[m.triangles[3 * t]] == 0;
+  EXPECT_EQ(leaf_triangles, 2u);
+  EXPECT_NEAR(leaf_normal(m, 0).z(), 2 * 4.0, 1e-12);  // area 4 m^2 after the scale, facing U
+  EXPECT_EQ(m.leaf_attachment_vertex[0], vs[1]);
+  EXPECT_NEAR(m.cluster_length[m.leaf_cluster[0]], 2.0, 1e-12);  // extent along H
+  EXPECT_NEAR(m.vertex_drag_area[vs[0]] * 5, 4.0, 1e-12);       // the area spread over its 5 points
 }
 
 TEST(TreeLeaves, CustomObjMeshIsInstancedOnEveryLeaf) {

@@ -16,7 +16,10 @@ constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 struct SkeletonBuilder {
   Skeleton sk;
 
-  SkeletonBuilder() { sk.leaf_polygon_offsets = {0}; }
+  SkeletonBuilder() {
+    sk.leaf_polygon_offsets = {0};
+    sk.leaf_triangle_offsets = {0};
+  }
 
   // One segment start => end; continues: same axis as the parent. => segment index.
   int segment(const Eigen::Vector3d& start, const Eigen::Vector3d& end, int parent, bool continues,
@@ -39,10 +42,11 @@ struct SkeletonBuilder {
     return segment(start, start + step, parent, true, width);
   }
 
-  // A leaf at `position` with turtle frame H, L (U = H x L); optional '{ . }' outline.
+  // A leaf at `position` with turtle frame H, L (U = H x L); optional '{ . }' outline, or the
+  // points of a mesh with its triangles (ids into those points).
   int leaf(int seg, const Eigen::Vector3d& position, const Eigen::Vector3d& heading,
            const Eigen::Vector3d& left, double scale = 1.0,
-           const std::vector<Eigen::Vector3d>& outline = {}) {
+           const std::vector<Eigen::Vector3d>& outline = {}, const std::vector<uint32_t>& triangles = {}) {
     sk.leaf_segment.push_back(seg);
     sk.leaf_position.push_back(position);
     sk.leaf_heading.push_back(heading);
@@ -51,6 +55,8 @@ struct SkeletonBuilder {
     sk.leaf_scale.push_back(scale);
     sk.polygon_points.insert(sk.polygon_points.end(), outline.begin(), outline.end());
     sk.leaf_polygon_offsets.push_back(uint32_t(sk.polygon_points.size()));
+    sk.leaf_triangles.insert(sk.leaf_triangles.end(), triangles.begin(), triangles.end());
+    sk.leaf_triangle_offsets.push_back(uint32_t(sk.leaf_triangles.size()));
     return int(sk.leaf_position.size()) - 1;
   }
 };

@@ -1,0 +1,7 @@
+-1 1   0 4   0 0
+PRECISION S: 2 T: 2
+CONTACT POINT  X: 0 Y: 0 Z: 0
+END POINT  X: 0 Y: 4 Z: 0
+HEADING  X: 0 Y: 1 Z: 0
+UP  X: 0 Y: 0 Z: 1
+petal
