@@ -19,6 +19,7 @@ struct ViewSettings {
   std::optional<double> tropism_elasticity;   // "... E: e" or "initial elasticity: e"
   std::vector<char> surfaces;                 // "surface: id file.s ...": ids drawn by ~id as leaves
   std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
+  std::vector<ViewCurve> curves;              // "curve: c.con [samples]", in order (curveX ... curveGAL)
 };
 
 // path => settings; files it names are found beside it. Throws InputError "file:line:col: message".
