@@ -1,7 +1,9 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <sstream>
 #include <span>
 #include <string>
 #include <utility>
@@ -48,12 +50,15 @@ class Deriver {
   }
 
   ModuleString homomorphism(const ModuleString& word) {
-    if (g_.homomorphism.empty()) return word;
+    if (!any_rules(&Lsystem::homomorphism)) return word;
     step_ = settings_.iterations + 1;
     ModuleString out;
-    expand_all(g_.homomorphism, word, kHomomorphism, &out);
+    expand_all(&Lsystem::homomorphism, word, kHomomorphism, &out);
     return out;
   }
+
+  // The global variables ([0] the last srand() argument).
+  std::vector<double>& variables() { return variables_; }
 
   // Adds the step and the rule to a runtime error of an expression.
   [[noreturn]] void rethrow(const EvalError& error) const {
@@ -93,15 +98,26 @@ class Deriver {
     check_cap(*out);
   }
 
+  // Whether some L-system has rules in this section.
+  bool any_rules(RuleSet Lsystem::*section) const {
+    return std::any_of(g_.lsystems.begin(), g_.lsystems.end(), [&](const Lsystem& ls) { return !(ls.*section).empty(); });
+  }
+
   // After productions (or the axiom): decomposition, then cuts.
   ModuleString finish_step(ModuleString word, int step) {
     step_ = step;
-    if (!g_.decomposition.empty()) {
+    if (any_rules(&Lsystem::decomposition)) {
       ModuleString out;
-      expand_all(g_.decomposition, word, kDecomposition, &out);
+      expand_all(&Lsystem::decomposition, word, kDecomposition, &out);
       word = std::move(out);
     }
-    if (g_.productions.any_cut || g_.decomposition.any_cut) cut_branches(&word);
+    if (std::any_of(g_.lsystems.begin(), g_.lsystems.end(),
+                    [](const Lsystem& ls) { return ls.productions.any_cut || ls.decomposition.any_cut; }))
+      cut_branches(&word);
+    if (g_.calls) {  // every call names an L-system (the next step, or the turtle, follows them)
+      enter(0);
+      follow_calls(word, 0, word.size());
+    }
     if (g_.queries) answer(&word);
     return word;
   }
@@ -110,16 +126,17 @@ class Deriver {
   // homomorphism, and every '?' with its letter that the homomorphism leaves as it is takes the
   // value it asks for.
   void answer(ModuleString* word) {
-    if (g_.homomorphism.empty()) return answer_queries(word, turtle_);
+    if (!any_rules(&Lsystem::homomorphism)) return answer_queries(word, turtle_);
     const int step = step_;
     step_ = settings_.iterations + 1;
     ModuleString drawn;
-    expand_all(g_.homomorphism, *word, kHomomorphism, &drawn, &drawn_at_);
+    expand_all(&Lsystem::homomorphism, *word, kHomomorphism, &drawn, &drawn_at_);
     step_ = step;
     answer_queries(&drawn, turtle_);
     for (size_t i = 1; i < word->size(); ++i) {
       const uint32_t d = drawn_at_[i];
-      if (word->symbols[i - 1] != '?' || drawn_at_[i + 1] != d + 1 || drawn_at_[i] != drawn_at_[i - 1] + 1 ||
+      if (word->symbols[i - 1] != '?' || !word->params_of(i - 1).empty() || drawn_at_[i + 1] != d + 1 ||
+          drawn_at_[i] != drawn_at_[i - 1] + 1 ||
           drawn.symbols[d] != word->symbols[i] || drawn.params_of(d).size() != word->params_of(i).size())
         continue;
       std::copy(drawn.params_of(d).begin(), drawn.params_of(d).end(), word->params.begin() + word->param_offsets[i]);
@@ -151,27 +168,64 @@ class Deriver {
     next->symbols.reserve(expected);
     next->param_offsets.reserve(expected + 1);
     next->params.reserve(std::min(word.params.size() * 2, expected * 4));
-    const RuleSet& set = g_.productions;
-    if (set.any_context) match_brackets(word);
+    if (std::any_of(g_.lsystems.begin(), g_.lsystems.end(), [](const Lsystem& ls) { return ls.productions.any_context; }))
+      match_brackets(word);
     word_ = &word;
+    if (g_.calls) rewrite_modules<true>(word, next);
+    else rewrite_modules<false>(word, next);
+    word_ = nullptr;
+  }
+
+  // The modules of word rewritten in order; with kCalls, those between a call '?(label, s)' and
+  // its '$' by the productions of L-system `label` (CPFG manual 7.2).
+  template <bool kCalls>
+  void rewrite_modules(const ModuleString& word, ModuleString* next) {
+    enter(0);
+    const RuleSet* set = &ls_->productions;
     double slots[kMaxSlots];
     for (size_t i = 0; i < word.size(); ++i) {
       const auto s = static_cast<unsigned char>(word.symbols[i]);
-      if (set.first_rule[s] == set.first_rule[s + 1]) {
+      if (set->first_rule[s] == set->first_rule[s + 1]) {
         copy_module(word, i, next);
+        if constexpr (kCalls) set = &follow_calls(word, i, 1)->productions;
         continue;
       }
       RandomStream random = RandomStream::keyed(seed(), kProduction, static_cast<uint64_t>(step_), i);
-      const Rule* rule = select(set, word.symbols[i], word.params_of(i), i, slots, random);
-      if (rule) {
-        emit_successor(set, *rule, slots, random, next);
-        i += rule->length() - 1;
-      } else {
-        copy_module(word, i, next);
-      }
+      const Rule* rule = select(*set, word.symbols[i], word.params_of(i), i, slots, random);
+      const size_t used = rule ? rule->length() : 1;
+      if (rule) emit_successor(*set, *rule, slots, random, next);
+      else copy_module(word, i, next);
+      if constexpr (kCalls) set = &follow_calls(word, i, used)->productions;
+      i += used - 1;
       if (next->size() > settings_.max_modules) check_cap(*next);
     }
-    word_ = nullptr;
+  }
+
+  // The L-system `index` is the only one called; => it.
+  const Lsystem* enter(uint32_t index) {
+    calls_.assign(1, index);
+    return ls_ = &g_.lsystems[index];
+  }
+
+  // Modules [i, i + count) of word passed: a call '?(label, s)' makes L-system `label` current,
+  // a '$' returns to its caller (one without a call is passed over, as cpfg does). => the
+  // current L-system.
+  const Lsystem* follow_calls(const ModuleString& word, size_t i, size_t count) {
+    for (size_t k = i; k < i + count; ++k) {
+      if (word.symbols[k] == '$' && calls_.size() > 1) calls_.pop_back();
+      if (word.symbols[k] != '?' || word.params_of(k).empty()) continue;
+      const double label = word.params_of(k)[0];
+      const int index = g_.lsystem_index(label);
+      if (index < 0) {
+        std::ostringstream value;
+        value << label;
+        throw InputError(g_.sources.at(0) + ": '?(" + value.str() + ", ...)' calls L-system " + value.str() + " " +
+                         (step_ == 0 ? std::string("in the axiom") : "while deriving step " + std::to_string(step_)) +
+                         ", but the file has no 'lsystem: " + value.str() + "'");
+      }
+      calls_.push_back(static_cast<uint32_t>(index));
+    }
+    return ls_ = &g_.lsystems[calls_.back()];
   }
 
   // match_[k] for every bracket of word: the index of its partner.
@@ -275,17 +329,24 @@ class Deriver {
   }
 
   // Left context: walks left, skipping complete branches (']' ... '[') and climbing out of the
-  // current branch ('['), passing over ignored symbols.
+  // current branch ('['), passing over ignored symbols; in a ring L-system the string's start
+  // goes on at its end (CPFG manual 3.1.1), at most one turn per pattern module.
   bool match_left(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
     const ModuleString& w = *word_;
+    const std::array<bool, 256>& skips = ls_->context_skips;
     ptrdiff_t j = static_cast<ptrdiff_t>(index) - 1;
+    uint32_t turns = 0;
     for (uint32_t p = rule.left_end; p-- > rule.left_begin;) {
       const PatternModule& pattern = set.patterns[p];
       for (;;) {
-        if (j < 0) return false;
+        if (j < 0) {
+          if (!ls_->ring || ++turns > rule.left_end - rule.left_begin) return false;
+          j = static_cast<ptrdiff_t>(w.size()) - 1;
+          continue;
+        }
         const char c = w.symbols[static_cast<size_t>(j)];
         if (c == ']') j = match_[static_cast<size_t>(j)] - 1;
-        else if (c == '[' || g_.context_skips[static_cast<unsigned char>(c)]) --j;
+        else if (c == '[' || skips[static_cast<unsigned char>(c)]) --j;
         else break;
       }
       const auto k = static_cast<size_t>(j);
@@ -298,10 +359,14 @@ class Deriver {
 
   // Right context: walks right, skipping lateral branches and ignored symbols, failing at the
   // end of the current branch (']'); pattern brackets enter a branch ('[') or leave it (']').
+  // An ignored '[' is entered and an ignored ']' passed (cpfg); a ring L-system's end goes on
+  // at its start.
   bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
     const ModuleString& w = *word_;
+    const std::array<bool, 256>& skips = ls_->context_skips;
     const size_t n = w.size();
     size_t j = index + rule.length();
+    uint32_t turns = 0;
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
       if (pattern.symbol == ']' || pattern.symbol == '=') {  // '=' (cpfg): to the branch's end, before its ']'
@@ -312,11 +377,15 @@ class Deriver {
         continue;
       }
       for (;;) {
-        if (j >= n) return false;
+        if (j >= n) {
+          if (!ls_->ring || ++turns > rule.right_end - rule.right_begin) return false;
+          j = 0;
+          continue;
+        }
         const char c = w.symbols[j];
-        if (c == '[' && pattern.symbol != '[') j = static_cast<size_t>(match_[j]) + 1;
-        else if (c == ']') return false;
-        else if (c != '[' && g_.context_skips[static_cast<unsigned char>(c)]) ++j;
+        if (c == '[' && pattern.symbol != '[') j = skips['['] ? j + 1 : static_cast<size_t>(match_[j]) + 1;
+        else if (c == ']' && !skips[']']) return false;
+        else if (c != '[' && skips[static_cast<unsigned char>(c)]) ++j;
         else break;
       }
       if (w.symbols[j] != pattern.symbol || w.params_of(j).size() != pattern.arity) return false;
@@ -339,20 +408,23 @@ class Deriver {
     }
   }
 
-  // Context-free rules applied recursively (up to set.max_depth) to every module: word => *out.
-  // at, when given: (word size + 1) where each module's expansion starts in *out (the modules
-  // a strict predecessor of several replaces start where the next one does).
-  void expand_all(const RuleSet& set, const ModuleString& word, Purpose purpose, ModuleString* out,
+  // Context-free rules of a section applied recursively (up to its max_depth) to every module,
+  // each with its L-system's rules: word => *out. at, when given: (word size + 1) where each
+  // module's expansion starts in *out (the modules a strict predecessor of several replaces
+  // start where the next one does).
+  void expand_all(RuleSet Lsystem::*section, const ModuleString& word, Purpose purpose, ModuleString* out,
                   std::vector<uint32_t>* at = nullptr) {
     out->clear();
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
     if (at) at->assign(word.size() + 1, 0);
+    const RuleSet* set = &(enter(0)->*section);
     for (size_t i = 0; i < word.size();) {
       RandomStream random = RandomStream::keyed(seed(), purpose, static_cast<uint64_t>(step_), i);
-      const size_t used = expand(set, word, i, random, out);
+      const size_t used = expand(*set, word, i, random, out);
       if (at) std::fill(at->begin() + static_cast<std::ptrdiff_t>(i) + 1, at->begin() + static_cast<std::ptrdiff_t>(i + used) + 1,
                         static_cast<uint32_t>(out->size()));
+      if (g_.calls) set = &(follow_calls(word, i, used)->*section);
       i += used;
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
@@ -446,6 +518,8 @@ class Deriver {
   int step_ = 0;
   const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
   const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
+  const Lsystem* ls_ = nullptr;         // the L-system rewriting the current module (its contexts' skips, ring)
+  std::vector<uint32_t> calls_;         // indices of the L-systems called at the current module, innermost last
   std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere
   std::vector<double> weights_;         // stochastic candidates' weights
   std::vector<const Rule*> chosen_;     // stochastic candidates
@@ -460,18 +534,22 @@ class Deriver {
 
 }  // namespace
 
-ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle) {
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle,
+                    std::vector<double>* variables) {
   Deriver deriver(grammar, settings, turtle);
   try {
-    return deriver.derive();
+    ModuleString word = deriver.derive();
+    if (variables) *variables = deriver.variables();
+    return word;
   } catch (const EvalError& error) {
     deriver.rethrow(error);
   }
 }
 
 ModuleString apply_homomorphism(const Grammar& grammar, const ModuleString& word,
-                                const DerivationSettings& settings) {
+                                const DerivationSettings& settings, const std::vector<double>* variables) {
   Deriver deriver(grammar, settings);
+  if (variables) deriver.variables() = *variables;
   try {
     return deriver.homomorphism(word);
   } catch (const EvalError& error) {

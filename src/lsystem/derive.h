@@ -3,6 +3,7 @@
 // contexts, stochastic choice, decomposition after every step, homomorphism on demand.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "lsystem/grammar.h"
 #include "lsystem/module_string.h"
@@ -22,12 +23,15 @@ struct DerivationSettings {
 // after the axiom and after every step, and they take their values (CPFG manual 6.9).
 // Throws InputError at the module cap and on runtime errors (division by zero...), naming the
 // step and the production.
-// `turtle` is the one that answers the query modules.
-ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {});
+// `turtle` is the one that answers the query modules. `variables`, when given, receives the
+// global variables as the End block leaves them (the homomorphism reads them).
+ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {},
+                    std::vector<double>* variables = nullptr);
 
 // word => word with the homomorphism rules applied (what the turtle reads; the derivation
-// never sees it). Throws InputError like derive.
+// never sees it), its expressions reading `variables` (derive's; when null, their values
+// before the Start block). Throws InputError like derive.
 ModuleString apply_homomorphism(const Grammar& grammar, const ModuleString& word,
-                                const DerivationSettings& settings);
+                                const DerivationSettings& settings, const std::vector<double>* variables = nullptr);
 
 }  // namespace treeanim

@@ -30,7 +30,7 @@ struct Function {
 };
 
 // The cpfg manual's function library (chapter 5), plus abs, min and max.
-constexpr std::array<Function, 26> kFunctions{{
+constexpr std::array<Function, 30> kFunctions{{
     {"sin", Op::kSin, 1},   {"cos", Op::kCos, 1},     {"tan", Op::kTan, 1},
     {"asin", Op::kAsin, 1}, {"acos", Op::kAcos, 1},   {"atan", Op::kAtan, 1},
     {"atan2", Op::kAtan2, 2}, {"sqrt", Op::kSqrt, 1}, {"exp", Op::kExp, 1},
@@ -39,7 +39,8 @@ constexpr std::array<Function, 26> kFunctions{{
     {"ceil", Op::kCeil, 1}, {"trunc", Op::kTrunc, 1}, {"sign", Op::kSign, 1},
     {"pow", Op::kPow, 2},   {"func", Op::kFunc, 2},   {"ran", Op::kRan, 1},
     {"nran", Op::kNran, 2}, {"bran", Op::kBran, 2},   {"biran", Op::kBiran, 2},
-    {"srand", Op::kSrand, 1}, {"fmod", Op::kRem, 2},
+    {"srand", Op::kSrand, 1}, {"fmod", Op::kRem, 2},   {"curveX", Op::kCurve, 2},
+    {"curveY", Op::kCurve, 2}, {"curveZ", Op::kCurve, 2}, {"curveGAL", Op::kCurveLength, 1},
 }};
 
 // Operands an instruction pops.
@@ -466,17 +467,24 @@ class Compiler {
     if (count != function->arity)
       fail(start, name + " expects " + plural(function->arity, "argument") + ", got " +
                       std::to_string(count));
-    emit(function->op, function->op == Op::kFunc ? function_number(first_argument_end, start) : 0, start);
+    uint32_t arg = 0;
+    if (function->op == Op::kFunc) arg = view_number(first_argument_end, start, name, program_.functions.size(), "function:");
+    if (function->op == Op::kCurveLength) arg = view_number(first_argument_end, start, name, program_.curves.size(), "curve:");
+    if (function->op == Op::kCurve)  // curveX, curveY, curveZ: coordinate 0, 1, 2 of the curve
+      arg = 3 * view_number(first_argument_end, start, name, program_.curves.size(), "curve:") +
+            static_cast<uint32_t>(name.back() - 'X');
+    emit(function->op, arg, start);
   }
-  // func(id, x): id, the code ending at first_argument_end, must be a constant numbering one
-  // of the view file's functions (or its name, parse_name) => its index.
-  uint32_t function_number(size_t first_argument_end, size_t start) const {
+  // func(id, x), curveX(id, t)...: id, the code ending at first_argument_end, must be a constant
+  // numbering one of the view file's `count` functions (or a function's name, parse_name) or
+  // curves => its index.
+  uint32_t view_number(size_t first_argument_end, size_t start, const std::string& name, size_t count,
+                       const char* lines) const {
     const Instruction id = program_.code[first_argument_end - 1];
     const double value = id.op == Op::kConst ? program_.constants[id.arg] : -1.0;
-    const size_t count = program_.functions.size();
     if (id.op != Op::kConst || value != std::floor(value) || value < 1 || value > double(count))
-      fail(start, "func expects a constant function number 1 ... " + std::to_string(count) +
-                      " (the view file's 'function:' lines" + (count ? ")" : ": it has none)"));
+      fail(start, name + " expects a constant number 1 ... " + std::to_string(count) + " (the view file's '" + lines +
+                      "' lines" + (count ? ")" : ": it has none)"));
     return static_cast<uint32_t>(value) - 1;
   }
 
@@ -668,6 +676,14 @@ Expr compile_expression(ExprProgram& program, std::string_view text, size_t* pos
   return expr;
 }
 
+Expr constant_expression(ExprProgram& program, double value, SourcePos pos) {
+  program.constants.push_back(value);
+  const auto begin = static_cast<uint32_t>(program.code.size());
+  program.code.push_back({Op::kConst, static_cast<uint32_t>(program.constants.size() - 1)});
+  program.code_pos.push_back(pos);
+  return {begin, begin + 1, pos};
+}
+
 Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, const TextOrigin& line,
                    const StatementScope& scope) {
   const ExprScope names{scope.locals, scope.defines, scope.globals};
@@ -733,6 +749,8 @@ namespace {
       case Op::kTrunc: stack[top] = std::trunc(b); break;
       case Op::kSign: stack[top] = b > 0.0 ? 1.0 : (b < 0.0 ? -1.0 : 0.0); break;
       case Op::kFunc: a = sample_function(program.functions[in.arg].samples, b); --top; break;
+      case Op::kCurve: a = program.curves[in.arg / 3].at(b)[in.arg % 3]; --top; break;
+      case Op::kCurveLength: stack[top] = program.curves[in.arg].length; break;
       case Op::kRan: stack[top] = random.uniform() * b; break;
       case Op::kNran: a = a + b * random.normal(); --top; break;
       case Op::kBran: {

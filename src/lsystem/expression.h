@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "lsystem/view_curve.h"
+
 namespace treeanim {
 
 // A place in a grammar source. line 0 marks a one-line source (an inline scene rule),
@@ -63,6 +65,7 @@ enum class Op : uint8_t {
   kSqrt, kExp, kLog, kAbs, kMin, kMax, kFloor, kCeil,
   kRem, kTrunc, kSign,                             // C's fmod, trunc; sign: -1, 0, 1
   kFunc,                                           // view-file function functions[arg] at x
+  kCurve, kCurveLength,                            // curves[arg / 3] coordinate arg % 3 at t; curves[arg] length
   kRan, kNran, kBran, kBiran, kSrand,              // random: never folded
   kLoadVar, kStoreVar, kStoreParam, kPop,          // variables[arg], formals[arg] (statements)
   kIndex, kLoadElem, kStoreElem,                   // array index < arg; variables[arg + index]
@@ -102,6 +105,7 @@ struct ExprProgram {
   std::vector<SourcePos> code_pos;   // (instructions) the operator's place, for runtime errors
   std::vector<double> constants;     // (constants)
   std::vector<SampledFunction> functions;  // func(id, x): the view file's functions, id 1, 2, ...
+  std::vector<ViewCurve> curves;     // curveX(id, t) ... curveGAL(id): the view file's curves, id 1, 2, ...
   std::vector<ArrayDecl> arrays;     // names the compiler resolves to array elements
   // expr => true when it is one constant (its value in *value).
   bool is_constant(const Expr& expr, double* value) const;
@@ -139,6 +143,9 @@ constexpr int kMaxExprStack = 32;
 // Throws GrammarError.
 Expr compile_expression(ExprProgram& program, std::string_view text, size_t* pos,
                         const TextOrigin& line, const ExprScope& scope);
+
+// value => an expression that is this constant (a string parameter's number).
+Expr constant_expression(ExprProgram& program, double value, SourcePos pos);
 
 // text at *pos = '{' => the block "{ statement ... }" compiled (cpfg manual 3.2: assignments
 // "name = expression;", "if (c) {...} [else {...}]", "while (c) {...}", "do {...} while (c);",

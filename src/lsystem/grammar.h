@@ -71,6 +71,18 @@ struct RuleSet {
   bool empty() const { return rules.empty(); }
 };
 
+// One L-system of a file ("lsystem: N" ... "endlsystem"). The first one in the file is derived;
+// the others are sub-L-systems, whose productions rewrite the modules between a call
+// '?(N, scale)' and its '$' (CPFG manual 7.2).
+struct Lsystem {
+  int label = 0;                           // N of its "lsystem: N" line (0 without one, or a name)
+  std::array<bool, 256> context_skips{};   // symbols passed over when matching contexts
+  bool ring = false;                       // "ring lsystem": contexts wrap around the string's ends (3.1.1)
+  RuleSet productions;
+  RuleSet decomposition;
+  RuleSet homomorphism;
+};
+
 struct Grammar {
   std::vector<std::string> sources;   // names of the texts (file path, or <scene>/lsystem/...)
   ExprProgram program;                // code of every expression
@@ -88,11 +100,12 @@ struct Grammar {
   Expr start_block, start_each_block, end_each_block, end_block;  // cpfg control blocks (manual 4.1)
   std::optional<Eigen::Vector3d> tropism;  // T of "tropism:"
   double tropism_elasticity = 0.0;         // e of "tropism:"
-  std::array<bool, 256> context_skips{};   // symbols passed over when matching contexts
   bool queries = false;                    // the axiom or a production writes ?P ?H ?U or ?L
-  RuleSet productions;
-  RuleSet decomposition;
-  RuleSet homomorphism;
+  bool calls = false;                      // the axiom or a successor calls a sub-L-system ('?(N, s)')
+  std::vector<Lsystem> lsystems{1};        // (L) in file order: [0] is derived, the rest are sub-L-systems
+
+  // Index in lsystems of the first "lsystem: label" (label truncated, as cpfg does), or -1.
+  int lsystem_index(double label) const;
 
   // "file:line:column" or "name:column" of a place.
   std::string where(const SourcePos& pos) const;
@@ -108,10 +121,11 @@ struct GrammarText {
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError
 // "name:line:column: message".
-// `functions` are the view file's, for func(id, x) (id a number or a function's name). A file's #include is read beside it.
+// `functions` and `curves` are the view file's, for func(id, x) (id a number or a function's
+// name) and curveX(id, t)... A file's #include is read beside it.
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text = std::nullopt,
-                      std::vector<SampledFunction> functions = {});
+                      std::vector<SampledFunction> functions = {}, std::vector<ViewCurve> curves = {});
 
 }  // namespace treeanim

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <sstream>
 
 #include "common/errors.h"
 #include "common/did_you_mean.h"
@@ -29,7 +30,7 @@ const std::vector<std::string> kValueDirectives = {
     "axiom", "derivation length", "angle", "seed", "ignore", "consider",
     "tropism", "maximum depth", "width factor", "lsystem", "start", "starteach", "end", "endeach",
     "define"};
-const std::vector<std::string> kSectionDirectives = {"homomorphism", "decomposition", "endlsystem"};
+const std::vector<std::string> kSectionDirectives = {"homomorphism", "decomposition", "endlsystem", "ring lsystem"};
 
 bool same_letters(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
@@ -110,7 +111,30 @@ class Parser {
   // Checks what needs the whole grammar, then indexes the rules.
   void finish() {
     if (!axiom_seen_) throw GrammarError{first_pos_, "expected an 'axiom:' line; the grammar has none"};
-    for (RuleSet* set : {&g_.productions, &g_.decomposition, &g_.homomorphism}) set->index();
+    for (Lsystem& ls : g_.lsystems) {
+      for (RuleSet* set : {&ls.productions, &ls.decomposition, &ls.homomorphism}) {
+        set->index();
+        check_calls(set->successor, set->successor_params);
+      }
+    }
+    check_calls(g_.axiom, g_.axiom_params);
+  }
+
+  // Every call '?(label, s)' whose label is a constant names an L-system of the file.
+  void check_calls(const std::vector<SuccessorModule>& modules, const std::vector<Expr>& params) const {
+    if (!g_.calls) return;
+    for (const SuccessorModule& m : modules) {
+      double label = 0;
+      if (m.symbol != '?' || m.arity == 0 || !g_.program.is_constant(params[m.first_param], &label) ||
+          g_.lsystem_index(label) >= 0)
+        continue;
+      std::string labels;
+      for (const Lsystem& ls : g_.lsystems) labels += (labels.empty() ? "" : ", ") + std::to_string(ls.label);
+      std::ostringstream value;
+      value << label;
+      throw GrammarError{m.pos, "'?(" + value.str() + ", ...)' calls L-system " + value.str() +
+                                    ", but the file has no 'lsystem: " + value.str() + "' (it has " + labels + ")"};
+    }
   }
 
  private:
@@ -122,13 +146,16 @@ class Parser {
   [[noreturn]] static void fail(const TextOrigin& line, size_t index, const std::string& message) {
     throw GrammarError{at_column(line, index), message};
   }
+  // The L-system being read (the last "lsystem:") and its section.
+  Lsystem& lsystem() { return g_.lsystems.back(); }
+  bool in_sub_lsystem() const { return g_.lsystems.size() > 1; }
   RuleSet& current() {
     switch (section_) {
-      case Section::kDecomposition: return g_.decomposition;
-      case Section::kHomomorphism: return g_.homomorphism;
+      case Section::kDecomposition: return lsystem().decomposition;
+      case Section::kHomomorphism: return lsystem().homomorphism;
       case Section::kProductions: break;
     }
-    return g_.productions;
+    return lsystem().productions;
   }
 
   // A file #included by `from`, found beside it.
@@ -168,9 +195,19 @@ class Parser {
   }
 
   void feed(const SourceLine& line) {
-    if (ended_) return;
     size_t begin = 0, end = line.text.size();
     trim(line.text, &begin, &end);
+    // After "endlsystem" only the next "lsystem:" (a sub-L-system, CPFG manual 7.2) is read;
+    // it is always a statement of its own.
+    size_t value = 0;
+    const bool opens = match_keyword(line.text, begin, end, "lsystem", true, &value);
+    if (ended_ && !opens) return;
+    if (opens) {
+      flush();
+      pending_ = line;
+      flush();
+      return;
+    }
     if (begin == end) {  // a blank line ends a statement, unless it has open parentheses or blocks
       if (!open_nesting(pending_.text)) flush();
       return;
@@ -219,12 +256,13 @@ class Parser {
     size_t end = text.size();
     size_t begin = 0;
     trim(text, &begin, &end);
-    if (begin == end || ended_) return;
+    size_t value = 0;
+    if (ended_ && !match_keyword(text, begin, end, "lsystem", true, &value)) return;
+    ended_ = false;
+    if (begin == end) return;
     if (parse_directive(text, begin, end, line)) return;
     const size_t arrow = find_arrow(text, begin, end);
     if (arrow != kNone) return parse_rule(text, begin, arrow, end, line);
-    if (same_letters(text.substr(begin, end - begin), "ring lsystem"))
-      fail(line, begin, "ring L-systems ('ring lsystem') are not supported (CPFG manual 3.1.1)");
     report_non_rule(text, begin, end, line);
   }
 
@@ -283,12 +321,14 @@ class Parser {
       while (rest < end && is_space(text[rest])) ++rest;
       // cpfg's "homomorphism: warnings" / "no warnings" only choose messages (manual 4.3.1).
       const std::string_view option = text.substr(rest, end - rest);
-      if (rest < end && keyword != "endlsystem" && (same_letters(option, "warnings") || same_letters(option, "no warnings")))
+      const bool section = keyword == "homomorphism" || keyword == "decomposition";
+      if (rest < end && section && (same_letters(option, "warnings") || same_letters(option, "no warnings")))
         rest = end;
       if (rest < end) fail(line, rest, "expected nothing after '" + keyword + "'" +
-                                           (keyword == "endlsystem" ? "" : " (or ': warnings', ': no warnings')"));
+                                           (section ? " (or ': warnings', ': no warnings')" : ""));
       if (keyword == "homomorphism") section_ = Section::kHomomorphism;
       else if (keyword == "decomposition") section_ = Section::kDecomposition;
+      else if (keyword == "ring lsystem") lsystem().ring = true;
       else ended_ = true;
       return true;
     }
@@ -300,15 +340,21 @@ class Parser {
       trim(text, &vbegin, &vend);
       if (vbegin == vend && keyword != "ignore" && keyword != "consider")
         fail(line, value, "expected a value after '" + keyword + ":'");
+      // A sub-L-system's derivation length and seed are the first L-system's (CPFG manual 7.2).
+      const bool first = !in_sub_lsystem();
       if (keyword == "start" || keyword == "starteach" || keyword == "end" || keyword == "endeach")
-        parse_control_block(text, vbegin, vend, line, keyword);
+        parse_control_block(text, vbegin, vend, line, keyword, begin);
       else if (keyword == "define") parse_arrays(text, vbegin, vend, line);
       else if (keyword == "axiom") set_axiom(text, vbegin, vend, line, at_column(line, begin));
-      else if (keyword == "derivation length") g_.derivation_length = integer_value(text, vbegin, vend, line, 0, 100000);
-      else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
+      else if (keyword == "derivation length") {
+        const auto length = static_cast<int>(integer_value(text, vbegin, vend, line, 0, 100000));
+        if (first) g_.derivation_length = length;
+      } else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
       else if (keyword == "width factor") g_.width_factor = constant_value(text, vbegin, vend, line);
-      else if (keyword == "seed") g_.seed = static_cast<uint64_t>(integer_value(text, vbegin, vend, line, 0, 1LL << 53));
-      else if (keyword == "lsystem") lsystem_label(text, vbegin, vend, line);
+      else if (keyword == "seed") {
+        const auto seed = static_cast<uint64_t>(integer_value(text, vbegin, vend, line, 0, 1LL << 53));
+        if (first) g_.seed = seed;
+      } else if (keyword == "lsystem") lsystem_label(text, vbegin, vend, line);
       else if (keyword == "maximum depth") current().max_depth = static_cast<int>(integer_value(text, vbegin, vend, line, 1, kMaxDepth));
       else if (keyword == "tropism") parse_tropism(text, vbegin, vend, line);
       else parse_skips(text, vbegin, vend, line, keyword == "consider", begin);
@@ -358,20 +404,20 @@ class Parser {
     g_.tropism_elasticity = values[3];
   }
 
-  // "ignore: symbols" or "consider: symbols".
+  // "ignore: symbols" or "consider: symbols". Brackets may be among them (a skipped '[' or ']'
+  // changes right contexts only, as in cpfg; see docs/grammar.md).
   void parse_skips(std::string_view text, size_t begin, size_t end, const TextOrigin& line, bool consider,
                    size_t directive) {
+    std::array<bool, 256>& skips = lsystem().context_skips;
     if (skips_kind_ != 0 && skips_kind_ != (consider ? 2 : 1))
       fail(line, directive, "'ignore:' and 'consider:' cannot both be given");
-    if (skips_kind_ == 0 && consider) g_.context_skips.fill(true);
+    if (skips_kind_ == 0 && consider) skips.fill(true);
     skips_kind_ = consider ? 2 : 1;
     for (size_t k = begin; k < end; ++k) {
       const char c = text[k];
       if (is_space(c)) continue;
-      if ((c == '[' || c == ']') && consider) continue;  // cpfg lists them; matching always follows them
-      if (c == '[' || c == ']') fail(line, k, "brackets cannot be ignored: context matching always follows them");
       if (!std::isgraph(static_cast<unsigned char>(c))) fail(line, k, "expected module symbols (printable ASCII)");
-      g_.context_skips[static_cast<unsigned char>(c)] = !consider;
+      skips[static_cast<unsigned char>(c)] = !consider;
     }
   }
 
@@ -500,16 +546,31 @@ class Parser {
     return end;
   }
 
-  // "Lsystem: label": a number or a name (used by sub-L-systems, which are not supported).
+  // "Lsystem: label": a number or a name (cpfg reads a name as 0). The first one labels the
+  // L-system that is derived; each later one starts a sub-L-system (CPFG manual 7.2).
   void lsystem_label(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     for (size_t k = begin; k < end; ++k)
       if (!std::isalnum(static_cast<unsigned char>(text[k])) && text[k] != '_')
         fail(line, k, "expected a label (a number or a name) after 'lsystem:'");
+    if (labelled_) {
+      g_.lsystems.emplace_back();
+      section_ = Section::kProductions;
+      skips_kind_ = 0;
+      sub_axiom_seen_ = false;
+    }
+    labelled_ = true;
+    int label = 0;
+    for (size_t k = begin; k < end && std::isdigit(static_cast<unsigned char>(text[k])) && label < 100'000'000; ++k)
+      label = label * 10 + (text[k] - '0');
+    lsystem().label = label;
   }
 
   // "Start: { statements }" (also StartEach, EndEach, End), an optional ';' after it.
   void parse_control_block(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
-                           const std::string& keyword) {
+                           const std::string& keyword, size_t directive) {
+    if (in_sub_lsystem())
+      fail(line, directive, "a sub-L-system's '" + keyword + ":' block is not supported (cpfg gives each call of a "
+                            "sub-L-system its own copy of the variables, CPFG manual 7.2)");
     if (text[begin] != '{') fail(line, begin, "expected '{' after '" + keyword + ":'");
     const StatementScope scope{nullptr, &g_.variables, true, &g_.defines};
     size_t pos = begin;
@@ -522,13 +583,20 @@ class Parser {
     else g_.end_block = block;
   }
 
+  // A sub-L-system's axiom is read and not used (CPFG manual 7.2: it runs only on its own).
   void set_axiom(std::string_view text, size_t begin, size_t end, const TextOrigin& line, SourcePos directive) {
-    if (axiom_seen_) throw GrammarError{directive, "a second 'axiom:'; the grammar has one already"};
-    axiom_seen_ = true;
+    bool& seen = in_sub_lsystem() ? sub_axiom_seen_ : axiom_seen_;
+    if (seen)
+      throw GrammarError{directive, std::string("a second 'axiom:'; the ") + (in_sub_lsystem() ? "sub-L-system" : "grammar") +
+                                        " has one already"};
+    seen = true;
     const std::vector<std::string> no_formals;
-    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines, &g_.variables}, &g_.axiom, &g_.axiom_params,
-               "axiom");
-    if (g_.axiom.empty()) fail(line, begin, "expected at least one module in the axiom");
+    std::vector<SuccessorModule> sub_axiom;
+    std::vector<Expr> sub_params;
+    std::vector<SuccessorModule>* axiom = in_sub_lsystem() ? &sub_axiom : &g_.axiom;
+    parse_word(text, begin, end, line, ExprScope{&no_formals, &g_.defines, &g_.variables}, axiom,
+               in_sub_lsystem() ? &sub_params : &g_.axiom_params, "axiom");
+    if (axiom->empty()) fail(line, begin, "expected at least one module in the axiom");
   }
 
   // Modules with actual parameters in text[begin, end) => appended to modules/params.
@@ -537,11 +605,16 @@ class Parser {
                   std::vector<SuccessorModule>* modules, std::vector<Expr>* params, const char* what) {
     std::vector<size_t> open;  // positions of unclosed '['
     const std::string_view word = text.substr(0, end);
+    char previous = 0;  // the module before
     for (size_t k = begin; k < end;) {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
       check_symbol(text, k, line, what);
-      if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
+      if (c == '?' && is_call(text, k, end)) g_.calls = true;
+      else if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
+      // @L("label", ...), @S("command") and @I("object", s) take a string first (CPFG manual 6.10, 9.4, 9.5).
+      const bool takes_string = previous == '@' && (c == 'L' || c == 'S' || c == 'I');
+      previous = c;
       if (c == '[') open.push_back(k);
       if (c == ']') {
         if (open.empty()) fail(line, k, "unbalanced brackets: ']' closes no '[' in the " + std::string(what));
@@ -553,7 +626,19 @@ class Parser {
         if (c == '[' || c == ']') fail(line, k, "brackets take no parameters");
         for (;;) {
           ++k;
-          params->push_back(compile_expression(g_.program, word, &k, line, scope));
+          while (k < end && is_space(text[k])) ++k;
+          if (k < end && text[k] == '"') {
+            if (!takes_string || module.arity > 0)
+              fail(line, k, "a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
+            const size_t quote = k;
+            for (++k; k < end && text[k] != '"'; ++k) k += text[k] == '\\' ? 1 : 0;
+            if (k >= end) fail(line, quote, "the string is never closed (expected '\"')");
+            ++k;
+            // Its value is its number in the file, as cpfg numbers strings; nothing reads the text.
+            params->push_back(constant_expression(g_.program, static_cast<double>(strings_++), at_column(line, quote)));
+          } else {
+            params->push_back(compile_expression(g_.program, word, &k, line, scope));
+          }
           if (module.arity == 255) fail(line, k, "more than 255 parameters in one module");
           ++module.arity;
           while (k < end && is_space(text[k])) ++k;
@@ -574,12 +659,16 @@ class Parser {
                                   std::string(what) + ")");
   }
 
+  // '?' at text[k] with parameters: a call of a sub-L-system '?(label, scale)' (CPFG manual 7.2).
+  static bool is_call(std::string_view text, size_t k, size_t end) {
+    const size_t p = parameters_at(text, k + 1, end);
+    return p < end && text[p] == '(';
+  }
+
   // '?' at text[k]: true for a query module ?P ?H ?U ?L (CPFG manual 6.9); a lone '?' is a
-  // module like any other; sub-L-systems and ?E are refused.
+  // module like any other; ?E is refused.
   static bool is_query(std::string_view text, size_t k, size_t end, const TextOrigin& line) {
     const char next = k + 1 < end ? text[k + 1] : ' ';
-    if (next == '(')
-      fail(line, k, "sub-L-systems ('?(id, scale) ... $') are not supported (CPFG manual 7.2)");
     if (next == 'E')
       fail(line, k, "'?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
     return next == 'P' || next == 'H' || next == 'U' || next == 'L';
@@ -779,6 +868,9 @@ class Parser {
   Section section_ = Section::kProductions;
   int skips_kind_ = 0;  // 0 none, 1 ignore:, 2 consider:
   bool axiom_seen_ = false;
+  bool sub_axiom_seen_ = false;  // the current sub-L-system has its axiom
+  uint32_t strings_ = 0;         // string parameters read so far
+  bool labelled_ = false;        // an "lsystem:" line was read
   bool ended_ = false;  // after "endlsystem"
   SourcePos first_pos_;  // the first text's start, for errors about what is missing
   SourceLine pending_;   // the statement being joined from lines
@@ -797,6 +889,12 @@ void RuleSet::index() {
   for (uint32_t r = 0; r < rules.size(); ++r) rule_order[next[static_cast<unsigned char>(rules[r].predecessor)]++] = r;
 }
 
+int Grammar::lsystem_index(double label) const {
+  for (size_t i = 0; i < lsystems.size(); ++i)
+    if (static_cast<double>(lsystems[i].label) == std::trunc(label)) return static_cast<int>(i);
+  return -1;
+}
+
 std::string Grammar::where(const SourcePos& pos) const {
   const std::string& name = sources.at(static_cast<size_t>(pos.source));
   if (pos.line == 0) return name + ":" + std::to_string(pos.column);
@@ -806,9 +904,10 @@ std::string Grammar::where(const SourcePos& pos) const {
 Grammar parse_grammar(const std::vector<GrammarText>& texts,
                       const std::vector<std::pair<std::string, double>>& define_overrides,
                       const std::optional<GrammarText>& axiom_text,
-                      std::vector<SampledFunction> functions) {
+                      std::vector<SampledFunction> functions, std::vector<ViewCurve> curves) {
   Grammar grammar;
   grammar.program.functions = std::move(functions);
+  grammar.program.curves = std::move(curves);
   Parser parser(grammar, define_overrides);
   try {
     if (axiom_text) parser.parse_inline_axiom(*axiom_text);

@@ -49,7 +49,7 @@ ViewSettings load_view(const LsystemOptions& options) {
 Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   if (options.grammar) {
     const std::vector<GrammarText> texts{{options.grammar->string(), read_file(*options.grammar), false}};
-    Grammar grammar = parse_grammar(texts, options.defines, std::nullopt, view.functions);
+    Grammar grammar = parse_grammar(texts, options.defines, std::nullopt, view.functions, view.curves);
     check_overrides(options, grammar);
     return grammar;
   }
@@ -78,6 +78,7 @@ TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& gra
   turtle.angle_degrees = options.angle.value_or(view.angle.value_or(grammar.angle.value_or(turtle.angle_degrees)));
   turtle.width_factor = options.width_factor.value_or(grammar.width_factor.value_or(turtle.width_factor));
   turtle.initial_width = view.initial_width.value_or(turtle.initial_width);
+  turtle.calls = grammar.calls;
   if (options.view) turtle.width_increment = view.width_increment.value_or(1.0);
   if (grammar.tropism) {
     turtle.tropism = *grammar.tropism;
@@ -96,12 +97,13 @@ Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
   const Grammar grammar = load_grammar(options, view);
   const DerivationSettings settings = derivation_settings(options, grammar);
   const TurtleSettings turtle = turtle_settings(options, grammar, view);
-  const ModuleString word = derive(grammar, settings, turtle);
+  std::vector<double> variables;  // as the derivation leaves them, for the homomorphism (CPFG manual 4.3.1)
+  const ModuleString word = derive(grammar, settings, turtle, &variables);
   if (stats) {
     stats->modules = word.size();
     stats->iterations = settings.iterations;
   }
-  return interpret(apply_homomorphism(grammar, word, settings), turtle);
+  return interpret(apply_homomorphism(grammar, word, settings, &variables), turtle);
 }
 
 }  // namespace treeanim

@@ -45,6 +45,7 @@ struct State {
   int32_t segment = -1;   // last segment drawn on this path: the parent of the next one
   bool branched = false;  // a '[' was opened since `segment` was drawn
   bool cylinder = false;  // inside a generalised cylinder (@Gs ... @Ge): 'f' draws too
+  double scale = 1.0;     // product of the open sub-L-system calls' scales: lengths, widths, surfaces
 };
 
 // A '{' not yet closed: the turtle state at the '{' (the leaf's base and frame) and where its
@@ -171,7 +172,10 @@ class Turtle {
           s_.heading = -s_.heading;
           s_.left = -s_.left;
           break;
-        case '$': roll_to_horizontal(s_); break;
+        case '$':
+          if (settings_.calls) return_from_call();
+          else roll_to_horizontal(s_);
+          break;
         case '[':
           stack_.push_back(s_);
           s_.branched = true;
@@ -183,11 +187,13 @@ class Turtle {
           }
           break;
         case '!':
-          if (has_param(i)) s_.width = first_param(i);
-          else if (settings_.width_increment) s_.width = std::max(s_.width - *settings_.width_increment, 0.0);
+          if (has_param(i)) s_.width = first_param(i) * s_.scale;
+          else if (settings_.width_increment) s_.width = std::max(s_.width - *settings_.width_increment * s_.scale, 0.0);
           else s_.width *= settings_.width_factor;
           break;
-        case '#': s_.width = has_param(i) ? first_param(i) : s_.width + settings_.width_increment.value_or(1.0); break;
+        case '#':
+          s_.width = has_param(i) ? first_param(i) * s_.scale : s_.width + settings_.width_increment.value_or(1.0) * s_.scale;
+          break;
         case '\'':
         case ';': s_.material = has_param(i) ? material_index(first_param(i)) : s_.material + 1; break;
         case ',':
@@ -196,7 +202,7 @@ class Turtle {
         case 'L': add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {}); break;
         case '~': i = surface(i); break;
         case '@': i = at_command(i); break;
-        case '?': i = query(i); break;
+        case '?': i = settings_.calls && has_param(i) ? call(i) : query(i); break;
         case '{': polygons_.push_back({s_, points_.size()}); break;
         case '.':
           if (!polygons_.empty()) points_.push_back(s_.position);
@@ -222,18 +228,20 @@ class Turtle {
       const std::span<const double> p = word_.params_of(i + 1);
       const auto& shapes = settings_.surfaces;
       const auto shape = std::find_if(shapes.begin(), shapes.end(), [&](const LeafShape& v) { return v.id == word_.symbols[i + 1]; });
-      if (shape == shapes.end()) add_leaf(s_, p.empty() ? 1.0 : p[0], {});
+      if (shape == shapes.end()) add_leaf(s_, (p.empty() ? 1.0 : p[0]) * s_.scale, {});
       else draw_surface(*shape, p);
       return i + 1;
     }
-    add_leaf(s_, has_param(i) ? first_param(i) : 1.0, {});
+    add_leaf(s_, (has_param(i) ? first_param(i) : 1.0) * s_.scale, {});
     return i;
   }
 
-  // A view-file surface scaled by p (none: 1; one: uniform; three: along -L, H, U), then the
-  // turtle moves to its end point (CPFG manual 6.7.1). A zero scale draws nothing, as in cpfg.
+  // A view-file surface scaled by p (none: 1; one: uniform; three: along -L, H, U) and by the
+  // open sub-L-system calls, then the turtle moves to its end point (CPFG manual 6.7.1). A zero
+  // scale draws nothing, as in cpfg.
   void draw_surface(const LeafShape& shape, std::span<const double> p) {
-    const Vector3d scale = p.empty() ? Vector3d(1, 1, 1) : p.size() < 3 ? Vector3d(p[0], p[0], p[0]) : Vector3d(p[0], p[1], p[2]);
+    const Vector3d scale =
+        (p.empty() ? Vector3d(1, 1, 1) : p.size() < 3 ? Vector3d(p[0], p[0], p[0]) : Vector3d(p[0], p[1], p[2])) * s_.scale;
     const double volume = scale.prod();
     if (!(volume != 0.0) || !std::isfinite(volume)) return;
     add_shape_leaf(s_, shape, scale);
@@ -244,14 +252,33 @@ class Turtle {
   // segment. Without a parameter (the line width) it rounds a joint or a tip, which the branch
   // mesh closes already, and is left out (docs/turtle.md).
   void draw_organ(const LeafShape& shape, std::span<const double> p) {
-    if (!p.empty() && p[0] > 0 && std::isfinite(p[0])) add_shape_leaf(s_, shape, Vector3d::Constant(p[0]));
+    if (!p.empty() && p[0] > 0 && std::isfinite(p[0])) add_shape_leaf(s_, shape, Vector3d::Constant(p[0] * s_.scale));
+  }
+
+  // '?(label, s)' calls a sub-L-system (CPFG manual 7.2): lengths, widths and surfaces are
+  // scaled by s (1 when not given) until its '$'. => the module used.
+  size_t call(size_t i) {
+    const std::span<const double> p = word_.params_of(i);
+    const double s = p.size() >= 2 ? p[1] : 1.0;
+    calls_.push_back(s_.scale);
+    s_.scale *= s;
+    s_.width *= s;
+    return i;
+  }
+
+  // '$' ends the innermost call: its scale is undone (a '$' without a call changes nothing).
+  void return_from_call() {
+    if (calls_.empty()) return;
+    if (s_.scale != 0.0) s_.width *= calls_.back() / s_.scale;
+    s_.scale = calls_.back();
+    calls_.pop_back();
   }
 
   // '?' and its letter (cpfg's query modules, CPFG manual 6.9): ?P ?H ?U ?L take the turtle's
   // position, heading, up and left vectors (x, y[, z]) when answering; they draw nothing.
   // => the last module used.
   size_t query(size_t i) {
-    if (i + 1 >= word_.size()) return i;
+    if (i + 1 >= word_.size() || has_param(i)) return i;
     const Vector3d* v = nullptr;
     switch (word_.symbols[i + 1]) {
       case 'P': v = &s_.position; break;
@@ -317,7 +344,7 @@ class Turtle {
   // F G f g at module i. Inside '{ }' they only move (F and f recording a vertex, ABOP ch. 5);
   // outside, F and G draw a segment and f and g move.
   void forward(size_t i, bool draws, bool records) {
-    const double length = has_param(i) ? first_param(i) : settings_.step;
+    const double length = (has_param(i) ? first_param(i) : settings_.step) * s_.scale;
     if (!polygons_.empty()) {
       s_.position += length * s_.heading;
       if (records) points_.push_back(s_.position);
@@ -442,6 +469,7 @@ class Turtle {
   const bool bends_;           // tropism on
   State s_;
   std::vector<State> stack_;          // '[' states, innermost last
+  std::vector<double> calls_;         // the scale before each open sub-L-system call, innermost last
   std::vector<OpenPolygon> polygons_; // open '{', innermost last
   std::vector<Vector3d> points_;      // vertices of the open polygons, outer ones first
   SinCosCache angles_;

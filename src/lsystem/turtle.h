@@ -19,6 +19,7 @@ struct TurtleSettings {
   Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
   double tropism_elasticity = 0.0;            // e; 0 = no tropism
   std::vector<LeafShape> surfaces;            // the view file's surfaces: ~id draws the one of its letter
+  bool calls = false;                         // the grammar calls sub-L-systems: '?(label, s)' scales until '$'
 };
 
 // Initial frame H=(0,1,0) L=(-1,0,0) U=(0,0,1) at the origin; +(90)F(1) ends at (-1,0,0),

@@ -183,6 +183,14 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       // cpfg keeps the first surface of an id and leaves out one whose file does not exist.
       if (surface && std::none_of(view.surfaces.begin(), view.surfaces.end(), same_id))
         view.surfaces.push_back(std::move(*surface));
+    } else if (key == "curve") {
+      std::istringstream in(rest);
+      std::string file;
+      int samples = 0;
+      in >> file;
+      if (!(in >> samples)) samples = 100;  // cpfg's default
+      if (samples < 2 || samples > 1'000'000) fail(name, i, "expected 2 ... 1000000 samples after the curve file");
+      view.curves.push_back(read_view_curve(path.parent_path() / file, samples));
     } else if (key == "function" || key == "function set") {
       std::istringstream in(rest);
       std::string file;

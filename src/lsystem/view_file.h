@@ -29,6 +29,7 @@ struct ViewSettings {
   std::optional<double> tropism_elasticity;   // "... E: e" or "initial elasticity: e"
   std::vector<ViewSurface> surfaces;          // "surface:" lines whose file exists, in order: drawn by ~id as leaves
   std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
+  std::vector<ViewCurve> curves;              // "curve: c.con [samples]", in order (curveX ... curveGAL)
 };
 
 // path => settings; files it names are found beside it. Throws InputError "file:line:col: message".

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/errors.h"
 #include "lsystem/derive.h"
@@ -28,11 +29,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     settings.iterations = std::min(grammar.derivation_length.value_or(3), kFuzzMaxIterations);
     settings.seed = 7;
     settings.max_modules = kFuzzModuleCap;
-    const ModuleString word = derive(grammar, settings);
-    const ModuleString drawn = apply_homomorphism(grammar, word, settings);
+    std::vector<double> variables;
+    const ModuleString word = derive(grammar, settings, {}, &variables);
+    const ModuleString drawn = apply_homomorphism(grammar, word, settings, &variables);
     TurtleSettings turtle;
     turtle.angle_degrees = grammar.angle.value_or(turtle.angle_degrees);
     turtle.width_factor = grammar.width_factor.value_or(turtle.width_factor);
+    turtle.calls = grammar.calls;
     interpret(drawn, turtle);
   } catch (const InputError&) {
     // The documented outcome of a bad grammar.

@@ -6,10 +6,12 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "common/errors.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
+#include "lsystem/turtle.h"
 
 namespace treeanim {
 namespace {
@@ -49,6 +51,18 @@ TEST(Cpfg, BlocksVariablesAndControlBlocks) {
             "A(0)B(1)B(2)");  // step 1: m = 2, count 10; step 2: m = 4 -> 0, count 11
 }
 
+// The homomorphism reads the globals as the derivation's End block leaves them.
+TEST(Cpfg, HomomorphismReadsTheGlobalsTheDerivationLeaves) {
+  const Grammar g = parse("Start: {ang = 30;}\nEnd: {ang = ang + 1;}\nderivation length: 1\naxiom: A\n"
+                          "homomorphism\nA --> +(ang) F\n");
+  std::vector<double> variables;
+  const ModuleString word = derive(g, {1, 1, 100}, {}, &variables);
+  const ModuleString drawn = apply_homomorphism(g, word, {1, 1, 100}, &variables);
+  ASSERT_EQ(drawn.size(), 2u);
+  EXPECT_EQ(drawn.params_of(0)[0], 31.0);
+  EXPECT_EQ(apply_homomorphism(g, word, {1, 1, 100}).params_of(0)[0], 0.0);  // before the Start block
+}
+
 TEST(Cpfg, SameSymbolWithDifferentAritiesAndDeepHomomorphism) {
   const Grammar g = parse("axiom: A A(3)\nA --> B\nA(n) --> A(n,n)\nhomomorphism\nmaximum depth: 1000\n"
                           "C(n) : n > 0 --> F C(n-1)\n");
@@ -72,8 +86,12 @@ std::string error_of(const std::string& text, int steps = 1) {
 TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n", 0), "no error");
   EXPECT_EQ(error_of("#define F(x) x\naxiom: F(1,2)\n"), "plant.l:2:8: macro 'F' expects 1 arguments, got 2");
-  EXPECT_EQ(error_of("axiom: A\nA --> B ?(1, 0.5) C $\n"),
-            "plant.l:2:9: sub-L-systems ('?(id, scale) ... $') are not supported (CPFG manual 7.2)");
+  EXPECT_EQ(error_of("axiom: A\nA --> B ?(3, 0.5) C $\n"),
+            "plant.l:2:9: '?(3, ...)' calls L-system 3, but the file has no 'lsystem: 3' (it has 0)");
+  EXPECT_EQ(error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
+            "plant.l: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4'");
+  EXPECT_EQ(error_of("axiom: A\nA --> B(\"x\")\n"),
+            "plant.l:2:9: a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
   EXPECT_EQ(error_of("axiom: A ?E(1)\n"),
             "plant.l:1:10: '?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
   EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
@@ -163,6 +181,117 @@ TEST(Cpfg, IncludeReadsTheFileBesideTheGrammar) {
     EXPECT_EQ(std::string(e.what()), (dir / "sub" / "broken.l").string() + ":2:15: expected a module symbol, got ')'");
   }
   std::filesystem::remove_all(dir);
+}
+
+// Sub-L-systems (CPFG manual 7.2): the modules between '?(label, s)' and its '$' are rewritten
+// by L-system `label`'s productions in the same steps as the rest (its own derivation length
+// and axiom are not used); the first L-system in the file is the one derived.
+const std::string kSubLsystems =
+    "Lsystem: 1\nderivation length: 2\naxiom: A B(1)\n"
+    "A --> F ?(2, 2) B(1) $ A\nB(x) --> B(x+1)\nendlsystem\n"
+    "some notes after the end\n"
+    "Lsystem: 2\nderivation length: 99\naxiom: B(7)\nB(x) --> C(x) B(x*10)\n"
+    "homomorphism\nC(x) --> F(x)\nendlsystem\n";
+
+TEST(Cpfg, SubLsystemsRewriteTheModulesTheyAreCalledFor) {
+  EXPECT_EQ(derive_text(kSubLsystems, 1), "F?(2,2)B(1)$AB(2)");
+  EXPECT_EQ(derive_text(kSubLsystems, 2), "F?(2,2)C(1)B(10)$F?(2,2)B(1)$AB(3)");
+  // Each L-system's homomorphism draws its own modules: C is drawn only inside a call of 2.
+  const Grammar g = parse(kSubLsystems + "");
+  ModuleString word;
+  word.clear();
+  const double one = 1, call[2] = {2, 1};
+  word.push('C', {&one, 1});
+  word.push('?', call);
+  word.push('C', {&one, 1});
+  word.push('$');
+  const ModuleString drawn = apply_homomorphism(g, word, {0, 1, 100});
+  EXPECT_EQ(std::string(drawn.symbols.begin(), drawn.symbols.end()), "C?F$");
+  // A sub-L-system's control blocks would need variables per call.
+  EXPECT_EQ(error_of("lsystem: 1\naxiom: A\nA --> ?(2) B $\nendlsystem\nlsystem: 2\nStart: {x = 1;}\n"),
+            "plant.l:6:1: a sub-L-system's 'start:' block is not supported (cpfg gives each call of a sub-L-system its "
+            "own copy of the variables, CPFG manual 7.2)");
+}
+
+// Contexts run across calls with the current L-system's ignore: list ('?' and '$' are modules).
+TEST(Cpfg, ContextsOfASubLsystemUseItsOwnIgnoreList) {
+  const std::string sub = "lsystem: 2\naxiom: B\nX < B --> D\nendlsystem\n";
+  EXPECT_EQ(derive_text("lsystem: 1\naxiom: X ?(2) B $\nendlsystem\n" + sub, 1), "X?(2)B$");
+  EXPECT_EQ(derive_text("lsystem: 1\naxiom: X ?(2) B $\nendlsystem\nlsystem: 2\nignore: ?\naxiom: B\n"
+                        "X < B --> D\nendlsystem\n", 1),
+            "X?(2)D$");
+}
+
+// The turtle scales lengths, widths and surfaces by a call's s until its '$' (cpfg's interpret.c).
+TEST(Cpfg, CallsScaleTheTurtle) {
+  const Grammar g = parse("lsystem: 1\naxiom: !(1) F(1) ?(2, 0.5) F(2) [ !(2) F(2) ] $ F(1)\nendlsystem\n"
+                          "lsystem: 2\naxiom: F\nendlsystem\n");
+  TurtleSettings turtle;
+  turtle.calls = g.calls;
+  const Skeleton k = interpret(derive(g, {0, 1, 100}), turtle);
+  ASSERT_EQ(k.segment_end.size(), 4u);
+  EXPECT_DOUBLE_EQ(k.segment_end[1].y(), 2.0);  // F(2) at half scale
+  EXPECT_DOUBLE_EQ(k.segment_end[2].y(), 3.0);
+  EXPECT_DOUBLE_EQ(k.segment_end[3].y(), 3.0);  // after '$': F(1) at full scale from y = 2
+  EXPECT_DOUBLE_EQ(k.segment_width[1], 0.5);
+  EXPECT_DOUBLE_EQ(k.segment_width[2], 1.0);    // !(2) at half scale
+  EXPECT_DOUBLE_EQ(k.segment_width[3], 1.0);
+}
+
+// Ring L-systems (CPFG manual 3.1.1): the string's ends are adjacent for contexts.
+TEST(Cpfg, RingLsystemsWrapContextsAroundTheString) {
+  EXPECT_EQ(derive_text("ring lsystem\nAxiom: A B C\nC < A --> X\nC > A --> Y\n", 1), "XBY");
+  EXPECT_EQ(derive_text("Axiom: A B C\nC < A --> X\nC > A --> Y\n", 1), "ABC");
+  EXPECT_EQ(derive_text("ring lsystem\nAxiom: A C [B]\nC < A --> Z\n", 1), "ZC[B]");  // past the branch at the end
+  // Everything ignored: the search stops after a turn instead of circling.
+  EXPECT_EQ(derive_text("ring lsystem\nignore: AB\nAxiom: A B\nC < A --> X\nA > C --> Y\n", 1), "AB");
+}
+
+// Brackets in ignore: and consider: (cpfg's RconDiff): a skipped '[' is entered and a skipped
+// ']' passed by right contexts; left contexts always follow brackets.
+TEST(Cpfg, IgnoredBracketsChangeRightContexts) {
+  EXPECT_EQ(derive_text("axiom: A[B]C\nA > B --> X\n", 1), "A[B]C");
+  EXPECT_EQ(derive_text("ignore: [\naxiom: A[B]C\nA > B --> X\n", 1), "X[B]C");
+  EXPECT_EQ(derive_text("ignore: [\naxiom: A[B]C\nB > C --> X\n", 1), "A[B]C");
+  EXPECT_EQ(derive_text("ignore: ]\naxiom: [A]B\nA > B --> X\n", 1), "[X]B");
+  EXPECT_EQ(derive_text("consider: AB\naxiom: A[C]B\nA > B --> X\n", 1), "X[C]B");
+  EXPECT_EQ(derive_text("consider: AB\naxiom: A[B]C\nA > B --> X\n", 1), "X[B]C");
+  EXPECT_EQ(derive_text("consider: AB[]\naxiom: A[B]C\nA > B --> X\n", 1), "A[B]C");
+  EXPECT_EQ(derive_text("ignore: [\naxiom: B[A]\nB < A --> X\n", 1), "B[X]");
+  EXPECT_EQ(derive_text("ignore: [\naxiom: A[B]\nA > [B] --> X\n", 1), "X[B]");  // a pattern's '[' still enters
+}
+
+// @L("format", values) labels (CPFG manual 6.10): the string is read past; the parameter holds
+// its number in the file and the turtle draws nothing.
+TEST(Cpfg, LabelsTakeAStringAndDrawNothing) {
+  EXPECT_EQ(derive_text("axiom: F @L(\"age %.f\", 3) @L(\"a \\\"b\\\"\") @S(\"ls\")\n", 0), "F@L(0,3)@L(1)@S(2)");
+  const Grammar g = parse("axiom: F @L(\"x\", 3) F\n");
+  const Skeleton k = interpret(derive(g, {0, 1, 100}), {});
+  EXPECT_EQ(k.segment_end.size(), 2u);
+  EXPECT_TRUE(k.leaf_segment.empty());
+  EXPECT_EQ(error_of("axiom: @L(\"open)\n"), "plant.l:1:11: the string is never closed (expected '\"')");
+}
+
+// curveX/curveY/curveZ/curveGAL (CPFG manual 5.5) read the view file's curves by arc length.
+TEST(Cpfg, CurveFunctions) {
+  ViewCurve line;
+  line.control = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 3, 0}, {0, 3, 0}, {0, 3, 0}};
+  line.arc = {0.0, 1.0 / 3, 2.0 / 3, 1.0};
+  line.length = 3;
+  const Grammar g = parse_grammar({{"plant.l", "Start: {L = curveGAL(1);}\naxiom: A(L, curveY(1, 1), curveX(1, 0.5), curveZ(1, 2))\n", false}},
+                                  {}, std::nullopt, {}, {line});
+  const ModuleString word = derive(g, {0, 1, 100});
+  ASSERT_EQ(word.params_of(0).size(), 4u);
+  EXPECT_EQ(word.params_of(0)[0], 3.0);
+  EXPECT_DOUBLE_EQ(word.params_of(0)[1], 3.0);
+  EXPECT_EQ(word.params_of(0)[2], 0.0);
+  EXPECT_EQ(word.params_of(0)[3], 0.0);
+  try {
+    parse_grammar({{"plant.l", "axiom: A(curveY(2, 0))\n", false}}, {}, std::nullopt, {}, {line});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "plant.l:1:10: curveY expects a constant number 1 ... 1 (the view file's 'curve:' lines)");
+  }
 }
 
 TEST(Cpfg, EndlessLoopStopsWithItsPlace) {

@@ -52,14 +52,14 @@ TEST(Grammar, DirectivesAndRules) {
   EXPECT_EQ(g.derivation_length, 3);
   EXPECT_EQ(g.angle, 22.5);
   EXPECT_EQ(g.seed, 42u);
-  EXPECT_TRUE(g.context_skips['+'] && g.context_skips['-'] && g.context_skips['F']);
-  EXPECT_FALSE(g.context_skips['A']);
+  EXPECT_TRUE(g.lsystems[0].context_skips['+'] && g.lsystems[0].context_skips['-'] && g.lsystems[0].context_skips['F']);
+  EXPECT_FALSE(g.lsystems[0].context_skips['A']);
   EXPECT_EQ(*g.tropism, Eigen::Vector3d(0, -1, 0));
   EXPECT_EQ(g.tropism_elasticity, 0.2);
   ASSERT_EQ(g.axiom.size(), 4u);  // A(1) B # C: '#' right after a module is a module
   EXPECT_EQ(g.axiom[2].symbol, '#');
-  ASSERT_EQ(g.productions.rules.size(), 2u);
-  const Rule& r = g.productions.rules[0];
+  ASSERT_EQ(g.lsystems[0].productions.rules.size(), 2u);
+  const Rule& r = g.lsystems[0].productions.rules[0];
   EXPECT_EQ(r.predecessor, 'A');
   EXPECT_EQ(r.left_end - r.left_begin, 1u);
   EXPECT_EQ(r.right_end - r.right_begin, 4u);  // [ C ] D
@@ -67,22 +67,22 @@ TEST(Grammar, DirectivesAndRules) {
   EXPECT_TRUE(r.condition.present());
   EXPECT_TRUE(r.probability.present());
   EXPECT_EQ(r.pos.line, 11);
-  EXPECT_EQ(g.productions.rules[1].successor_end, g.productions.rules[1].successor_begin);  // '*'
-  EXPECT_EQ(g.homomorphism.rules.size(), 1u);
-  EXPECT_EQ(g.decomposition.rules.size(), 1u);
-  EXPECT_EQ(g.decomposition.max_depth, 3);
+  EXPECT_EQ(g.lsystems[0].productions.rules[1].successor_end, g.lsystems[0].productions.rules[1].successor_begin);  // '*'
+  EXPECT_EQ(g.lsystems[0].homomorphism.rules.size(), 1u);
+  EXPECT_EQ(g.lsystems[0].decomposition.rules.size(), 1u);
+  EXPECT_EQ(g.lsystems[0].decomposition.max_depth, 3);
 }
 
 TEST(Grammar, ArrowsAndTurnSymbolsAsPredecessors) {
   const Grammar g = parse("axiom: A\nA->B\n- --> +\n--->&\n+ > - --> ^\n");
-  ASSERT_EQ(g.productions.rules.size(), 4u);
-  EXPECT_EQ(g.productions.rules[0].predecessor, 'A');
-  EXPECT_EQ(g.productions.successor[g.productions.rules[0].successor_begin].symbol, 'B');
-  EXPECT_EQ(g.productions.rules[1].predecessor, '-');
-  EXPECT_EQ(g.productions.rules[2].predecessor, '-');
-  EXPECT_EQ(g.productions.successor[g.productions.rules[2].successor_begin].symbol, '&');
-  EXPECT_EQ(g.productions.rules[3].predecessor, '+');
-  EXPECT_EQ(g.productions.patterns[g.productions.rules[3].right_begin].symbol, '-');
+  ASSERT_EQ(g.lsystems[0].productions.rules.size(), 4u);
+  EXPECT_EQ(g.lsystems[0].productions.rules[0].predecessor, 'A');
+  EXPECT_EQ(g.lsystems[0].productions.successor[g.lsystems[0].productions.rules[0].successor_begin].symbol, 'B');
+  EXPECT_EQ(g.lsystems[0].productions.rules[1].predecessor, '-');
+  EXPECT_EQ(g.lsystems[0].productions.rules[2].predecessor, '-');
+  EXPECT_EQ(g.lsystems[0].productions.successor[g.lsystems[0].productions.rules[2].successor_begin].symbol, '&');
+  EXPECT_EQ(g.lsystems[0].productions.rules[3].predecessor, '+');
+  EXPECT_EQ(g.lsystems[0].productions.patterns[g.lsystems[0].productions.rules[3].right_begin].symbol, '-');
 }
 
 TEST(Grammar, SceneDefinesOverrideFileDefines) {
@@ -136,7 +136,7 @@ TEST(Grammar, MalformedGrammarsReportFileLineColumn) {
       {"axiom: F\nderivaton length: 5\n",
        "g.lsys:2:1: unknown directive 'derivaton length:' (expected one of axiom:, derivation length:, angle:, seed:, "
        "ignore:, consider:, tropism:, maximum depth:, width factor:, lsystem:, start:, starteach:, end:, endeach:, "
-       "define:, homomorphism, decomposition, endlsystem, "
+       "define:, homomorphism, decomposition, endlsystem, ring lsystem, "
        "#define; did you mean 'derivation length:'?)"},
       {"axiom: F\nF --> F[+F\n",
        "g.lsys:2:8: unbalanced brackets: '[' is never closed (expected ']' before the end of the successor)"},

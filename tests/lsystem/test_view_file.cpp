@@ -147,6 +147,39 @@ TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(error_of("function set: noitems.fset\n"), "noitems.fset:2:1: expected 'items: n' after 'funcgalleryver'");
 }
 
+// A cuspy curve file in cpfg's layout: a straight line from (0, 0) to (0, 3) (control points on
+// a line, the ends tripled so that the B-spline reaches them).
+const char* kLine = "version: 1.4\ncontact: 0 0 0\nheading: 0 1 0\npoints: 4\nrange: 0.0 1.0\ndimension: 4\n"
+                    "type: bspline\n0 0 0 3\n0 1 0 1\n0 2 0 1\n0 3 0 3\n";
+
+// curve: files (CPFG manual 5.5) are read by arc length: the line's length and its points.
+TEST_F(ViewFile, CurvesAreReadByArcLength) {
+  write("line.con", kLine);
+  const ViewSettings v = read_view_file(write("plant.v", "curve: line.con\ncurve: line.con 7\n"));
+  ASSERT_EQ(v.curves.size(), 2u);
+  EXPECT_NEAR(v.curves[0].length, 3.0, 1e-9);
+  EXPECT_EQ(v.curves[0].arc.size(), 100u);
+  EXPECT_EQ(v.curves[1].arc.size(), 7u);
+  for (const double s : {0.0, 0.25, 0.5, 0.9, 1.0}) {
+    EXPECT_NEAR(v.curves[0].at(s)[1], 3.0 * s, 2e-3) << s;
+    EXPECT_EQ(v.curves[0].at(s)[0], 0.0);
+  }
+  EXPECT_NEAR(v.curves[0].at(-1)[1], 0.0, 1e-12);  // clamped to the ends
+  EXPECT_NEAR(v.curves[0].at(2)[1], 3.0, 1e-12);
+  write("closed.con", "points: 4\ntype: bspline-closed\n0 0\n1 0\n1 1\n0 1\n");
+  const ViewSettings closed = read_view_file(write("closed.v", "curve: closed.con\n"));
+  EXPECT_NEAR(closed.curves[0].at(0)[0], closed.curves[0].at(1)[0], 1e-12);  // a closed curve ends where it starts
+  EXPECT_NEAR(closed.curves[0].at(0)[1], closed.curves[0].at(1)[1], 1e-12);
+  write("few.con", "points: 2\n0 0\n1 1\n");
+  EXPECT_EQ(error_of("curve: few.con\n"), "few.con:1:1: expected at least 4 control points (multiplicities included)");
+  write("bezier.con", "points: 4\ntype: bezier\n0 0\n1 0\n1 1\n0 1\n");
+  EXPECT_EQ(error_of("curve: bezier.con\n"),
+            "bezier.con:1:1: curve type 'bezier' is not supported (expected bspline, bspline-closed or bspline-phantom)");
+  write("extra.con", "points: 1\n0 0\n1 1\n");
+  EXPECT_EQ(error_of("curve: extra.con\n"), "extra.con:3:1: more points than 'points:' announces");
+  EXPECT_EQ(error_of("curve: line.con 1\n"), "plant.v:1:1: expected 2 ... 1000000 samples after the curve file");
+}
+
 TEST_F(ViewFile, MissingViewFileIsAnInputError) {
   try {
     read_view_file(dir_ / "none.v");
