@@ -76,6 +76,7 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
   o.leaf_turn = section.number("leaf_turn", o.leaf_turn, Range::between(0, 1));
   o.yield_strain = section.number("yield_strain", o.yield_strain, Range::positive());
+  o.root_flexibility = section.number("root_flexibility", o.root_flexibility, Range::non_negative());
   // Below ~1 MPa (softer than any self-supporting plant tissue; green wood is 5-12 GPa) a
   // branch has no stiffness to speak of and the wind carries the tree away.
   o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::at_least(1e6));

@@ -8,7 +8,8 @@
 
 namespace treeanim {
 
-BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus, double yield_strain) {
+BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
+  const double youngs_modulus = options.youngs_modulus, yield_strain = options.yield_strain;
   const size_t C = tree.cluster_count();
   BarChain chain;
   chain.cluster_joint.setZero(3, C);
@@ -35,6 +36,8 @@ BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus, double yi
     const double r = tree.cluster_radius[c], second_moment = std::numbers::pi * r * r * r * r / 4;
     half[c] = second_moment > 0 ? tree.cluster_length[c] / (2 * youngs_modulus * second_moment) : 0;
   }
+  // Y is up: the tree's top, from which each root's height is measured.
+  const double top = tree.vertex_count() ? tree.rest_positions.row(1).maxCoeff() : 0.0;
   for (size_t c = 0; c < C; ++c) {
     if (tree.cluster_kind[c] == kClusterLeaf) continue;
     chain.cluster_compliance[c] = half[c];
@@ -51,6 +54,12 @@ BarChain build_bar_chain(const TreeModel& tree, double youngs_modulus, double yi
     }
     const double r = tree.cluster_radius[c];
     if (r > 0) chain.cluster_max_turn[c] = chain.cluster_compliance[c] * yield_strain * youngs_modulus * std::numbers::pi * r * r * r / 4;
+    // The root plate turns the root's joint further under the same moment, up to the same
+    // largest turn: the soil gives way about where the stem's base would yield.
+    if (p < 0 && half[c] > 0) {
+      const double height = std::max(0.0, top - chain.cluster_joint(1, c));
+      chain.cluster_compliance[c] += options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];
+    }
   }
   return chain;
 }

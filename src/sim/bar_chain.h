@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "sim/sim_options.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -19,12 +20,14 @@ struct BarChain {
   std::vector<double> cluster_max_turn;
 };
 
-// Tree model + Young's modulus (Pa) + yield strain => the joints and the branch joints'
-// compliances and largest turns. A cluster's flexibility L / (E I) is split between the
-// joints at its two ends (the trapezoidal rule, second order in the cluster length): a joint
-// that continues its parent's axis has half of each, a lateral's base or the clamped root
-// half of its own. The yield moment of a cluster of radius r is strain E pi r^3 / 4.
-BarChain build_bar_chain(const TreeModel& model, double youngs_modulus, double yield_strain);
+// Tree model + options (Young's modulus, yield strain, root flexibility) => the joints and the
+// branch joints' compliances and largest turns. A cluster's flexibility L / (E I) is split
+// between the joints at its two ends (the trapezoidal rule, second order in the cluster
+// length): a joint that continues its parent's axis has half of each, a lateral's base half of
+// its own, and the root half of its own plus the root plate's, root_flexibility H / (E I) for a
+// tree H tall (the soil turns the stem's base, up to the stem's own largest turn). The yield
+// moment of a cluster of radius r is strain E pi r^3 / 4.
+BarChain build_bar_chain(const TreeModel& model, const HsmOptions& options);
 
 // Tree model + chain => the tree's reach (m): the longest path from a root cluster's joint to a
 // vertex along the chain of joints. No connected pose moves a vertex farther than twice

@@ -171,7 +171,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
       parallel(t.membership_count() >= 4096) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   const double extent = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
-  chain = build_bar_chain(t, o.youngs_modulus, o.yield_strain);
+  chain = build_bar_chain(t, o);
   const double size = std::max(extent, tree_reach(t, chain));
   const bool anchored = std::any_of(t.vertex_anchored.begin(), t.vertex_anchored.end(), [](auto a) { return a != 0; });
   runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();

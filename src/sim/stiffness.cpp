@@ -61,7 +61,7 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, Ste
   const std::vector<uint32_t> order = parents_first(model);
   // The limb hanging from each cluster: its first frequency as a bar chain (Rayleigh), so
   // that taper, branching and the crown's mass, leaves included, set it as they set a tree's.
-  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, E, options.yield_strain));
+  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, options));
   // Parents before children: a cluster sways at most at the frequency of the softest limb
   // between it and the ground (a twig on a swaying bough moves with the bough).
   rates.cluster_frequency.assign(C, 0);

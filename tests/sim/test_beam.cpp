@@ -37,6 +37,7 @@ HsmOptions cantilever_options(double damping_ratio) {
   options.damping_ratio = damping_ratio;
   options.max_frequency = 120;
   options.max_limb_frequency = 120;
+  options.root_flexibility = 0;  // clamped, as Euler-Bernoulli's cantilever
   options.sleep = false;
   return options;
 }
