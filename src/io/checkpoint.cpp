@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kFormat = "treeanim-checkpoint";
-constexpr int32_t kFormatVersion = 2;  // 2: the prediction keeps its goal offsets
+constexpr int32_t kFormatVersion = 3;  // 2: the prediction keeps its goal offsets; 3: and its damping terms
 
 // A variable-length UTF-8 string type, or -1.
 hid_t make_string_type() {
@@ -135,6 +135,10 @@ void write_prediction(const CheckpointFile& file, hid_t group, const StepPredict
   file.array(group, "prediction_drag_force", file_type, memory_type, {3, hsize_t(p.drag_force.rows())},
              p.drag_force.data());
   file.array(group, "prediction_goal", file_type, memory_type, {3, hsize_t(p.goal.rows())}, p.goal.data());
+  file.array(group, "prediction_damping_offset", file_type, memory_type, {3, hsize_t(p.damping_offset.rows())},
+             p.damping_offset.data());
+  file.array(group, "prediction_damping_compliance", file_type, memory_type, {hsize_t(p.damping_compliance.rows())},
+             p.damping_compliance.data());
 }
 
 template <typename Real>
@@ -144,10 +148,16 @@ void read_prediction(const CheckpointFile& file, hid_t group, const StepPredicti
   p.velocity.resize(shape.velocity.rows(), 3);
   p.drag_force.resize(shape.drag_force.rows(), 3);
   p.goal.resize(shape.goal.rows(), 3);
+  p.damping_offset.resize(shape.damping_offset.rows(), 3);
+  p.damping_compliance.resize(shape.damping_compliance.rows());
   file.read_array(group, "prediction_offset", memory_type, {3, hsize_t(p.offset.rows())}, p.offset.data());
   file.read_array(group, "prediction_velocity", memory_type, {3, hsize_t(p.velocity.rows())}, p.velocity.data());
   file.read_array(group, "prediction_drag_force", memory_type, {3, hsize_t(p.drag_force.rows())}, p.drag_force.data());
   file.read_array(group, "prediction_goal", memory_type, {3, hsize_t(p.goal.rows())}, p.goal.data());
+  file.read_array(group, "prediction_damping_offset", memory_type, {3, hsize_t(p.damping_offset.rows())},
+                  p.damping_offset.data());
+  file.read_array(group, "prediction_damping_compliance", memory_type, {hsize_t(p.damping_compliance.rows())},
+                  p.damping_compliance.data());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 
 #include "sim/solver_step.h"
 
@@ -42,9 +43,13 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   const uint32_t* members = tree.cluster_members.data();
   const uint8_t* active = attachment.member_active.data();
   const Real* inv_count = attachment.vertex_inv_count.data();
+  const Real* drag_damping = scratch.vertex_drag_damping.data();
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
   for (size_t c = first; c < last; ++c) {
     double force_x = 0, force_y = 0, force_z = 0, moment_x = 0, moment_y = 0, moment_z = 0;
+    // The same vertices' 2 D (the largest rate at which the quadratic drag changes with the
+    // velocity) and its moment about the joint: the chain's aerodynamic damping.
+    double damping = 0, lever_x = 0, lever_y = 0, lever_z = 0;
     const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
     if (!attachment.cluster_flying[c])
       for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
@@ -55,9 +60,13 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
         force_x += gx, force_y += gy, force_z += gz;
         const double ax = rest[3 * size_t(v)] - jx, ay = rest[3 * size_t(v) + 1] - jy, az = rest[3 * size_t(v) + 2] - jz;
         moment_x += ay * gz - az * gy, moment_y += az * gx - ax * gz, moment_z += ax * gy - ay * gx;
+        const double d = 2 * double(drag_damping[v]) * share;
+        damping += d, lever_x += d * ax, lever_y += d * ay, lever_z += d * az;
       }
     scratch.cluster_load.col(c) = Eigen::Vector3d(force_x, force_y, force_z);
     scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_x, moment_y, moment_z);
+    scratch.cluster_damping[c] = damping;
+    scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_x, lever_y, lever_z);
   }
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
@@ -67,14 +76,23 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     if (p < 0 || attachment.cluster_flying[c]) continue;
     scratch.cluster_load.col(p) += scratch.cluster_load.col(c);
     scratch.cluster_moment.col(p) += scratch.cluster_moment.col(c) + (joint.col(c) - joint.col(p)).cross(scratch.cluster_load.col(c));
+    scratch.cluster_damping[p] += scratch.cluster_damping[c];
+    scratch.cluster_damping_moment.col(p) +=
+        scratch.cluster_damping_moment.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_damping[c];
   }
   // 3. Parents before children: each joint turns by its compliance times its moment (in
-  // parallel: the sines and cosines), and the turns accumulate from the root (one thread).
+  // parallel: the sines and cosines), and the turns accumulate from the root (one thread),
+  // as do the damping's sums over the joints from the root, C_j S_j and C_j S_j . (j_c - j_j)
+  // (about the cluster's own joint: small numbers wherever the tree stands).
 #pragma omp for schedule(static)
   for (size_t c = 0; c < C; ++c) {
     Eigen::Vector3d theta = model.chain.cluster_compliance[c] * scratch.cluster_moment.col(c);
     const double angle = theta.norm(), largest = model.chain.cluster_max_turn[c];
     if (angle > largest) theta *= largest / angle;
+    // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
+    // for a moment across its turn (none along it): a yielded joint does not move back.
+    const double give = angle > largest ? largest / angle : 1.0;
+    scratch.cluster_damping_path.col(c) = (model.chain.cluster_compliance[c] * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
   }
 #pragma omp single
@@ -83,8 +101,12 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     Eigen::Map<Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
     if (p < 0 || attachment.cluster_flying[c]) {
       scratch.cluster_static_joint.col(c) = joint.col(c);
+      scratch.cluster_damping_lever[c] = 0;
       continue;
     }
+    scratch.cluster_damping_path.col(c) += scratch.cluster_damping_path.col(p);
+    scratch.cluster_damping_lever[c] =
+        scratch.cluster_damping_lever[p] + scratch.cluster_damping_path.col(p).dot(joint.col(c) - joint.col(p));
     const Eigen::Matrix3d turn = R;
     const Eigen::Map<const Eigen::Matrix3d> parent(&scratch.cluster_static_rotation(0, p));
     scratch.cluster_static_joint.col(c) =
@@ -99,15 +121,19 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
                           size_t end) {
   const TreeModel& tree = model.tree;
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest:
-  // R (x0 - joint) + static joint - x0, written out on raw arrays as Eigen evaluates it.
+  // R (x0 - joint) + static joint - x0, written out on raw arrays as Eigen evaluates it; and
+  // the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
+  // everything moves with it (docs/solver.md, "Aerodynamic damping").
   const double *rest = tree.rest_positions.data(), *joint = model.chain.cluster_joint.data();
   const double *rotation = scratch.cluster_static_rotation.data(), *moved = scratch.cluster_static_joint.data();
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
+  const double *path = scratch.cluster_damping_path.data(), *lever = scratch.cluster_damping_lever.data();
   Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
+  Real* compliance = prediction.damping_compliance.data();
   for (size_t v = begin; v < end; ++v) {
-    double ox = 0, oy = 0, oz = 0;
+    double ox = 0, oy = 0, oz = 0, back = 0;
     const double x = rest[3 * v], y = rest[3 * v + 1], z = rest[3 * v + 2];
     for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
       const uint32_t slot = memberships[s];
@@ -118,9 +144,11 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
       ox += (((R[0] * dx + R[3] * dy) + R[6] * dz) + moved[3 * c]) - x;
       oy += (((R[1] * dx + R[4] * dy) + R[7] * dz) + moved[3 * c + 1]) - y;
       oz += (((R[2] * dx + R[5] * dy) + R[8] * dz) + moved[3 * c + 2]) - z;
+      back += ((path[3 * c] * dx + path[3 * c + 1] * dy) + path[3 * c + 2] * dz) + lever[c];
     }
     const double share = double(attachment.vertex_inv_count[v]);
     gx[v] = static_cast<Real>(ox * share), gy[v] = static_cast<Real>(oy * share), gz[v] = static_cast<Real>(oz * share);
+    compliance[v] = static_cast<Real>(std::max(back * share, 0.0));
   }
 }
 

@@ -4,6 +4,8 @@
 // (docs/solver.md, "One step" 4 and 1).
 #include <omp.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -215,8 +217,12 @@ void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& 
   set_air_time(model.wind, state.time, model.h, scratch.air);
   scratch.member_correction.setZero();  // no step was matched: no shape kick (a rare pass)
 #pragma omp parallel for schedule(static) if (model.parallel)
-  for (size_t c = 0; c < model.C; ++c)
+  for (size_t c = 0; c < model.C; ++c) {
+    // The clusters' rotations as the last match left them (the drag's rest frame, prediction.h).
+    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) =
+        Eigen::Quaterniond(state.cluster_rotations.col(c)).toRotationMatrix();
     if (cluster_awake(model, attachment, state, c)) sample_cluster_air(model, attachment, state, scratch, c);
+  }
   correct_and_predict(model, attachment, state, scratch, VertexPass::kFromState, frame, 0);
 }
 

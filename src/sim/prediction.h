@@ -74,19 +74,25 @@ inline bool block_flagged(const VertexBlock<Real>& block, int n) {
 
 // Predicted vertices [begin, begin + n) => corrected u and v in place (`prediction` then
 // holds the state at the step's end) and, with kForce, the drag each will feel over the next
-// step from its damped velocity (prediction.drag_force). With kEnd the runaway limit is
-// checked. Returns block_flagged.
+// step from its velocity at the step's start (prediction.drag_force, damping_offset;
+// scratch.vertex_drag_damping). With kEnd the runaway limit is checked. Returns block_flagged.
 template <bool kEnd, bool kForce, typename Real>
 inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
+                          StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
                           const VertexInputs<Real>& in, VertexBlock<Real>& block) {
   const Real inv_h = static_cast<Real>(1.0 / model.h);
   const Real half_inv_h = static_cast<Real>(0.5 / model.h);
   const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
                         scratch.cluster_air.col(2).data()};
-  Real* force[3] = {nullptr, nullptr, nullptr};
+  Real *force[3] = {nullptr, nullptr, nullptr}, *damped[3] = {nullptr, nullptr, nullptr};
   if constexpr (kForce)
-    for (int i = 0; i < 3; ++i) force[i] = prediction.drag_force.col(i).data() + begin;
+    for (int i = 0; i < 3; ++i) {
+      force[i] = prediction.drag_force.col(i).data() + begin;
+      damped[i] = prediction.damping_offset.col(i).data() + begin;
+    }
+  const Real* compliance = prediction.damping_compliance.data() + begin;
+  Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
+  const double* rotation = scratch.cluster_rotation_matrix.data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
   const double* mass = model.tree.vertex_mass.data() + begin;
   const Real limit2 = static_cast<Real>(model.runaway_distance2);
@@ -106,19 +112,34 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
     if constexpr (kForce) {
       // The drag at the step's start, from the velocity there: half a step of damping and of
-      // the last goal's pull after the staggered v (second order; docs/solver.md "One step").
+      // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
+      // toward the last goal without the part this vertex's velocity took off through its drag,
+      // and that damping is implicit: the velocity is divided by 1 + gamma h / 2, gamma = K c
+      // (docs/solver.md "Aerodynamic damping"): stable at any step, however strong the drag.
       const uint32_t c = air_cluster[k];
       const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
-      const Real rx = air[0][c] - (vx * half - pull_back * (ux - in.goal[0][k]) + shape * px);
-      const Real ry = air[1][c] - (vy * half - pull_back * (uy - in.goal[1][k]) + shape * py);
-      const Real rz = air[2][c] - (vz * half - pull_back * (uz - in.goal[2][k]) + shape * pz);
+      const Real implicit = 1 / (1 + pull_back * compliance[k]);
+      const Real wx = (vx * half - pull_back * (ux - (in.goal[0][k] + damped[0][k])) + shape * px) * implicit;
+      const Real wy = (vy * half - pull_back * (uy - (in.goal[1][k] + damped[1][k])) + shape * py) * implicit;
+      const Real wz = (vz * half - pull_back * (uz - (in.goal[2][k] + damped[2][k])) + shape * pz) * implicit;
+      damped[0][k] = compliance[k] * wx, damped[1][k] = compliance[k] * wy, damped[2][k] = compliance[k] * wz;
+      const Real rx = air[0][c] - wx, ry = air[1][c] - wy, rz = air[2][c] - wz;
       // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
       // the free-flight average over the step (drag_share) would understate it ever more as
       // the step grows (a leaf in a gale at a 0.25 s step: 16x).
       const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * static_cast<Real>(mass[k]);
-      force[0][k] = rx * scale;
-      force[1][k] = ry * scale;
-      force[2][k] = rz * scale;
+      drag_damping[k] = scale;
+      // The chain takes its moments with rest arms, so its load is the air's push and the
+      // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
+      // moves with, a drag that opposes a limb's motion then always opposes it, however far
+      // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
+      const double* R = rotation + 9 * size_t(c);  // column-major
+      const Real bx = static_cast<Real>(R[0]) * wx + static_cast<Real>(R[1]) * wy + static_cast<Real>(R[2]) * wz;
+      const Real by = static_cast<Real>(R[3]) * wx + static_cast<Real>(R[4]) * wy + static_cast<Real>(R[5]) * wz;
+      const Real bz = static_cast<Real>(R[6]) * wx + static_cast<Real>(R[7]) * wy + static_cast<Real>(R[8]) * wz;
+      force[0][k] = (air[0][c] - bx) * scale;
+      force[1][k] = (air[1][c] - by) * scale;
+      force[2][k] = (air[2][c] - bz) * scale;
     }
     block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
     Real excess = 0;  // > 0: an attached vertex ran away

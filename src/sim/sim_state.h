@@ -21,6 +21,13 @@ struct StepPrediction {
   // (V x 3) m, the offset from rest the global term pulled toward in that step (the static
   // deflection; 0 without the beam). The next step's velocity estimate reads it.
   Rows3 goal;
+  // (V x 3) m, the part of that goal the vertex's own velocity took off through its drag, c v
+  // at the step's start (the chain's damping, diagonal estimate): goal + it is the deflection
+  // the next step's velocity estimate extrapolates (docs/solver.md, "Aerodynamic damping").
+  Rows3 damping_offset;
+  // (V) s, c: how far the chain moves the vertex's goal back per m/s of the vertex's velocity
+  // when its whole limb moves with it, from that step's drag (0 without the beam).
+  Eigen::Matrix<Real, Eigen::Dynamic, 1> damping_compliance;
 };
 
 struct SimState {

@@ -50,6 +50,8 @@ SimState Solver<Real>::initial_state(double time) const {
   prediction.velocity.setZero(model.V, 3);
   prediction.drag_force.setZero(model.store_drag_force ? model.V : 0, 3);
   prediction.goal.setZero(model.V, 3);
+  prediction.damping_offset.setZero(model.V, 3);
+  prediction.damping_compliance.setZero(model.V);
   return state;
 }
 
@@ -65,11 +67,14 @@ void Solver<Real>::adopt(SimState& state, long long frame) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   const auto rows = static_cast<Eigen::Index>(model.V);
   if (prediction.offset.rows() != rows || prediction.velocity.rows() != rows ||
-      prediction.drag_force.rows() != (model.store_drag_force ? rows : 0) || prediction.goal.rows() != rows) {
+      prediction.drag_force.rows() != (model.store_drag_force ? rows : 0) || prediction.goal.rows() != rows ||
+      prediction.damping_offset.rows() != rows || prediction.damping_compliance.rows() != rows) {
     prediction.offset.setZero(rows, 3);
     prediction.velocity.setZero(rows, 3);
     prediction.drag_force.setZero(model.store_drag_force ? rows : 0, 3);
     prediction.goal.setZero(rows, 3);
+    prediction.damping_offset.setZero(rows, 3);
+    prediction.damping_compliance.setZero(rows);
     state.predicted = false;
   }
   adopt_leaf_flags(model, state, attachment);

@@ -261,6 +261,11 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   cluster_moment.setZero(3, m.C);
   cluster_static_rotation.setZero(9, m.C);
   cluster_static_joint.setZero(3, m.C);
+  vertex_drag_damping.assign(m.V, Real(0));
+  cluster_damping.assign(m.C, 0);
+  cluster_damping_moment.setZero(3, m.C);
+  cluster_damping_path.setZero(3, m.C);
+  cluster_damping_lever.assign(m.C, 0);
   island_fell_asleep.assign(m.I, 0);
 }
 

@@ -130,6 +130,13 @@ struct StepScratch {
   Eigen::Matrix3Xd cluster_moment;         // (3 x C) N m, its moment about the cluster's joint
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_static_rotation;  // (9 x C) the cluster's turn in the static deflection
   Eigen::Matrix3Xd cluster_static_joint;   // (3 x C) m, where its joint is in the static deflection
+  // --- the chain's aerodynamic damping (docs/solver.md, "Aerodynamic damping") ---
+  std::vector<Real> vertex_drag_damping;   // (V) N s/m, D = 0.5 rho Cd A |air - v|: the drag per m/s of relative velocity
+  std::vector<double> cluster_damping;     // (C) N s/m, sum of 2 D over the cluster and everything beyond it
+  Eigen::Matrix3Xd cluster_damping_moment; // (3 x C) N s, sum of 2 D (x0 - joint) over the same vertices
+  // (3 x C) s/m, sum over the joints from the root to the cluster's of compliance times damping moment
+  Eigen::Matrix3Xd cluster_damping_path;
+  std::vector<double> cluster_damping_lever;  // (C) s, the same joints' sum of compliance C_j S_j . (j_c - j_j)
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
   AirSample air;                           // the wind at the time being sampled
 
