@@ -422,10 +422,11 @@ class Compiler {
     const std::string near = suggestion(name, candidates);
     return " (expected " + list + (near.empty() ? "" : "; did you mean '" + near + "'?") + ")";
   }
-  // A string "..." at pos() (after spaces) => its text, the escapes \n \t \" \\ undone.
-  std::string parse_string(const std::string& what, size_t start) {
+  // The `noun` ("format string") of `function`, a string "..." at pos() (after spaces) => its
+  // text, the escapes \n \t \" \\ undone.
+  std::string parse_string(const std::string& noun, const std::string& function, size_t start) {
     skip_space();
-    if (peek() != '"') fail(pos_, "expected " + what + " \"...\", got " + describe_next());
+    if (peek() != '"') fail(pos_, "expected a " + noun + " \"...\" in " + function + "(), got " + describe_next());
     std::string out;
     for (++pos_; pos_ < text_.size() && text_[pos_] != '"'; ++pos_) {
       if (text_[pos_] != '\\' || pos_ + 1 >= text_.size()) {
@@ -435,7 +436,7 @@ class Compiler {
       const char escaped = text_[++pos_];
       out += escaped == 'n' ? '\n' : escaped == 't' ? '\t' : escaped;
     }
-    if (pos_ >= text_.size()) fail(start, what + " is never closed (expected '\"')");
+    if (pos_ >= text_.size()) fail(start, "the " + noun + " of " + function + " is never closed (expected '\"')");
     ++pos_;
     return out;
   }
@@ -443,7 +444,7 @@ class Compiler {
   // printed (the output streams are treeanim's own); its value is 0.
   void parse_printf(size_t start) {
     ++pos_;  // '('
-    parse_string("a format string after 'printf('", start);
+    parse_string("format string", "printf", start);
     while (accept(",")) {
       parse_conditional();
       emit(Op::kPop, 0, start);
@@ -458,10 +459,10 @@ class Compiler {
       fail(start, "fopen opens a file in a block of statements of a grammar file (Start: { fp = fopen(\"data.txt\", \"r\"); })");
     ++pos_;  // '('
     const size_t name_at = (skip_space(), pos_);
-    const std::string name = parse_string("a file name after 'fopen('", start);
+    const std::string name = parse_string("file name", "fopen", start);
     expect(",", "after the file name of fopen");
     const size_t mode_at = (skip_space(), pos_);
-    const std::string mode = parse_string("a mode (\"r\") after the file name", start);
+    const std::string mode = parse_string("mode", "fopen", start);
     expect(")", "to close fopen(");
     if (mode != "r" && mode != "rt" && mode != "rb")
       fail(mode_at, "fopen(..., \"" + mode + "\") writes a file, which is not supported: a grammar must not write files "
@@ -479,7 +480,7 @@ class Compiler {
     parse_conditional();
     expect(",", "after the file of fscan");
     const size_t format_at = (skip_space(), pos_);
-    ScanCall scan{parse_string("a format string after the file", start), 0, 0};
+    ScanCall scan{parse_string("format string", "fscan", start), 0, 0};
     if (const std::string wrong = check_scan_format(scan.format); !wrong.empty()) fail(format_at, "fscan: " + wrong);
     std::vector<std::pair<std::string, size_t>> targets;
     while (accept(",")) {
