@@ -632,6 +632,7 @@ class Parser {
     std::vector<size_t> open;  // positions of unclosed '['
     const std::string_view word = text.substr(0, end);
     char previous = 0;  // the module before
+    size_t previous_at = 0;  // and where it is
     for (size_t k = begin; k < end;) {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
@@ -640,7 +641,11 @@ class Parser {
       else if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
       // @L("label", ...), @S("command") and @I("object", s) take a string first (CPFG manual 6.10, 9.4, 9.5).
       const bool takes_string = previous == '@' && (c == 'L' || c == 'S' || c == 'I');
+      if (previous == '@' && c == 'P')
+        fail(line, previous_at, "'@P' (@PS, @PC, @PD: a bicubic patch from turtle positions, CPFG manual 6.7.2) is not "
+                          "supported; draw the surface from a '.s' file with '~id' (a 'surface:' line of the view file)");
       previous = c;
+      previous_at = k;
       if (c == '[') open.push_back(k);
       if (c == ']') {
         if (open.empty()) fail(line, k, "unbalanced brackets: ']' closes no '[' in the " + std::string(what));

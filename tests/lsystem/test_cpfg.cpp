@@ -98,6 +98,9 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A ?E(1)\n"),
             "plant.l:1:10: '?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
   EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
+  EXPECT_EQ(error_of("axiom: A\nA --> F @PS(1, 1) @PC(1, 0, 0) @PD(1, 4, 4)\n"),
+            "plant.l:2:9: '@P' (@PS, @PC, @PD: a bicubic patch from turtle positions, CPFG manual 6.7.2) is not "
+            "supported; draw the surface from a '.s' file with '~id' (a 'surface:' line of the view file)");
 }
 
 // '=' in a right context (cpfg's generate.c) skips to the end of the current branch.
