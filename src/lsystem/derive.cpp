@@ -77,6 +77,12 @@ class Deriver {
                               : settings_.seed ^ (std::bit_cast<uint64_t>(srand_value) * 0x9e3779b97f4a7c15ULL);
   }
 
+  // The seed of the homomorphism's draws: its own "seed:" (CPFG manual 4.3.3: the same draws
+  // whatever the derivation's seed), else the derivation's.
+  uint64_t homomorphism_seed() const {
+    return g_.homomorphism_seed ? RandomStream::keyed(*g_.homomorphism_seed, kHomomorphism, 0, 0).next_u64() : seed();
+  }
+
   // A Start/StartEach/EndEach/End block, its draws keyed by the step.
   void run_block(const Expr& block) {
     if (!block.present()) return;
@@ -242,8 +248,9 @@ class Deriver {
     }
   }
 
-  // The rule rewriting a module (symbol, params; at `index` of word_ when contexts or a strict
-  // predecessor of several modules apply; word_ null: only rules of one module apply),
+  // The rule rewriting a module (symbol, params; at `index` of word_, where contexts and a strict
+  // predecessor of several modules are matched; a module from a successor (derived_) takes the
+  // contexts of `index` and only rules of one module),
   // its formal parameters bound in slots; nullptr when none applies. The first applicable rule
   // wins; when it has a probability, one of all applicable rules with a probability is drawn
   // with weights proportional to them.
@@ -318,7 +325,7 @@ class Deriver {
   // The strict predecessor after its first module: the modules right after it, one by one
   // (no module passed over; CPFG manual 3.1).
   bool match_tail(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
-    if (!word_ || index + rule.length() > word_->size()) return false;
+    if (derived_ || !word_ || index + rule.length() > word_->size()) return false;
     for (uint32_t p = rule.tail_begin; p < rule.tail_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
       const size_t j = index + 1 + (p - rule.tail_begin);
@@ -365,7 +372,7 @@ class Deriver {
     const ModuleString& w = *word_;
     const std::array<bool, 256>& skips = ls_->context_skips;
     const size_t n = w.size();
-    size_t j = index + rule.length();
+    size_t j = derived_ ? origin_end_ : index + rule.length();
     uint32_t turns = 0;
     for (uint32_t p = rule.right_begin; p < rule.right_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
@@ -418,9 +425,12 @@ class Deriver {
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
     if (at) at->assign(word.size() + 1, 0);
+    if (std::any_of(g_.lsystems.begin(), g_.lsystems.end(), [&](const Lsystem& ls) { return (ls.*section).any_context; }))
+      match_brackets(word);
+    const uint64_t key = purpose == kHomomorphism ? homomorphism_seed() : seed();
     const RuleSet* set = &(enter(0)->*section);
     for (size_t i = 0; i < word.size();) {
-      RandomStream random = RandomStream::keyed(seed(), purpose, static_cast<uint64_t>(step_), i);
+      RandomStream random = RandomStream::keyed(key, purpose, static_cast<uint64_t>(step_), i);
       const size_t used = expand(*set, word, i, random, out);
       if (at) std::fill(at->begin() + static_cast<std::ptrdiff_t>(i) + 1, at->begin() + static_cast<std::ptrdiff_t>(i + used) + 1,
                         static_cast<uint32_t>(out->size()));
@@ -442,15 +452,16 @@ class Deriver {
   // => its expansion appended to *out, depth first in successor order, with an explicit stack
   // (frames_) instead of recursion; the last module of a successor replaces its rule's frame,
   // so a rule that ends by calling itself runs in constant space. Successor modules are
-  // expanded one by one (a rule of several modules applies to the word only). => the modules
-  // of word used.
+  // expanded one by one (a rule of several modules applies to the word only); their contexts
+  // are those of module `index` in word (CPFG manual 4.3.2). => the modules of word used.
   size_t expand(const RuleSet& set, const ModuleString& word, size_t index, RandomStream& random,
                 ModuleString* out) {
     frames_.clear();
     frame_slots_.clear();
     word_ = &word;
     const size_t used = begin_module(set, word.symbols[index], word.params_of(index), index, 0, random, out);
-    word_ = nullptr;
+    derived_ = true;
+    origin_end_ = index + used;
     while (!frames_.empty()) {
       Frame& frame = frames_.back();
       const Rule& rule = *frame.rule;
@@ -467,13 +478,15 @@ class Deriver {
         frames_.pop_back();
       }
       params_.assign(scratch_.begin(), scratch_.end());
-      begin_module(set, module.symbol, params_, 0, depth, random, out);
+      begin_module(set, module.symbol, params_, index, depth, random, out);
       if (out->size() > settings_.max_modules) check_cap(*out);
     }
+    word_ = nullptr;
+    derived_ = false;
     return used;
   }
 
-  // A module at `depth` (at `index` of word_ when that is set): copied to *out when no rule
+  // A module at `depth` (its contexts those of `index` in word_): copied to *out when no rule
   // applies, else its rule's frame pushed. => the modules its rule replaces (1 when none).
   size_t begin_module(const RuleSet& set, char symbol, std::span<const double> params, size_t index, int depth,
                       RandomStream& random, ModuleString* out) {
@@ -518,6 +531,8 @@ class Deriver {
   int step_ = 0;
   const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
   const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
+  bool derived_ = false;                // the module being expanded comes from a successor: its contexts are its origin's
+  size_t origin_end_ = 0;               // past the modules of word_ the expansion started from
   const Lsystem* ls_ = nullptr;         // the L-system rewriting the current module (its contexts' skips, ring)
   std::vector<uint32_t> calls_;         // indices of the L-systems called at the current module, innermost last
   std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere

@@ -48,7 +48,7 @@ int arity_of(Op op) {
   switch (op) {
     case Op::kConst: case Op::kParam: case Op::kLoadVar: case Op::kJump: return 0;
     case Op::kNeg: case Op::kNot: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
-    case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: return 1;
+    case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: case Op::kFclose: case Op::kFscan: return 1;
     case Op::kStoreElem: return 2;
     case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem:
     case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe:
@@ -76,6 +76,7 @@ bool foldable(Op op) {
     case Op::kConst: case Op::kParam: case Op::kRan: case Op::kNran: case Op::kBran: case Op::kBiran:
     case Op::kSrand: case Op::kLoadVar: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
     case Op::kJump: case Op::kJumpIfZero: case Op::kLoadElem: case Op::kStoreElem:
+    case Op::kFopen: case Op::kFclose: case Op::kFscan:
       return false;
     default: return true;
   }
@@ -421,16 +422,29 @@ class Compiler {
     const std::string near = suggestion(name, candidates);
     return " (expected " + list + (near.empty() ? "" : "; did you mean '" + near + "'?") + ")";
   }
+  // The `noun` ("format string") of `function`, a string "..." at pos() (after spaces) => its
+  // text, the escapes \n \t \" \\ undone.
+  std::string parse_string(const std::string& noun, const std::string& function, size_t start) {
+    skip_space();
+    if (peek() != '"') fail(pos_, "expected a " + noun + " \"...\" in " + function + "(), got " + describe_next());
+    std::string out;
+    for (++pos_; pos_ < text_.size() && text_[pos_] != '"'; ++pos_) {
+      if (text_[pos_] != '\\' || pos_ + 1 >= text_.size()) {
+        out += text_[pos_];
+        continue;
+      }
+      const char escaped = text_[++pos_];
+      out += escaped == 'n' ? '\n' : escaped == 't' ? '\t' : escaped;
+    }
+    if (pos_ >= text_.size()) fail(start, "the " + noun + " of " + function + " is never closed (expected '\"')");
+    ++pos_;
+    return out;
+  }
   // printf("format", values...) (CPFG manual 5.4): its values are computed and nothing is
   // printed (the output streams are treeanim's own); its value is 0.
   void parse_printf(size_t start) {
     ++pos_;  // '('
-    skip_space();
-    if (peek() != '"') fail(pos_, "expected a format string \"...\" after 'printf(', got " + describe_next());
-    ++pos_;
-    while (pos_ < text_.size() && text_[pos_] != '"') pos_ += text_[pos_] == '\\' ? 2 : 1;
-    if (pos_ >= text_.size()) fail(start, "the format string of printf is never closed (expected '\"')");
-    ++pos_;
+    parse_string("format string", "printf", start);
     while (accept(",")) {
       parse_conditional();
       emit(Op::kPop, 0, start);
@@ -438,8 +452,96 @@ class Compiler {
     expect(")", "to close printf(");
     emit_constant(0.0, start);
   }
+  // fopen(name, "r") (CPFG manual 5.4), in a block: the file, found beside the grammar, is read
+  // now; each call rewinds it and its value is the file's id. Writing is refused.
+  void parse_fopen(size_t start) {
+    if (!statements_ || !statements_->read_data_file)
+      fail(start, "fopen opens a file in a block of statements of a grammar file (Start: { fp = fopen(\"data.txt\", \"r\"); })");
+    ++pos_;  // '('
+    const size_t name_at = (skip_space(), pos_);
+    const std::string name = parse_string("file name", "fopen", start);
+    expect(",", "after the file name of fopen");
+    const size_t mode_at = (skip_space(), pos_);
+    const std::string mode = parse_string("mode", "fopen", start);
+    expect(")", "to close fopen(");
+    if (mode != "r" && mode != "rt" && mode != "rb")
+      fail(mode_at, "fopen(..., \"" + mode + "\") writes a file, which is not supported: a grammar must not write files "
+                    "on a render farm (CPFG manual 5.4; fopen(name, \"r\") reads a data file beside the grammar)");
+    const std::string text = statements_->read_data_file(name, at(name_at));
+    program_.files.push_back({text, new_global()});
+    emit(Op::kFopen, static_cast<uint32_t>(program_.files.size() - 1), start);
+  }
+  // fscan(file, "format", &x, &y...) (CPFG manual 5.4), in a block: C's fscanf for numbers. The
+  // targets' values go through hidden globals, which keep a target's value when nothing is read
+  // into it; its value is the number of values read (-1 at the end of the file).
+  void parse_fscan(size_t start) {
+    if (!statements_) fail(start, "fscan reads into variables in a block of statements (\"{ n = fscan(fp, \"%f\", &x); }\")");
+    ++pos_;  // '('
+    parse_conditional();
+    expect(",", "after the file of fscan");
+    const size_t format_at = (skip_space(), pos_);
+    ScanCall scan{parse_string("format string", "fscan", start), 0, 0};
+    if (const std::string wrong = check_scan_format(scan.format); !wrong.empty()) fail(format_at, "fscan: " + wrong);
+    std::vector<std::pair<std::string, size_t>> targets;
+    while (accept(",")) {
+      skip_space();
+      accept("&");
+      const size_t name_at = (skip_space(), pos_);
+      while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
+      if (pos_ == name_at || std::isdigit(static_cast<unsigned char>(text_[name_at])) ||
+          array_named(std::string(text_.substr(name_at, pos_ - name_at))))
+        fail(name_at, "expected a variable '&name' to read into (fscan reads into variables, not array elements)");
+      targets.emplace_back(std::string(text_.substr(name_at, pos_ - name_at)), name_at);
+    }
+    expect(")", "to close fscan(");
+    size_t conversions = 0;
+    for (size_t k = 0; k + 1 < scan.format.size(); ++k)
+      if (scan.format[k] == '%' && scan.format[k + 1] != '%' && scan.format[k + 1] != '*') ++conversions;
+      else if (scan.format[k] == '%') ++k;
+    if (targets.size() != conversions)
+      fail(start, "fscan's format converts " + plural(static_cast<int>(conversions), "value") + " into " +
+                      plural(static_cast<int>(targets.size()), "variable"));
+    scan.values = static_cast<uint32_t>(targets.size());
+    for (size_t t = 0; t < targets.size(); ++t) {
+      const uint32_t hidden = new_global();
+      if (t == 0) scan.first_variable = hidden;
+      load_target(targets[t].first, targets[t].second);
+      emit(Op::kStoreVar, hidden, targets[t].second);
+    }
+    program_.scans.push_back(scan);
+    emit(Op::kFscan, static_cast<uint32_t>(program_.scans.size() - 1), start);
+    for (size_t t = 0; t < targets.size(); ++t) {
+      emit(Op::kLoadVar, scan.first_variable + static_cast<uint32_t>(t), targets[t].second);
+      emit_store(targets[t].first, targets[t].second);
+    }
+  }
+  // A variable the grammar cannot name (its name is empty) => its variables index.
+  uint32_t new_global() {
+    statements_->globals->push_back("");
+    return static_cast<uint32_t>(statements_->globals->size());
+  }
+  // The value of fscan's target `name` (0 for a variable its assignment creates).
+  void load_target(const std::string& name, size_t where) {
+    if (const int slot = index_of(statements_->locals, name); slot >= 0) return emit(Op::kParam, static_cast<uint32_t>(slot), where);
+    if (const int variable = index_of(statements_->globals, name); variable >= 0)
+      return emit(Op::kLoadVar, static_cast<uint32_t>(variable) + 1, where);
+    emit_constant(0.0, where);
+  }
   void parse_call(const std::string& name, size_t start) {
     if (name == "printf") return parse_printf(start);
+    if (name == "fopen") return parse_fopen(start);
+    if (name == "fscan" || name == "fscanf") return parse_fscan(start);
+    if (name == "fprintf")
+      fail(start, "fprintf writes to a file, which is not supported: a grammar must not write files on a render farm "
+                  "(CPFG manual 5.4; printf computes its values and prints nothing)");
+    if (name == "fclose" || name == "fflush") {
+      ++pos_;  // '('
+      parse_conditional();
+      expect(")", ("to close " + name + "(").c_str());
+      if (name == "fclose") return emit(Op::kFclose, 0, start);
+      emit(Op::kPop, 0, start);  // reading needs no flushing
+      return emit_constant(0.0, start);
+    }
     const Function* function = nullptr;
     for (const Function& f : kFunctions)
       if (name == f.name) function = &f;
@@ -643,6 +745,13 @@ std::string format_number(double v) {
   throw EvalError{program.code_pos[instruction], message};
 }
 
+// The file an fopen returned `id` for.
+const DataFile& data_file(const ExprProgram& program, uint32_t instruction, double id) {
+  if (!(id >= 1 && id <= static_cast<double>(program.files.size())))
+    throw EvalError{program.code_pos[instruction], "expected a file that fopen opened, got " + format_number(id)};
+  return program.files[static_cast<size_t>(id) - 1];
+}
+
 }  // namespace
 
 RandomStream RandomStream::keyed(uint64_t seed, uint64_t purpose, uint64_t step, uint64_t position) {
@@ -791,6 +900,25 @@ namespace {
         --top;
         if (b == 0.0) k = in.arg - 1;
         continue;
+      case Op::kFopen:
+        if (variables) variables[program.files[in.arg].offset_variable] = 0.0;
+        stack[++top] = static_cast<double>(in.arg + 1);
+        break;
+      case Op::kFclose: {
+        const DataFile& file = data_file(program, k, b);
+        if (variables) variables[file.offset_variable] = static_cast<double>(file.text.size());
+        stack[top] = 0.0;
+        break;
+      }
+      case Op::kFscan: {
+        const DataFile& file = data_file(program, k, b);
+        const ScanCall& scan = program.scans[in.arg];
+        if (!variables) eval_fail(program, k, "fscan reads into variables");
+        auto offset = static_cast<size_t>(variables[file.offset_variable]);
+        stack[top] = scan_values(file.text, &offset, scan.format, variables + scan.first_variable);
+        variables[file.offset_variable] = static_cast<double>(offset);
+        break;
+      }
       case Op::kJump:
         if (in.arg <= k && ++jumps_back > kMaxLoopIterations)
           eval_fail(program, k, "a loop ran more than 10000000 times");

@@ -5,11 +5,13 @@
 // Rejected alternative: an AST walked recursively; the flat bytecode is smaller, has no
 // pointers to chase, and makes constant folding a matter of looking at the last instructions.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "lsystem/data_file.h"
 #include "lsystem/view_curve.h"
 
 namespace treeanim {
@@ -70,6 +72,7 @@ enum class Op : uint8_t {
   kLoadVar, kStoreVar, kStoreParam, kPop,          // variables[arg], formals[arg] (statements)
   kIndex, kLoadElem, kStoreElem,                   // array index < arg; variables[arg + index]
   kJump, kJumpIfZero,                              // to code[arg] (?:, if, while)
+  kFopen, kFclose, kFscan,                         // files[arg] rewound; a file closed; scans[arg] read
 };
 
 struct Instruction {
@@ -107,6 +110,8 @@ struct ExprProgram {
   std::vector<SampledFunction> functions;  // func(id, x): the view file's functions, id 1, 2, ...
   std::vector<ViewCurve> curves;     // curveX(id, t) ... curveGAL(id): the view file's curves, id 1, 2, ...
   std::vector<ArrayDecl> arrays;     // names the compiler resolves to array elements
+  std::vector<DataFile> files;       // fopen(name, "r"): file id k + 1 is files[k]
+  std::vector<ScanCall> scans;       // fscan(file, "format", &x, ...) calls
   // expr => true when it is one constant (its value in *value).
   bool is_constant(const Expr& expr, double* value) const;
 };
@@ -132,6 +137,8 @@ struct StatementScope {
   std::vector<std::string>* globals = nullptr;    // the grammar's variables
   bool assign_globals = false;                    // true in Start/StartEach/EndEach/End blocks
   const std::vector<std::pair<std::string, double>>* defines = nullptr;
+  // fopen(name, "r") at pos => the text of the file `name` beside the grammar (throws GrammarError).
+  std::function<std::string(const std::string& name, SourcePos pos)> read_data_file;
 };
 
 // Deepest operand stack an expression may need; deeper ones are rejected when compiled.

@@ -94,6 +94,7 @@ struct Grammar {
   std::optional<double> angle;        // degrees
   std::optional<double> width_factor;
   uint64_t seed = 0;
+  std::optional<uint64_t> homomorphism_seed;  // "seed:" after "homomorphism": its own draws (CPFG manual 4.3.3)
   std::vector<std::string> variables;      // global variables (assigned in Start/End blocks); slot i + 1
                                            // (an array: its name, then "" for its other elements)
   std::vector<double> initial_values;      // (variables + 1) their values before the Start block (arrays' initialisers)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "common/errors.h"
@@ -165,6 +167,24 @@ class Parser {
     if (!read_text_file(resolved, text, reason))
       throw GrammarError{at, "cannot read the included file '" + resolved.string() + "' (" + reason + ")"};
     return {resolved.string(), text};
+  }
+
+  // fopen's reader (CPFG manual 5.4): a file beside the grammar file that names it, by a
+  // relative path that stays in that folder.
+  std::function<std::string(const std::string&, SourcePos)> data_files() const {
+    return [this](const std::string& name, SourcePos at) {
+      const std::filesystem::path path(name);
+      if (at.line == 0)
+        throw GrammarError{at, "fopen reads a file beside the grammar file; an inline grammar has none"};
+      if (path.empty() || path.is_absolute() || std::any_of(path.begin(), path.end(), [](const auto& p) { return p == ".."; }))
+        throw GrammarError{at, "fopen(\"" + name + "\") names a file outside the grammar's folder: a grammar reads only "
+                               "files beside it (a relative path without '..')"};
+      const std::filesystem::path resolved = std::filesystem::path(g_.sources.at(static_cast<size_t>(at.source))).parent_path() / path;
+      std::string text, reason;
+      if (!read_text_file(resolved, text, reason))
+        throw GrammarError{at, "fopen cannot read '" + resolved.string() + "' (" + reason + ")"};
+      return text;
+    };
   }
 
   // Nesting of parentheses everywhere and of braces before the arrow (blocks of a rule's head,
@@ -352,8 +372,14 @@ class Parser {
       } else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
       else if (keyword == "width factor") g_.width_factor = constant_value(text, vbegin, vend, line);
       else if (keyword == "seed") {
+        // After "homomorphism" it seeds the homomorphism's own draws (CPFG manual 4.3.3); the
+        // decomposition draws with the productions (4.4).
+        if (section_ == Section::kDecomposition)
+          fail(line, begin, "a decomposition draws with the productions' random numbers: 'seed:' belongs before "
+                            "'decomposition' (CPFG manual 4.4)");
         const auto seed = static_cast<uint64_t>(integer_value(text, vbegin, vend, line, 0, 1LL << 53));
-        if (first) g_.seed = seed;
+        if (first && section_ == Section::kHomomorphism) g_.homomorphism_seed = seed;
+        else if (first) g_.seed = seed;
       } else if (keyword == "lsystem") lsystem_label(text, vbegin, vend, line);
       else if (keyword == "maximum depth") current().max_depth = static_cast<int>(integer_value(text, vbegin, vend, line, 1, kMaxDepth));
       else if (keyword == "tropism") parse_tropism(text, vbegin, vend, line);
@@ -572,7 +598,7 @@ class Parser {
       fail(line, directive, "a sub-L-system's '" + keyword + ":' block is not supported (cpfg gives each call of a "
                             "sub-L-system its own copy of the variables, CPFG manual 7.2)");
     if (text[begin] != '{') fail(line, begin, "expected '{' after '" + keyword + ":'");
-    const StatementScope scope{nullptr, &g_.variables, true, &g_.defines};
+    const StatementScope scope{nullptr, &g_.variables, true, &g_.defines, data_files()};
     size_t pos = begin;
     const Expr block = compile_block(g_.program, text.substr(0, end), &pos, line, scope);
     while (pos < end && (is_space(text[pos]) || text[pos] == ';')) ++pos;
@@ -606,6 +632,7 @@ class Parser {
     std::vector<size_t> open;  // positions of unclosed '['
     const std::string_view word = text.substr(0, end);
     char previous = 0;  // the module before
+    size_t previous_at = 0;  // and where it is
     for (size_t k = begin; k < end;) {
       const char c = text[k];
       if (is_space(c)) { ++k; continue; }
@@ -614,7 +641,11 @@ class Parser {
       else if (c == '?' && is_query(text, k, end, line) && section_ != Section::kHomomorphism) g_.queries = true;
       // @L("label", ...), @S("command") and @I("object", s) take a string first (CPFG manual 6.10, 9.4, 9.5).
       const bool takes_string = previous == '@' && (c == 'L' || c == 'S' || c == 'I');
+      if (previous == '@' && c == 'P')
+        fail(line, previous_at, "'@P' (@PS, @PC, @PD: a bicubic patch from turtle positions, CPFG manual 6.7.2) is not "
+                          "supported; draw the surface from a '.s' file with '~id' (a 'surface:' line of the view file)");
       previous = c;
+      previous_at = k;
       if (c == '[') open.push_back(k);
       if (c == ']') {
         if (open.empty()) fail(line, k, "unbalanced brackets: ']' closes no '[' in the " + std::string(what));
@@ -714,9 +745,13 @@ class Parser {
     if (gt != kNone && find_top_level(text, gt + 1, head_end, '>') != kNone)
       fail(line, find_top_level(text, gt + 1, head_end, '>'), "expected one '>' after the predecessor");
     if (lt != kNone && gt != kNone && gt < lt) fail(line, gt, "expected '<' (left context) before '>' (right context)");
-    const bool contexts_allowed = section_ == Section::kProductions;
-    if (!contexts_allowed && (lt != kNone || gt != kNone))
-      fail(line, lt != kNone ? lt : gt, "contexts are only allowed in productions, not in decomposition or homomorphism rules");
+    // Homomorphism rules match contexts in the word being drawn (CPFG manual 4.3.2). cpfg
+    // matches a decomposition rule's contexts in the word before the step, which the
+    // decomposition here (run on the word after it) never sees.
+    if (section_ == Section::kDecomposition && (lt != kNone || gt != kNone))
+      fail(line, lt != kNone ? lt : gt,
+           "contexts are only allowed in productions and homomorphism rules, not in decomposition rules "
+           "(cpfg matches them in the word before the step)");
 
     const size_t pred_begin = lt == kNone ? begin : lt + 1;
     const size_t pred_end = gt == kNone ? head_end : gt;
@@ -759,7 +794,7 @@ class Parser {
   // manual 3.2); names the blocks assign for the first time become locals in formals.
   void parse_statements(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
                         std::vector<std::string>* formals, Rule* rule) {
-    const StatementScope statements{formals, &g_.variables, false, &g_.defines};
+    const StatementScope statements{formals, &g_.variables, false, &g_.defines, data_files()};
     const std::string_view head = text.substr(0, end);
     auto skip = [&](size_t k) { while (k < end && is_space(text[k])) ++k; return k; };
     size_t k = skip(begin);

@@ -177,7 +177,10 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
         view.tropism = Eigen::Vector3d(v[0], v[1], v[2]);
       }
       if (e != std::string::npos) view.tropism_elasticity = number(name, i, rest.substr(e + 2), "E");
-    } else if (key == "surface") {
+    } else if (key == "tsurface") {
+      fail(name, i, "'tsurface:' (a surface of triangles in rayshade's format, CPFG manual 8.1.5, 8.4) is not supported; "
+                    "give the surface as a bezieredit '.s' file on a 'surface:' line");
+    } else if (key == "surface" || key == "line") {  // cpfg reads "line:" as a surface of that id (8.1.5)
       std::optional<ViewSurface> surface = read_surface_line(path, i, rest);
       const auto same_id = [&](const ViewSurface& v) { return surface && v.id == surface->id; };
       // cpfg keeps the first surface of an id and leaves out one whose file does not exist.

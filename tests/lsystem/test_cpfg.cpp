@@ -18,9 +18,8 @@ namespace {
 
 Grammar parse(const std::string& text) { return parse_grammar({{"plant.l", text, false}}, {}); }
 
-std::string derive_text(const std::string& grammar, int steps) {
-  const Grammar g = parse(grammar);
-  const ModuleString word = derive(g, {steps, 1, 1'000'000});
+// word => "A(1,2)B" (parameters truncated).
+std::string text_of(const ModuleString& word) {
   std::string out;
   for (size_t i = 0; i < word.size(); ++i) {
     out += word.symbols[i];
@@ -29,6 +28,10 @@ std::string derive_text(const std::string& grammar, int steps) {
     if (!p.empty()) out += ")";
   }
   return out;
+}
+
+std::string derive_text(const std::string& grammar, int steps) {
+  return text_of(derive(parse(grammar), {steps, 1, 1'000'000}));
 }
 
 TEST(Cpfg, HeadersCommentsMacrosAndRulesOverLines) {
@@ -95,6 +98,9 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A ?E(1)\n"),
             "plant.l:1:10: '?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
   EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
+  EXPECT_EQ(error_of("axiom: A\nA --> F @PS(1, 1) @PC(1, 0, 0) @PD(1, 4, 4)\n"),
+            "plant.l:2:9: '@P' (@PS, @PC, @PD: a bicubic patch from turtle positions, CPFG manual 6.7.2) is not "
+            "supported; draw the surface from a '.s' file with '~id' (a 'surface:' line of the view file)");
 }
 
 // '=' in a right context (cpfg's generate.c) skips to the end of the current branch.
@@ -292,6 +298,75 @@ TEST(Cpfg, CurveFunctions) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "plant.l:1:10: curveY expects a constant number 1 ... 1 (the view file's 'curve:' lines)");
   }
+}
+
+// Homomorphism rules match contexts in the word being drawn; a module a homomorphism rule
+// produces takes the contexts of the module it comes from (CPFG manual 4.3.2).
+TEST(Cpfg, HomomorphismContextsAreTheDerivedWords) {
+  const Grammar g = parse("derivation length: 0\naxiom: F P(1,2) F P(1,5) [Q] F\nignore: Q\n"
+                          "homomorphism\nF > P(x,y) : y > 3 --> f\nP(x,y) < F --> G(x)\n");
+  const ModuleString word = derive(g, {0, 1, 100});
+  EXPECT_EQ(text_of(apply_homomorphism(g, word, {0, 1, 100})), "FP(1,2)fP(1,5)[Q]G(1)");
+  const Grammar deep = parse("axiom: F P(1,2) F P(1,5)\nhomomorphism\nmaximum depth: 2\n"
+                             "F --> G P(0,0)\nG > P(x,y) : y > 3 --> f\n");
+  EXPECT_EQ(text_of(apply_homomorphism(deep, derive(deep, {0, 1, 100}), {0, 1, 100})),
+            "GP(0,0)P(1,2)fP(0,0)P(1,5)");
+}
+
+// "seed:" after "homomorphism" seeds its draws alone (CPFG manual 4.3.3): the same drawing
+// whatever the derivation's seed, which it leaves as it is.
+TEST(Cpfg, HomomorphismSeedKeysOnlyTheHomomorphism) {
+  const std::string text = "axiom: A\nhomomorphism\nseed: 5\nA --> F(ran(1000))\n";
+  const Grammar g = parse(text);
+  EXPECT_EQ(g.seed, 0u);
+  const ModuleString word = derive(g, {0, 1, 100});
+  EXPECT_EQ(apply_homomorphism(g, word, {0, 1, 100}).params, apply_homomorphism(g, word, {0, 2, 100}).params);
+  const Grammar unseeded = parse("axiom: A\nhomomorphism\nA --> F(ran(1000))\n");
+  EXPECT_NE(apply_homomorphism(unseeded, word, {0, 1, 100}).params, apply_homomorphism(unseeded, word, {0, 2, 100}).params);
+  EXPECT_EQ(error_of("axiom: A\ndecomposition\nseed: 5\n"),
+            "plant.l:3:1: a decomposition draws with the productions' random numbers: 'seed:' belongs before "
+            "'decomposition' (CPFG manual 4.4)");
+}
+
+// fopen(name, "r") and fscan (CPFG manual 5.4) read a data file beside the grammar, as C's
+// fscanf reads numbers; writing files is refused.
+TEST(Cpfg, FscanReadsADataFileBesideTheGrammar) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("treeanim_test_cpfg_fscan-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lengths.txt") << "first: 3, 4\n5\n  6.5e0\n";
+  const std::string grammar = (dir / "plant.l").string();
+  const auto grow = [&](const std::string& text, int steps) {
+    return text_of(derive(parse_grammar({{grammar, text, false}}, {}), {steps, 1, 100}));
+  };
+  const std::string reader =
+      "Start: {fp = fopen(\"lengths.txt\", \"r\"); n = fscan(fp, \"first: %f,%lf\", &a, &b);}\n"
+      "derivation length: 4\naxiom: C(a + b, n) A\n"
+      "A : {k = fscan(fp, \"%f\", &x);} k == 1 --> B(x) A\nA : {k = fscan(fp, \"%f\", &x);} * --> E(k, x)\n"
+      "End: {fclose(fp);}\n";
+  EXPECT_EQ(grow(reader, 2), "C(7,2)B(5)B(6)A");
+  EXPECT_EQ(grow(reader, 3), "C(7,2)B(5)B(6)E(-1,0)");  // the end of the file: -1, x keeps its value
+  const auto refused = [&](const std::string& text) {
+    try {
+      parse_grammar({{grammar, text, false}}, {});
+    } catch (const InputError& e) {
+      return std::string(e.what()).substr(grammar.size());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(refused("Start: {fp = fopen(\"out.txt\", \"w\");}\naxiom: A\n"),
+            ":1:31: fopen(..., \"w\") writes a file, which is not supported: a grammar must not write files on a "
+            "render farm (CPFG manual 5.4; fopen(name, \"r\") reads a data file beside the grammar)");
+  EXPECT_EQ(refused("Start: {fp = fopen(\"../secret\", \"r\");}\naxiom: A\n"),
+            ":1:20: fopen(\"../secret\") names a file outside the grammar's folder: a grammar reads only files beside "
+            "it (a relative path without '..')");
+  EXPECT_EQ(refused("Start: {fp = fopen(\"lengths.txt\", \"r\"); fprintf(fp, \"%f\", 1);}\naxiom: A\n"),
+            ":1:41: fprintf writes to a file, which is not supported: a grammar must not write files on a render "
+            "farm (CPFG manual 5.4; printf computes its values and prints nothing)");
+  EXPECT_EQ(refused("Start: {fp = fopen(\"lengths.txt\", \"r\"); n = fscan(fp, \"%s\", &a);}\naxiom: A\n"),
+            ":1:55: fscan: '%s' reads no number (fscan reads %f, %e, %g, %d or %i: every variable is a number)");
+  EXPECT_EQ(refused("Start: {fp = fopen(\"missing.txt\", \"r\");}\naxiom: A\n").substr(0, 30),
+            ":1:20: fopen cannot read '" + dir.string().substr(0, 4));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Cpfg, EndlessLoopStopsWithItsPlace) {

@@ -167,7 +167,8 @@ TEST(Grammar, MalformedGrammarsReportFileLineColumn) {
       {"axiom: A\nA -->\n", "g.lsys:2:6: expected a successor after the arrow (write '*' for an empty successor)"},
       {"axiom: A\nA --> B*C\n", "g.lsys:2:8: '*' is not a module; alone it stands for an empty successor"},
       {"axiom: A\ndecomposition\nB < A --> C\n",
-       "g.lsys:3:3: contexts are only allowed in productions, not in decomposition or homomorphism rules"},
+       "g.lsys:3:3: contexts are only allowed in productions and homomorphism rules, not in decomposition rules "
+       "(cpfg matches them in the word before the step)"},
       {"#include \"x.h\"\naxiom: A\n",
        "g.lsys:1:1: cannot read the included file 'x.h' (no such file)"},
       {"axiom: A(1/0)\n", "g.lsys:1:11: division by zero"},

@@ -94,6 +94,19 @@ TEST_F(ViewFile, SurfaceLinesTakeScalePrecisionAndTheFirstOfAnId) {
   EXPECT_FALSE(v.surfaces[3].precision);    // "0 0" leaves it to the file
 }
 
+// cpfg reads "line: id file.s scale" as a surface of that id (CPFG manual 8.1.5: its line
+// type is never drawn); "tsurface:" is refused rather than left out.
+TEST_F(ViewFile, LineIsASurfaceAndTsurfaceIsRefused) {
+  write_surface("blade.s");
+  const ViewSettings v = read_view_file(write("plant.v", "line: L blade.s 0.5\nsurface: L blade.s 9\n"));
+  ASSERT_EQ(v.surfaces.size(), 1u);
+  EXPECT_EQ(v.surfaces[0].id, 'L');
+  EXPECT_EQ(v.surfaces[0].scale, 0.5);
+  EXPECT_EQ(error_of("angle factor: 8\ntsurface: t leaf.ray 1\n"),
+            "plant.v:2:1: 'tsurface:' (a surface of triangles in rayshade's format, CPFG manual 8.1.5, 8.4) is not "
+            "supported; give the surface as a bezieredit '.s' file on a 'surface:' line");
+}
+
 TEST_F(ViewFile, AngleFactorDividesTheCircleAndWidthsInPixelsAreLeftOut) {
   const ViewSettings v = read_view_file(write("plant.v", "angle factor: 16\ninitial line width: 3 pixels\n"));
   EXPECT_EQ(v.angle, 22.5);

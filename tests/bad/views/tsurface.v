@@ -1,0 +1,2 @@
+angle increment: 20
+tsurface: t leaf.ray 1
