@@ -1,5 +1,7 @@
 #include "lsystem/lsystem.h"
 
+#include <algorithm>
+
 #include "common/errors.h"
 #include "common/read_text_file.h"
 
@@ -38,6 +40,32 @@ LeafShape view_surface_shape(const ViewSurface& v, std::optional<int> scene_prec
   if (shape.triangles.empty())
     throw InputError(v.where + ": the surface '" + std::string(1, v.id) + "' has no area (every patch collapses to a line or a point)");
   return shape;
+}
+
+// The tropisms of the grammar and the view file, and the scene's lsystem.tropism and
+// lsystem.tropism_elasticity in place of the first of them: the view file's first "tropism:"
+// line (its T: direction, keeping its intensity, and its E:), else its older "tropism
+// direction:"/"initial elasticity:" when it gives either, else the grammar's "tropism:".
+void set_tropisms(const LsystemOptions& options, const Grammar& grammar, const ViewSettings& view, TurtleSettings& turtle) {
+  turtle.movements = view.movements;
+  turtle.old_tropism = view.old_tropism.value_or(turtle.old_tropism);
+  turtle.initial_elasticity = view.initial_elasticity.value_or(0.0);
+  turtle.elasticity_increment = view.elasticity_increment.value_or(0.0);
+  if (grammar.tropism) {
+    turtle.tropism = *grammar.tropism;
+    turtle.tropism_elasticity = grammar.tropism_elasticity;
+  }
+  const auto first = std::find_if(turtle.movements.begin(), turtle.movements.end(), [](const Movement& m) { return !m.torque; });
+  if (first != turtle.movements.end()) {
+    if (options.tropism) first->direction = options.tropism->normalized() * first->direction.norm();
+    if (options.tropism_elasticity) first->elasticity = *options.tropism_elasticity;
+  } else if (view.old_tropism || view.initial_elasticity) {
+    if (options.tropism) turtle.old_tropism = options.tropism->normalized();
+    if (options.tropism_elasticity) turtle.initial_elasticity = *options.tropism_elasticity;
+  } else {
+    if (options.tropism) turtle.tropism = *options.tropism;
+    if (options.tropism_elasticity) turtle.tropism_elasticity = *options.tropism_elasticity;
+  }
 }
 
 }  // namespace
@@ -80,14 +108,9 @@ TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& gra
   turtle.initial_width = view.initial_width.value_or(turtle.initial_width);
   turtle.calls = grammar.calls;
   if (options.view) turtle.width_increment = view.width_increment.value_or(1.0);
-  if (grammar.tropism) {
-    turtle.tropism = *grammar.tropism;
-    turtle.tropism_elasticity = grammar.tropism_elasticity;
-  }
-  if (view.tropism) turtle.tropism = *view.tropism;
-  if (view.tropism_elasticity) turtle.tropism_elasticity = *view.tropism_elasticity;
-  if (options.tropism) turtle.tropism = *options.tropism;
-  if (options.tropism_elasticity) turtle.tropism_elasticity = *options.tropism_elasticity;
+  set_tropisms(options, grammar, view, turtle);
+  turtle.initial_scale = view.initial_scale.value_or(1.0);
+  turtle.scale_multiplier = view.scale_multiplier.value_or(1.0);
   for (const ViewSurface& v : view.surfaces) turtle.surfaces.push_back(view_surface_shape(v, options.surface_precision));
   return turtle;
 }

@@ -45,7 +45,10 @@ struct State {
   int32_t segment = -1;   // last segment drawn on this path: the parent of the next one
   bool branched = false;  // a '[' was opened since `segment` was drawn
   bool cylinder = false;  // inside a generalised cylinder (@Gs ... @Ge): 'f' draws too
-  double scale = 1.0;     // product of the open sub-L-system calls' scales: lengths, widths, surfaces
+  double scale = 1.0;     // cpfg's turtle scale (sub-L-system calls, @D): lengths, widths, surfaces
+  Vector3d last_heading{0, 1, 0};  // H after the last F or G (cpfg's tropisms keep U from twisting against it)
+  Vector3d last_up{0, 0, 1};       // U after the last F or G
+  double elasticity = 0.0;         // of cpfg's older tropism, changed by '_'
 };
 
 // A '{' not yet closed: the turtle state at the '{' (the leaf's base and frame) and where its
@@ -148,7 +151,11 @@ class Turtle {
         settings_(settings),
         default_turn_{std::cos(settings.angle_degrees * kDegToRad),
                       std::sin(settings.angle_degrees * kDegToRad)},
-        bends_(settings.tropism_elasticity != 0.0) {
+        bends_(settings.tropism_elasticity != 0.0),
+        moves_(!settings.movements.empty()) {
+    for (const Movement& m : settings.movements) elasticity_.push_back(m.elasticity);
+    s_.elasticity = settings.initial_elasticity;
+    s_.scale = settings.initial_scale;
     reserve_outputs();
   }
 
@@ -178,12 +185,16 @@ class Turtle {
           break;
         case '[':
           stack_.push_back(s_);
+          saved_elasticity_.insert(saved_elasticity_.end(), elasticity_.begin(), elasticity_.end());
           s_.branched = true;
           break;
         case ']':
           if (!stack_.empty()) {
             s_ = stack_.back();
             stack_.pop_back();
+            std::copy(saved_elasticity_.end() - static_cast<std::ptrdiff_t>(elasticity_.size()), saved_elasticity_.end(),
+                      elasticity_.begin());
+            saved_elasticity_.resize(saved_elasticity_.size() - elasticity_.size());
           }
           break;
         case '!':
@@ -209,6 +220,7 @@ class Turtle {
           break;
         case '}': close_polygon(); break;
         case '%': i = end_of_branch(symbols, i) - 1; break;  // the loop's ++i lands on the ']'
+        case '_': s_.elasticity = has_param(i) ? first_param(i) : s_.elasticity + settings_.elasticity_increment; break;
         default: break;  // structural module (A, B, X ...): nothing to draw
       }
     }
@@ -257,22 +269,28 @@ class Turtle {
 
   // '?(label, s)' calls a sub-L-system (CPFG manual 7.2): lengths, widths and surfaces are
   // scaled by s (1 when not given) until its '$'. => the module used.
+  // As in cpfg, a call's scale multiplies the caller's call scale, not an @D scale set since.
   size_t call(size_t i) {
     const std::span<const double> p = word_.params_of(i);
     const double s = p.size() >= 2 ? p[1] : 1.0;
-    calls_.push_back(s_.scale);
-    s_.scale *= s;
+    calls_.push_back(call_scale() * s);
+    s_.scale = calls_.back();
     s_.width *= s;
     return i;
   }
 
-  // '$' ends the innermost call: its scale is undone (a '$' without a call changes nothing).
+  // '$' ends the innermost call: the turtle takes the caller's call scale and the width follows
+  // (a '$' without a call changes nothing).
   void return_from_call() {
     if (calls_.empty()) return;
-    if (s_.scale != 0.0) s_.width *= calls_.back() / s_.scale;
-    s_.scale = calls_.back();
+    const double ended = calls_.back();
     calls_.pop_back();
+    s_.scale = call_scale();
+    if (ended != 0.0) s_.width *= s_.scale / ended;
   }
+
+  // The innermost open call's scale, else the view file's initial scale.
+  double call_scale() const { return calls_.empty() ? settings_.initial_scale : calls_.back(); }
 
   // '?' and its letter (cpfg's query modules, CPFG manual 6.9): ?P ?H ?U ?L take the turtle's
   // position, heading, up and left vectors (x, y[, z]) when answering; they draw nothing.
@@ -297,7 +315,8 @@ class Turtle {
   // '@' and the letter after it (cpfg's two-character modules, CPFG manual 6): @v rolls L
   // horizontal, @M(x,y,z) moves to a point, @R(hx,hy,hz[,ux,uy,uz]) sets the heading, @O(d) (a
   // sphere) and @o(d) @c(d) (circles) become small leaves, @Gs ... @Ge (a generalised cylinder)
-  // makes 'f' draw; textures (@T*), @Gc and the rest draw nothing. => the last module used.
+  // makes 'f' draw; @T* set tropisms (tropism_module), @D* the scale (scale_module); textures
+  // (@Tx), @Gc and the rest draw nothing. => the last module used.
   size_t at_command(size_t i) {
     if (i + 1 >= word_.size()) return i;
     const size_t c = i + 1;
@@ -310,6 +329,8 @@ class Turtle {
           return c + 1;
         }
         break;
+      case 'T': return tropism_module(c);
+      case 'D': return scale_module(c);
       case 'O': draw_organ(sphere_shape(), p); break;
       case 'o':  // a circle in the screen's plane: a baked tree has no screen, so it lies in HL as @c
       case 'c': draw_organ(disc_shape(), p); break;
@@ -323,6 +344,55 @@ class Turtle {
     }
     return c;
   }
+
+  // @T and its subfunction at c + 1 (CPFG manual 6.8, as cpfg reads them): @Ts(id, e) sets
+  // movement id's elasticity (no e: 0), @Ti(id, d) adds d and @Td(id, d) subtracts it (no d: the
+  // line's S:), @Tp carries U from the last segment, @Tf makes this frame the last segment's,
+  // @Tx is a texture. Without any parameter, or with an id that names no line, @Ts/@Ti/@Td do
+  // nothing (cpfg warns); @T with its own parameters reads no subfunction and does nothing.
+  // => the last module used.
+  size_t tropism_module(size_t c) {
+    if (has_param(c) || c + 1 >= word_.size()) return c;
+    const std::span<const double> p = word_.params_of(c + 1);
+    const char sub = word_.symbols[c + 1];
+    switch (sub) {
+      case 'x': break;
+      case 'p': carry_up(frame()); break;
+      case 'f':
+        s_.last_heading = s_.heading;
+        s_.last_up = s_.up;
+        break;
+      case 's':
+      case 'i':
+      case 'd': {
+        const double id = p.empty() ? 0.0 : std::trunc(p[0] - 1.0);
+        if (p.empty() || !(id >= 0.0 && id < static_cast<double>(elasticity_.size()))) break;
+        double& e = elasticity_[static_cast<size_t>(id)];
+        const double value = p.size() >= 2 ? p[1] : sub == 's' ? 0.0 : settings_.movements[static_cast<size_t>(id)].step;
+        e = sub == 's' ? value : sub == 'i' ? e + value : e - value;
+        break;
+      }
+      default: return c;  // cpfg reads an unknown subfunction as a module of its own
+    }
+    return c + 1;
+  }
+
+  // @D(s) sets the turtle scale to s; @Di(x) multiplies it by x and @Dd(x) divides it (no x: the
+  // view file's scale multiplier; x = 0 changes nothing), as cpfg does (CPFG manual 6.3).
+  // => the last module used.
+  size_t scale_module(size_t c) {
+    if (has_param(c)) {
+      s_.scale = first_param(c);
+      return c;
+    }
+    if (c + 1 >= word_.size() || (word_.symbols[c + 1] != 'i' && word_.symbols[c + 1] != 'd')) return c;
+    const double x = has_param(c + 1) ? first_param(c + 1) : settings_.scale_multiplier;
+    if (x != 0.0) s_.scale = word_.symbols[c + 1] == 'i' ? s_.scale * x : s_.scale / x;
+    return c + 1;
+  }
+
+  // The turtle's frame for the tropisms.
+  BendFrame frame() { return {s_.heading, s_.left, s_.up, s_.last_heading, s_.last_up}; }
 
   // @R: heading h, and up from p[3..5] when given (else the nearest frame to the old one).
   void set_heading(const Vector3d& h, std::span<const double> p) {
@@ -343,8 +413,10 @@ class Turtle {
 
   // F G f g at module i. Inside '{ }' they only move (F and f recording a vertex, ABOP ch. 5);
   // outside, F and G draw a segment and f and g move.
+  // cpfg's tropisms turn the turtle before all four moves and its older tropism after them.
   void forward(size_t i, bool draws, bool records) {
     const double length = (has_param(i) ? first_param(i) : settings_.step) * s_.scale;
+    if (moves_) apply_movements(settings_.movements, elasticity_, frame());
     if (!polygons_.empty()) {
       s_.position += length * s_.heading;
       if (records) points_.push_back(s_.position);
@@ -352,6 +424,11 @@ class Turtle {
       draw_segment(static_cast<uint32_t>(i), length);
     } else {
       s_.position += length * s_.heading;
+    }
+    if (s_.elasticity != 0.0) bend_old_style(settings_.old_tropism, s_.elasticity, frame());
+    if (moves_ && draws) {
+      s_.last_heading = s_.heading;
+      s_.last_up = s_.up;
     }
   }
 
@@ -467,9 +544,12 @@ class Turtle {
   const TurtleSettings& settings_;
   const SinCos default_turn_;  // cos, sin of settings.angle_degrees
   const bool bends_;           // tropism on
+  const bool moves_;           // cpfg tropisms or torques given
   State s_;
   std::vector<State> stack_;          // '[' states, innermost last
-  std::vector<double> calls_;         // the scale before each open sub-L-system call, innermost last
+  std::vector<double> calls_;         // the scale of each open sub-L-system call, innermost last
+  std::vector<double> elasticity_;    // [movements] current elasticity of each cpfg tropism and torque
+  std::vector<double> saved_elasticity_;  // [open '[' x movements] elasticity_ at each open '[', innermost last
   std::vector<OpenPolygon> polygons_; // open '{', innermost last
   std::vector<Vector3d> points_;      // vertices of the open polygons, outer ones first
   SinCosCache angles_;

@@ -7,6 +7,7 @@
 #include "lsystem/leaf_shapes.h"
 #include "lsystem/module_string.h"
 #include "lsystem/skeleton.h"
+#include "lsystem/tropism.h"
 
 namespace treeanim {
 
@@ -18,6 +19,12 @@ struct TurtleSettings {
   std::optional<double> width_increment;      // cpfg view file: '#' adds it, '!' without a parameter subtracts it
   Eigen::Vector3d tropism{0, -1, 0};          // T of "tropism:" (direction of the bending force)
   double tropism_elasticity = 0.0;            // e; 0 = no tropism
+  std::vector<Movement> movements;            // cpfg view file's "tropism:"/"torque:" lines, before every F G f g
+  Eigen::Vector3d old_tropism{0, 1, 0};       // cpfg's unit "tropism direction:" (8.1.10), after every F G f g
+  double initial_elasticity = 0.0;            // cpfg's "initial elasticity:" of that tropism ('_' changes it)
+  double elasticity_increment = 0.0;          // cpfg's "elasticity increment:": what '_' adds
+  double initial_scale = 1.0;                 // cpfg's "initial scale:": lengths, widths and surfaces (@D changes it)
+  double scale_multiplier = 1.0;              // cpfg's "scale multiplier:": @Di multiplies, @Dd divides by it
   std::vector<LeafShape> surfaces;            // the view file's surfaces: ~id draws the one of its letter
   bool calls = false;                         // the grammar calls sub-L-systems: '?(label, s)' scales until '$'
 };

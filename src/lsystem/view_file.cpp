@@ -2,8 +2,12 @@
 #include "lsystem/view_file.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
 #include <sstream>
 
 #include "common/errors.h"
@@ -98,6 +102,56 @@ std::vector<double> sample_spline(const std::vector<Eigen::Vector2d>& control) {
   return out;
 }
 
+// "tropism: T: x y z [A: angle] [I: intensity] [E: elasticity] [S: step]" (or "torque:", whose A:
+// is read and not used) of line `line` => the movement as cpfg computes it (CPFG manual 8.1.8).
+// cpfg drops a line it cannot read; here it is refused with its place.
+Movement read_movement(const std::string& name, size_t line, const std::string& key, const std::string& rest) {
+  std::string spaced = rest;
+  std::replace_if(spaced.begin(), spaced.end(), [](char c) { return c == ',' || c == ':' || c == '\t'; }, ' ');
+  std::istringstream in(spaced);
+  const std::string head = "'" + key + ":' ";
+  Movement m;
+  m.torque = key == "torque";
+  std::optional<Eigen::Vector3d> t;
+  std::optional<double> intensity;
+  std::string seen;
+  for (std::string word; in >> word;) {
+    if (word.size() != 1 || std::string("TAIES").find(word[0]) == std::string::npos)
+      fail(name, line, head + "expected a subcommand T: A: I: E: or S:, got '" + word + "'");
+    const char c = word[0];
+    if (seen.find(c) != std::string::npos) fail(name, line, head + "gives '" + word + ":' twice");
+    seen += c;
+    std::array<double, 3> v{};
+    for (int k = 0; k < (c == 'T' ? 3 : 1); ++k) {
+      std::string number;
+      in >> number;
+      size_t used = 0;
+      try {
+        v[static_cast<size_t>(k)] = std::stod(number, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != number.size() || !std::isfinite(v[static_cast<size_t>(k)]))
+        fail(name, line, head + "expected " + (c == 'T' ? "three numbers" : "a number") + " after '" + word + ":'");
+    }
+    if (c == 'T') t = Eigen::Vector3d(v[0], v[1], v[2]);
+    if (c == 'I' && !t) fail(name, line, head + "expected 'T:' before 'I:' (cpfg reads an intensity before the direction as 0 and drops the line)");
+    if (c == 'I') intensity = v[0];
+    if (c == 'A' && !m.torque) {
+      m.cos_angle = std::cos(v[0] * std::numbers::pi / 180.0);
+      m.sin_angle = std::sin(v[0] * std::numbers::pi / 180.0);
+    }
+    if (c == 'E') m.elasticity = v[0];
+    if (c == 'S') m.step = v[0];
+  }
+  if (!t) fail(name, line, head + "expected 'T: x y z' (it is mandatory)");
+  const double length = t->norm();
+  if (length == 0.0) fail(name, line, head + "expected a non-zero 'T:' vector");
+  if (intensity && *intensity == 0.0) fail(name, line, head + "expected a non-zero 'I:' (cpfg drops a line of intensity 0)");
+  m.direction = *t * (intensity ? std::clamp(*intensity / length, -1.0, 1.0) : 1.0 / length);
+  return m;
+}
+
 // "id file.s scale [i j] [texture]" of the view file's line `line` => the surface with its
 // file read, or nothing when that file does not exist (cpfg then leaves the surface out).
 std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, size_t line, const std::string& rest) {
@@ -169,14 +223,17 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
     } else if (key == "initial line width") {
       if (rest.find('p') == std::string::npos) view.initial_width = number(name, i, rest, key.c_str());
     } else if (key == "line width increment") view.width_increment = number(name, i, rest, key.c_str());
-    else if (key == "tropism") {
-      const size_t t = rest.find("T:"), e = rest.find("E:");
-      if (t != std::string::npos) {
-        const std::vector<double> v = numbers(rest.substr(t + 2, e == std::string::npos ? std::string::npos : e - t - 2));
-        if (v.size() != 3 || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0) fail(name, i, "expected 'T: x,y,z' (non-zero) after 'tropism:'");
-        view.tropism = Eigen::Vector3d(v[0], v[1], v[2]);
-      }
-      if (e != std::string::npos) view.tropism_elasticity = number(name, i, rest.substr(e + 2), "E");
+    else if (key == "tropism" || key == "torque") view.movements.push_back(read_movement(name, i, key, rest));
+    else if (key == "tropism direction") {
+      const std::vector<double> v = numbers(rest);
+      if (v.size() != 3 || !Eigen::Vector3d(v[0], v[1], v[2]).allFinite() || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0)
+        fail(name, i, "expected 'tropism direction: x,y,z' (three numbers, not all 0)");
+      view.old_tropism = Eigen::Vector3d(v[0], v[1], v[2]).normalized();
+    } else if (key == "initial elasticity") view.initial_elasticity = number(name, i, rest, key.c_str());
+    else if (key == "elasticity increment") view.elasticity_increment = number(name, i, rest, key.c_str());
+    else if (key == "initial scale" || key == "scale multiplier") {
+      const double x = number(name, i, rest, key.c_str());
+      (key == "initial scale" ? view.initial_scale : view.scale_multiplier) = x == 0.0 ? 1.0 : x;
     } else if (key == "tsurface") {
       fail(name, i, "'tsurface:' (a surface of triangles in rayshade's format, CPFG manual 8.1.5, 8.4) is not supported; "
                     "give the surface as a bezieredit '.s' file on a 'surface:' line");

@@ -9,6 +9,7 @@
 
 #include "lsystem/expression.h"
 #include "lsystem/surface_file.h"
+#include "lsystem/tropism.h"
 
 namespace treeanim {
 
@@ -25,8 +26,12 @@ struct ViewSettings {
   std::optional<double> angle;                // "angle increment: a" or 360 / "angle factor: n"
   std::optional<double> initial_width;        // "initial line width: w" (not in pixels)
   std::optional<double> width_increment;      // "line width increment: d": '#' adds, '!' subtracts
-  std::optional<Eigen::Vector3d> tropism;     // "tropism: T: x,y,z ..."
-  std::optional<double> tropism_elasticity;   // "... E: e" or "initial elasticity: e"
+  std::vector<Movement> movements;            // "tropism:" and "torque:" lines, in order (ids 1, 2, ...)
+  std::optional<Eigen::Vector3d> old_tropism; // "tropism direction: x,y,z", made unit (8.1.10)
+  std::optional<double> initial_elasticity;   // "initial elasticity: e" of that tropism
+  std::optional<double> elasticity_increment; // "elasticity increment: d": what '_' adds
+  std::optional<double> initial_scale;        // "initial scale: s" (0 reads as 1, as in cpfg)
+  std::optional<double> scale_multiplier;     // "scale multiplier: m" of @Di/@Dd (0 reads as 1)
   std::vector<ViewSurface> surfaces;          // "surface:" lines whose file exists, in order: drawn by ~id as leaves
   std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
   std::vector<ViewCurve> curves;              // "curve: c.con [samples]", in order (curveX ... curveGAL)

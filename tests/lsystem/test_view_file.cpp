@@ -66,9 +66,9 @@ TEST_F(ViewFile, ReadsTheSettingsThatShapeTheTreeAndPassesRenderingOnes) {
   EXPECT_EQ(v.angle, 22.5);
   EXPECT_EQ(v.initial_width, 0.4);
   EXPECT_EQ(v.width_increment, 0.05);
-  ASSERT_TRUE(v.tropism);
-  EXPECT_EQ(*v.tropism, Eigen::Vector3d(0, -1, 0));
-  EXPECT_EQ(v.tropism_elasticity, 0.2);
+  ASSERT_EQ(v.movements.size(), 1u);
+  EXPECT_EQ(v.movements[0].direction, Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(v.movements[0].elasticity, 0.2);
   ASSERT_EQ(v.surfaces.size(), 1u);
   EXPECT_EQ(v.surfaces[0].id, 'l');
   EXPECT_EQ(v.surfaces[0].scale, 1.0);
@@ -112,7 +112,7 @@ TEST_F(ViewFile, AngleFactorDividesTheCircleAndWidthsInPixelsAreLeftOut) {
   EXPECT_EQ(v.angle, 22.5);
   EXPECT_FALSE(v.initial_width);
   EXPECT_FALSE(v.width_increment);
-  EXPECT_FALSE(v.tropism);
+  EXPECT_TRUE(v.movements.empty());
 }
 
 TEST_F(ViewFile, FunctionFilesInBothFormatsAreFoundBesideTheViewFile) {
@@ -139,8 +139,8 @@ TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(error_of("viewpoint: 0,0,1\nangle increment: wide\n"), "plant.v:2:1: expected a number after 'angle increment:'");
   EXPECT_EQ(error_of("angle factor: 0\n"), "plant.v:1:1: expected a non-zero 'angle factor:'");
   EXPECT_EQ(error_of("line width increment: nan\n"), "plant.v:1:1: expected a number after 'line width increment:'");
-  EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: expected 'T: x,y,z' (non-zero) after 'tropism:'");
-  EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: expected a number after 'E:'");
+  EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: 'tropism:' expected a non-zero 'T:' vector");
+  EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: 'tropism:' expected a number after 'E:'");
   EXPECT_EQ(error_of("surface: leaf leaf.s 1\n"), "plant.v:1:1: expected a one-letter surface id after 'surface:'");
   EXPECT_EQ(error_of("surface: l\n"), "plant.v:1:1: expected 'surface: id file.s scale' (the file name after the id)");
   EXPECT_EQ(error_of("surface: l leaf.s big\n"), "plant.v:1:1: expected 'surface: id file.s scale' (a number after the file name)");
@@ -158,6 +158,54 @@ TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
             "short.fset:14:1: expected a funcedit function starting with 'fver 1 1' (or 'range:' in the older format)");
   write("noitems.fset", "funcgalleryver 1 1\n");
   EXPECT_EQ(error_of("function set: noitems.fset\n"), "noitems.fset:2:1: expected 'items: n' after 'funcgalleryver'");
+}
+
+// Several tropisms and torques (CPFG manual 8.1.8) as cpfg computes them: T made unit and scaled
+// by the intensity clamp(I / |T|, -1, 1), A: as its cosine and sine (not for a torque), E:, S:.
+TEST_F(ViewFile, TropismAndTorqueLinesInOrder) {
+  const ViewSettings v = read_view_file(write("plant.v", "tropism: T: 0 2 0 E: 0.1\n"
+                                                         "tropism: T: 0.0  0.0 1.0  A:90 I: 0.5 S: 0.05\n"
+                                                         "torque: T: 1,0,0 A: 30 E: -0.2\n"
+                                                         "tropism: T: 0 3 0 I: 6\n"
+                                                         "tropism direction: 0,-2,0\ninitial elasticity: 0.15\n"
+                                                         "elasticity increment: -0.06\ninitial scale: 0\nscale multiplier: 2\n"));
+  ASSERT_EQ(v.movements.size(), 4u);
+  EXPECT_FALSE(v.movements[0].torque);
+  EXPECT_EQ(v.movements[0].direction, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(v.movements[0].cos_angle, 1.0);
+  EXPECT_EQ(v.movements[0].sin_angle, 0.0);
+  EXPECT_EQ(v.movements[0].elasticity, 0.1);
+  EXPECT_EQ(v.movements[1].direction, Eigen::Vector3d(0, 0, 0.5));
+  EXPECT_NEAR(v.movements[1].cos_angle, 0.0, 1e-15);
+  EXPECT_EQ(v.movements[1].sin_angle, 1.0);
+  EXPECT_EQ(v.movements[1].elasticity, 0.0);
+  EXPECT_EQ(v.movements[1].step, 0.05);
+  EXPECT_TRUE(v.movements[2].torque);
+  EXPECT_EQ(v.movements[2].cos_angle, 1.0);  // A: means nothing to a torque
+  EXPECT_EQ(v.movements[2].elasticity, -0.2);
+  EXPECT_EQ(v.movements[3].direction, Eigen::Vector3d(0, 3, 0));  // I / |T| = 2, clamped to 1
+  EXPECT_EQ(v.old_tropism, Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(v.initial_elasticity, 0.15);
+  EXPECT_EQ(v.elasticity_increment, -0.06);
+  EXPECT_EQ(v.initial_scale, 1.0);  // 0 reads as 1, as in cpfg
+  EXPECT_EQ(v.scale_multiplier, 2.0);
+}
+
+// cpfg drops a tropism line it cannot read and goes on; here it is refused with its place.
+TEST_F(ViewFile, MalformedTropismLinesAreRefused) {
+  EXPECT_EQ(error_of("tropism: E: 0.2\n"), "plant.v:1:1: 'tropism:' expected 'T: x y z' (it is mandatory)");
+  EXPECT_EQ(error_of("\ntorque: T: 0 1\n"), "plant.v:2:1: 'torque:' expected three numbers after 'T:'");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 B: 2\n"), "plant.v:1:1: 'tropism:' expected a subcommand T: A: I: E: or S:, got 'B'");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 0.5\n"), "plant.v:1:1: 'tropism:' expected a subcommand T: A: I: E: or S:, got '0.5'");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 E: 1 E: 2\n"), "plant.v:1:1: 'tropism:' gives 'E:' twice");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 A: 9x\n"), "plant.v:1:1: 'tropism:' expected a number after 'A:'");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 I: 0\n"), "plant.v:1:1: 'tropism:' expected a non-zero 'I:' (cpfg drops a line of intensity 0)");
+  EXPECT_EQ(error_of("tropism: I: 2 T: 0 1 0\n"),
+            "plant.v:1:1: 'tropism:' expected 'T:' before 'I:' (cpfg reads an intensity before the direction as 0 and drops the line)");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 E:\n"), "plant.v:1:1: 'tropism:' expected a number after 'E:'");
+  EXPECT_EQ(error_of("tropism direction: 0,0,0\n"), "plant.v:1:1: expected 'tropism direction: x,y,z' (three numbers, not all 0)");
+  EXPECT_EQ(error_of("initial elasticity: soft\n"), "plant.v:1:1: expected a number after 'initial elasticity:'");
+  EXPECT_EQ(error_of("initial scale: big\n"), "plant.v:1:1: expected a number after 'initial scale:'");
 }
 
 // A cuspy curve file in cpfg's layout: a straight line from (0, 0) to (0, 3) (control points on
