@@ -1,14 +1,14 @@
 // End to end: the built treeanim binary, its exit codes, messages and outputs.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdlib>
 
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "temp_folder_test.h"
 
 namespace {
 
@@ -26,16 +26,9 @@ std::string slurp(const fs::path& file) {
   return text.str();
 }
 
-class Cli : public ::testing::Test {
+class Cli : public TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("treeanim-cli-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-            "-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Cli() : TempFolderTest("treeanim-cli") {}
 
   fs::path write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
@@ -47,7 +40,6 @@ class Cli : public ::testing::Test {
     const int status = std::system(command.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir_ / "stdout"), slurp(dir_ / "stderr")};
   }
-  fs::path dir_;
 };
 
 // Three unit segments straight up, one bake output.

@@ -1,8 +1,6 @@
 // cpfg surface files and the leaf shapes made of them (docs/turtle.md "Surfaces, spheres and
 // circles"): the file's format and its errors, the tessellation, the frame, the sphere and disc.
 // The surface files are written for these tests (tests/data/cpfg/leaf.s and variants of it).
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -11,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "temp_folder_test.h"
 #include "common/errors.h"
 #include "lsystem/leaf_shapes.h"
 #include "lsystem/surface_file.h"
@@ -29,16 +28,9 @@ std::string test_surface_text() {
 }
 
 // A fresh folder per test for the files it writes.
-class SurfaceFile : public ::testing::Test {
+class SurfaceFile : public TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("treeanim_surface_" + std::to_string(::getpid()) + "_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  SurfaceFile() : TempFolderTest("treeanim_surface") {}
 
   BezierSurface read(const std::string& text) const {
     std::ofstream(dir_ / "leaf.s") << text;
@@ -59,7 +51,6 @@ class SurfaceFile : public ::testing::Test {
     return "no error";
   }
 
-  fs::path dir_;
 };
 
 TEST_F(SurfaceFile, ReadsTheHeaderAndThePatch) {

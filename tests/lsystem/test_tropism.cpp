@@ -1,8 +1,6 @@
 // cpfg's tropisms and torques (CPFG manual 6.8, 8.1.8), its older tropism (8.1.10) and turtle
 // scale (6.3): grammars and view files written for these tests in cpfg's style, the shapes
 // checked against bends computed by hand.
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <numbers>
 #include <string>
 
+#include "temp_folder_test.h"
 #include "lsystem/lsystem.h"
 
 namespace treeanim {
@@ -19,16 +18,9 @@ namespace {
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
-class Tropism : public ::testing::Test {
+class Tropism : public TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("treeanim_tropism_" + std::to_string(::getpid()) + "_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Tropism() : TempFolderTest("treeanim_tropism") {}
 
   // A grammar of one axiom and its view file => the skeleton (options as the scene gives them).
   Skeleton grow(const std::string& axiom, const std::string& view, LsystemOptions options = {}) const {
@@ -39,7 +31,6 @@ class Tropism : public ::testing::Test {
     return grow_skeleton(options, nullptr);
   }
 
-  fs::path dir_;
 };
 
 // The unit vector at angle a (radians) from +y toward +x.

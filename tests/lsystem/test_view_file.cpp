@@ -1,7 +1,5 @@
 // cpfg view files (docs/scene.md "lsystem.view", CPFG manual 8.1) and the funcedit functions
 // they name: files written for these tests in cpfg's style, in a folder of their own.
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include <array>
@@ -10,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "temp_folder_test.h"
 #include "common/errors.h"
 #include "lsystem/view_file.h"
 
@@ -19,16 +18,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh folder per test, as a vlab object folder holds its .v and the files it names.
-class ViewFile : public ::testing::Test {
+class ViewFile : public TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("treeanim_view_" + std::to_string(::getpid()) + "_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  ViewFile() : TempFolderTest("treeanim_view") {}
 
   fs::path write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;
@@ -49,7 +41,6 @@ class ViewFile : public ::testing::Test {
     return "no error";
   }
 
-  fs::path dir_;
 };
 
 // A funcedit function: y = x on [0, 1] (control points on a line give a line).
