@@ -154,8 +154,10 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   auto nothing = [](size_t, size_t) {};
 #pragma omp parallel if (model.parallel)
   {
-    const auto [first, last] =
+    // Named, not a structured binding: the lambdas below capture them (clang before 16 cannot).
+    const std::pair<size_t, size_t> range =
         balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    const size_t first = range.first, last = range.second;
     // 4. Correct the matched step (or load the state), and measure the drag of the next one.
     const auto [my_bad, my_runaway] = with_kernel_isa([&] {
       return for_vertex_blocks(
