@@ -58,7 +58,7 @@ BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
     // largest turn: the soil gives way about where the stem's base would yield.
     if (p < 0 && half[c] > 0) {
       const double height = std::max(0.0, top - chain.cluster_joint(1, c));
-      chain.cluster_compliance[c] += options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];
+      chain.cluster_compliance[c] += options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];  // 2 half / L = 1 / (E I)
     }
   }
   return chain;

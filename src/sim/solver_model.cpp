@@ -179,7 +179,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   precompute_members(*this, a);
   precompute_pins(*this, a);
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(*this, a, static_cast<uint32_t>(c));
-  const StepRates rates = compute_step_rates(tree, options, h);
+  const StepRates rates = compute_step_rates(tree, options, chain, h);  // before the leaves join the chain
   cluster_alpha = rates.cluster_alpha;
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
   vertex_half_damping.resize(V);

@@ -47,7 +47,7 @@ std::vector<uint32_t> parents_first(const TreeModel& model) {
 }
 
 // Physical mode: segment (local) and limb frequencies of every cluster (docs/solver.md).
-void physical_frequencies(const TreeModel& model, const HsmOptions& options, StepRates& rates) {
+void physical_frequencies(const TreeModel& model, const HsmOptions& options, const BarChain& chain, StepRates& rates) {
   const size_t C = model.cluster_count();
   const double E = options.youngs_modulus;
   // Each vertex's mass is shared among its clusters, so subtree sums count it once.
@@ -61,7 +61,7 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, Ste
   const std::vector<uint32_t> order = parents_first(model);
   // The limb hanging from each cluster: its first frequency as a bar chain (Rayleigh), so
   // that taper, branching and the crown's mass, leaves included, set it as they set a tree's.
-  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, options));
+  const std::vector<double> limb = limb_frequencies(model, chain);
   // Parents before children: a cluster sways at most at the frequency of the softest limb
   // between it and the ground (a twig on a swaying bough moves with the bough).
   rates.cluster_frequency.assign(C, 0);
@@ -95,6 +95,10 @@ double global_frequency(double rate, double h) { return std::acos(1 - std::clamp
 double local_frequency(double rate, double h) { return std::asin(std::sqrt(std::clamp(rate, 0.0, 1.0))) / h; }
 
 StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, double h) {
+  return compute_step_rates(model, options, build_bar_chain(model, options), h);
+}
+
+StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, const BarChain& chain, double h) {
   const size_t C = model.cluster_count(), V = model.vertex_count();
   StepRates rates;
   rates.cluster_alpha.assign(C, 0);
@@ -102,7 +106,7 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
   std::vector<double> cluster_damping_frequency(C, 0);
   size_t branches = 0, capped = 0;
   if (options.stiffness == StiffnessMode::kPhysical) {
-    physical_frequencies(model, options, rates);
+    physical_frequencies(model, options, chain, rates);
     for (size_t c = 0; c < C; ++c) {
       const bool leaf = model.cluster_kind[c] == kClusterLeaf;
       // A branch cluster without geometry (zero radius, length or mass) has no finite

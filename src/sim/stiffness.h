@@ -3,6 +3,7 @@
 // (docs/solver.md, "Stiffness" and "Damping").
 #include <vector>
 
+#include "sim/bar_chain.h"
 #include "sim/sim_options.h"
 #include "tree/tree_model.h"
 
@@ -28,7 +29,10 @@ double local_rate(double omega, double h);
 double global_frequency(double rate, double h);
 double local_frequency(double rate, double h);
 
-// Model (geometry, masses) + options + step h => every per-step rate of the solver.
+// Model (geometry, masses) + options + its bar chain (build_bar_chain) + step h => every
+// per-step rate of the solver.
+StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, const BarChain& chain, double h);
+// The same with the model's chain built here.
 StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, double h);
 
 }  // namespace treeanim

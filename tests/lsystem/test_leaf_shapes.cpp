@@ -6,11 +6,11 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "temp_folder_test.h"
 #include "common/errors.h"
+#include "common/read_text_file.h"
 #include "lsystem/leaf_shapes.h"
 #include "lsystem/surface_file.h"
 
@@ -20,11 +20,11 @@ namespace {
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
+// The surface file the tests share (tests/data/cpfg/leaf.s) => its text.
 std::string test_surface_text() {
-  std::ifstream in(fs::path(TREEANIM_SOURCE_DIR) / "tests/data/cpfg/leaf.s");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+  std::string text, reason;
+  if (!read_text_file(fs::path(TREEANIM_SOURCE_DIR) / "tests/data/cpfg/leaf.s", text, reason)) ADD_FAILURE() << reason;
+  return text;
 }
 
 // A fresh folder per test for the files it writes.
