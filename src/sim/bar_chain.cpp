@@ -53,7 +53,12 @@ BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
       }
     }
     const double r = tree.cluster_radius[c];
-    if (r > 0) chain.cluster_max_turn[c] = chain.cluster_compliance[c] * yield_strain * youngs_modulus * std::numbers::pi * r * r * r / 4;
+    // At most a quarter turn, as a leaf's petiole: rigid clusters stand for a bent branch only
+    // while each joint turns moderately; a slender twig's yield turn (eps_y L / r) can be
+    // several whole turns, and its goal then swung round with the smallest change of load.
+    if (r > 0)
+      chain.cluster_max_turn[c] = std::min(std::numbers::pi / 2, chain.cluster_compliance[c] * yield_strain *
+                                                                     youngs_modulus * std::numbers::pi * r * r * r / 4);
     // The root plate turns the root's joint further under the same moment, up to the same
     // largest turn: the soil gives way about where the stem's base would yield.
     if (p < 0 && half[c] > 0) {

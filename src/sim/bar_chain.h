@@ -14,8 +14,8 @@ namespace treeanim {
 struct BarChain {
   Eigen::Matrix3Xd cluster_joint;          // (3 x C) m, rest point the cluster turns about: its base (a leaf: its shared vertex)
   std::vector<double> cluster_compliance;  // (C) rad/(N m) of the cluster's joint; 0 for leaves (set by the solver)
-  // (C) rad, the joint's largest turn: where the wood at its surface reaches the yield strain
-  // (a leaf: a quarter turn, set by the solver). Beyond it the joint turns no further, as a
+  // (C) rad, the joint's largest turn: where the wood at its surface reaches the yield strain,
+  // at most a quarter turn (a leaf: a quarter turn, set by the solver). Beyond it the joint turns no further, as a
   // plastic hinge would: a gale folds a limb as far as wood bends, not round in circles.
   std::vector<double> cluster_max_turn;
 };

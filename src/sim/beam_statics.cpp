@@ -5,6 +5,7 @@
 // position, so loads bend a branch from its root, as they bend a beam.
 #include <omp.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 
@@ -19,6 +20,45 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
   const double angle = theta.norm();
   if (!(angle > 0)) return Eigen::Matrix3d::Identity();
   return Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix();
+}
+
+// The air the step's averages left out (AirSample::unresolved) => the six points of an
+// unscented transform about the air, +- sqrt(3) sigma_k (sum of sigma_k sigma_k^T: the
+// covariance). false when nothing is left out.
+bool unresolved_points(const AirSample& air, Eigen::Vector3d (&point)[6]) {
+  if (!(air.unresolved.trace() > 0)) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(air.unresolved);
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d sigma = std::sqrt(3 * std::max(eigen.eigenvalues()[k], 0.0)) * eigen.eigenvectors().col(k);
+    point[2 * k] = sigma;
+    point[2 * k + 1] = -sigma;
+  }
+  return true;
+}
+
+// A joint's turn under the step's mean loads, the load beyond it and its drag per unit |u| u
+// (area) with that drag's moment times the compliance (reach), the unscented points and the
+// yield turn => the mean of its turns at the points, each at most the yield turn. The loads
+// beyond the joint are |u| u per unit area for one relative air u (the velocity's drag
+// included); each point changes that air and so |u| u, quadratically. A load that swings
+// within the step past the yield turn and across it bends the joint less than its mean
+// would; below yield the mean keeps the quadratic drag's second-order rise.
+Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vector3d& load, double area,
+                                  const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double largest) {
+  if (!(area > 0)) return theta.norm() > largest ? Eigen::Vector3d(theta * (largest / theta.norm())) : theta;
+  const Eigen::Vector3d g = load / area;
+  const double size = std::sqrt(g.norm());
+  const Eigen::Vector3d u = size > 0 ? Eigen::Vector3d(g / size) : Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& d : point) {
+    const Eigen::Vector3d air = u + d;
+    Eigen::Vector3d turn = theta + reach.cross(air.norm() * air - g);
+    const double angle = turn.norm();
+    if (angle > largest) turn *= largest / angle;
+    sum += turn;
+  }
+  return sum / 6;
 }
 
 }  // namespace
@@ -44,12 +84,18 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   const uint8_t* active = attachment.member_active.data();
   const Real* inv_count = attachment.vertex_inv_count.data();
   const Real* drag_damping = scratch.vertex_drag_damping.data();
+  const Real* drag = model.vertex_drag.data();
+  const double* mass = tree.vertex_mass.data();
+  Eigen::Vector3d unresolved[6];
+  const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
   for (size_t c = first; c < last; ++c) {
     double force_x = 0, force_y = 0, force_z = 0, moment_x = 0, moment_y = 0, moment_z = 0;
     // The same vertices' 2 D (the largest rate at which the quadratic drag changes with the
     // velocity) and its moment about the joint: the chain's aerodynamic damping.
     double damping = 0, lever_x = 0, lever_y = 0, lever_z = 0;
+    // Their drag per unit |u| u and its moment: the load of the air the step leaves out.
+    double area = 0, arm_x = 0, arm_y = 0, arm_z = 0;
     const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
     if (!attachment.cluster_flying[c])
       for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
@@ -62,11 +108,17 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
         moment_x += ay * gz - az * gy, moment_y += az * gx - ax * gz, moment_z += ax * gy - ay * gx;
         const double d = 2 * double(drag_damping[v]) * share;
         damping += d, lever_x += d * ax, lever_y += d * ay, lever_z += d * az;
+        if (averaged) {
+          const double a = double(drag[v]) * mass[v] * share;
+          area += a, arm_x += a * ax, arm_y += a * ay, arm_z += a * az;
+        }
       }
     scratch.cluster_load.col(c) = Eigen::Vector3d(force_x, force_y, force_z);
     scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_x, moment_y, moment_z);
     scratch.cluster_damping[c] = damping;
     scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_x, lever_y, lever_z);
+    scratch.cluster_drag_area[c] = area;
+    scratch.cluster_drag_arm.col(c) = Eigen::Vector3d(arm_x, arm_y, arm_z);
   }
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
@@ -79,6 +131,11 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     scratch.cluster_damping[p] += scratch.cluster_damping[c];
     scratch.cluster_damping_moment.col(p) +=
         scratch.cluster_damping_moment.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_damping[c];
+    if (averaged) {
+      scratch.cluster_drag_area[p] += scratch.cluster_drag_area[c];
+      scratch.cluster_drag_arm.col(p) +=
+          scratch.cluster_drag_arm.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_drag_area[c];
+    }
   }
   // 3. Parents before children: each joint turns by its compliance times its moment (in
   // parallel: the sines and cosines), and the turns accumulate from the root (one thread),
@@ -86,12 +143,17 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   // (about the cluster's own joint: small numbers wherever the tree stands).
 #pragma omp for schedule(static)
   for (size_t c = 0; c < C; ++c) {
-    Eigen::Vector3d theta = model.chain.cluster_compliance[c] * scratch.cluster_moment.col(c);
+    const double compliance = model.chain.cluster_compliance[c];
+    Eigen::Vector3d theta = compliance * scratch.cluster_moment.col(c);
     const double angle = theta.norm(), largest = model.chain.cluster_max_turn[c];
-    if (angle > largest) theta *= largest / angle;
     // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
     // for a moment across its turn (none along it): a yielded joint does not move back.
     const double give = angle > largest ? largest / angle : 1.0;
+    if (averaged)
+      theta = mean_yielded_turn(theta, scratch.cluster_load.col(c), scratch.cluster_drag_area[c],
+                                compliance * scratch.cluster_drag_arm.col(c), unresolved, largest);
+    else if (angle > largest)
+      theta *= largest / angle;
     scratch.cluster_damping_path.col(c) = (model.chain.cluster_compliance[c] * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
   }

@@ -266,6 +266,8 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   cluster_damping_moment.setZero(3, m.C);
   cluster_damping_path.setZero(3, m.C);
   cluster_damping_lever.assign(m.C, 0);
+  cluster_drag_area.assign(m.C, 0);
+  cluster_drag_arm.setZero(3, m.C);
   island_fell_asleep.assign(m.I, 0);
 }
 

@@ -137,6 +137,9 @@ struct StepScratch {
   // (3 x C) s/m, sum over the joints from the root to the cluster's of compliance times damping moment
   Eigen::Matrix3Xd cluster_damping_path;
   std::vector<double> cluster_damping_lever;  // (C) s, the same joints' sum of compliance C_j S_j . (j_c - j_j)
+  // --- the air a step leaves out (docs/solver.md, "What a step cannot resolve") ---
+  std::vector<double> cluster_drag_area;   // (C) kg/m, 0.5 rho Cd A over the cluster and everything beyond it
+  Eigen::Matrix3Xd cluster_drag_arm;       // (3 x C) kg, 0.5 rho Cd A (x0 - joint) over the same vertices
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
   AirSample air;                           // the wind at the time being sampled
 

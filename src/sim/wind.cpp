@@ -197,6 +197,7 @@ void WindField::sample_time(double t, double window, AirSample& air) const {
   air.gust = speed > 0 ? Eigen::Vector3d(air.mean * (gust_amplitude(t) / speed)) : Eigen::Vector3d::Zero();
   air.turbulence = intensity * speed;
   const Eigen::Vector3d d = advection(t);
+  air.unresolved.setZero();
   for (int j = 0; j < phase_count(); ++j) {
     const double b = mode_omega[j] * t - mode_wave.col(j).dot(d);
     // The wave's rate here, db/dt, and its mean over the window: a box filter's response
@@ -205,6 +206,11 @@ void WindField::sample_time(double t, double window, AirSample& air) const {
     const double kept = std::exp(-rate * rate / 24);
     air.sin_b[j] = kept * std::sin(b);
     air.cos_b[j] = kept * std::cos(b);
+    // A unit wave's variance 1/2 splits into its windows' means (kept^2 / 2) and what varies
+    // within a window: the rest, along the wave's amplitude vector.
+    const Eigen::Vector3d amplitude =
+        j < mode_count() ? Eigen::Vector3d(mode_amplitude.col(j) * air.turbulence) : Eigen::Vector3d(air.gust / kGustWaves);
+    air.unresolved += (0.5 * (1 - kept * kept)) * (amplitude * amplitude.transpose());
   }
 }
 

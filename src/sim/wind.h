@@ -24,6 +24,9 @@ struct AirSample {
   Eigen::Vector3d gust = Eigen::Vector3d::Zero();  // m/s, gust amplitude along the mean wind (0 in calm air)
   double turbulence = 0;                           // m/s, turbulence amplitude I |mean|
   double sin_b[kMaxPhases] = {}, cos_b[kMaxPhases] = {};  // (phases) sin/cos(w_j t - k_j . D(t))
+  // (m/s)^2, covariance of the air the window's average left out: the waves' variance within
+  // a step, which the step cannot resolve (0 at a window of 0, or in air without waves)
+  Eigen::Matrix3d unresolved = Eigen::Matrix3d::Zero();
 };
 
 class WindField {
@@ -43,7 +46,8 @@ class WindField {
   void spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const;
   // t, window (s) => the terms every point shares at t (mean, gust vector, turbulence
   // amplitude, temporal phases), each wave averaged over the window about t: a step of length
-  // `window` feels the waves it resolves and not those it would alias (0: the values at t).
+  // `window` feels the waves it resolves and not those it would alias (0: the values at t);
+  // what the averages left out, as a covariance (AirSample::unresolved).
   void sample_time(double t, double window, AirSample& air) const;
   // Spatial phases of x + the terms at t => the air velocity at (x, t) (m/s).
   Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air) const;

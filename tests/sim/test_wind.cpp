@@ -139,6 +139,54 @@ TEST(Wind, ALoopRepeatsWithItsPeriodEverywhere) {
   EXPECT_GT((field.velocity(x, 1.0) - field.velocity(x, 2.0)).norm(), 0.1);
 }
 
+// Windows of length h about t_k => (mean over windows of the variance of the air within a
+// window (m/s)^2, summed over the axes; mean over windows of trace(AirSample::unresolved)).
+std::pair<double, double> within_window_variance(const WindField& field, const Eigen::Vector3d& x, double h) {
+  double measured = 0, modelled = 0;
+  const int windows = 400, samples = 64;
+  for (int k = 0; k < windows; ++k) {
+    const double t = 0.37 * k + 1;
+    std::vector<Eigen::Vector3d> air;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i = 0; i < samples; ++i) air.push_back(field.velocity(x, t + h * ((i + 0.5) / samples - 0.5)));
+    for (const Eigen::Vector3d& a : air) mean += a / samples;
+    for (const Eigen::Vector3d& a : air) measured += (a - mean).squaredNorm() / samples / windows;
+    AirSample sample;
+    field.sample_time(t, h, sample);
+    modelled += sample.unresolved.trace() / windows;
+  }
+  return {measured, modelled};
+}
+
+TEST(Wind, WhatAStepAveragesOutIsTheVarianceWithinIt) {
+  // The air's variance within a step, which the step's averages leave out (docs/solver.md,
+  // "What a step cannot resolve"): none at a window of 0, all of the turbulence's at a window
+  // far longer than its waves, and close to it between (the model is a Gaussian filter, the
+  // step a box).
+  WindOptions wind = forest_wind(4);
+  wind.keys[0].gust = 0;
+  wind.turbulence_intensity = 0.5;
+  const WindField field(wind);
+  const Eigen::Vector3d x(3, -2, 5);
+  AirSample point;
+  field.sample_time(2.0, 0, point);
+  EXPECT_EQ(point.unresolved.trace(), 0);
+  // The whole turbulent variance, from a long series at the point.
+  const std::vector<Eigen::Vector3d> series = air_series(field, x, 0.01, 60000);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& a : series) mean += a / double(series.size());
+  double total = 0;
+  for (const Eigen::Vector3d& a : series) total += (a - mean).squaredNorm() / double(series.size());
+  field.sample_time(2.0, 30, point);
+  EXPECT_NEAR(point.unresolved.trace(), total, 0.1 * total);
+  for (const double h : {0.1, 0.5}) {
+    const auto [measured, modelled] = within_window_variance(field, x, h);
+    EXPECT_GT(measured, 0.02 * total) << h;
+    EXPECT_NEAR(modelled, measured, 0.2 * measured) << "window " << h << " s";
+    RecordProperty("unresolved_at_" + std::to_string(h), std::to_string(modelled / measured));
+  }
+}
+
 TEST(Wind, WithoutALoopTheFieldDoesNotRepeat) {
   const WindField field(gusty_wind());
   const Eigen::Vector3d x(0, 1, 0);

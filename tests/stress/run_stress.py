@@ -67,16 +67,17 @@ def largest_branch_displacement(path):
         return worst, float((rest.max(axis=0) - rest.min(axis=0)).max())
 
 
-def exaggeration(binary, scene, out_dir):
-    """Baked random scene => (passed, text): its branch vertices against the same scene at 64
-    substeps (skipped with per-step stiffness, which has no converged motion)."""
+def exaggeration(binary, scene, out_dir, sets=None):
+    """Baked random scene (with `sets`, the --set overrides it was baked with) => (passed, text):
+    its branch vertices against the same scene at 64 substeps (skipped with per-step
+    stiffness, which has no converged motion)."""
     with open(scene) as f:
         config = json.load(f)
     if config.get("hsm", {}).get("stiffness", "physical") != "physical":
         return True, "per_step stiffness: no reference"
     reference_dir = os.path.join(out_dir, "reference")
     os.makedirs(reference_dir)
-    code, err, _ = treeanim(binary, scene, reference_dir, {"time.substeps": 64})
+    code, err, _ = treeanim(binary, scene, reference_dir, dict(sets or {}, **{"time.substeps": 64}))
     if code != 0:
         return False, f"the 64-substep reference failed: exit {code}: {err.splitlines()[-1] if err else ''}"
     own, size = largest_branch_displacement(os.path.join(out_dir, "out.h5"))
@@ -213,8 +214,13 @@ def run_case(binary, case):
         if "million" in case:
             return run_million(binary, case, tmp)
         sets = dict(case.get("set", {}), outputs=[{"format": "hdf5", "path": "out.h5"}])
-        code, err, _ = treeanim(binary, os.path.join(HERE, case["scene"]), tmp, sets, timeout=case.get("timeout", 300))
-        return judge(code, err, tmp, "out.h5")
+        scene = os.path.join(HERE, case["scene"])
+        code, err, _ = treeanim(binary, scene, tmp, sets, timeout=case.get("timeout", 300))
+        passed, text = judge(code, err, tmp, "out.h5")
+        if passed and case.get("converged"):
+            passed, versus = exaggeration(binary, scene, tmp, sets)
+            text += "; " + versus
+        return passed, text
 
 
 def run_random(binary, count, seed):
