@@ -107,6 +107,10 @@ struct SolverModel {
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
+  // (V) for a vertex in one cluster alone (and no leaf's shared vertex: that membership is
+  // never released), the end of the run of consecutive such vertices of the same cluster
+  // that it is in; else 0. The goal writes take a run as one loop on the cluster's values.
+  std::vector<uint32_t> vertex_run_end;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
