@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "sim/lanes.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -45,9 +46,7 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   const Real* inv_count = attachment.vertex_inv_count.data();
   const Real* drag_damping = scratch.vertex_drag_damping.data();
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-  // Pairs of the sums in one SSE register each (GCC's vector extension: the same IEEE
-  // operation on each lane, so the same values as ten scalar sums).
-  using Pair = double __attribute__((vector_size(16)));
+  // The ten sums in pairs (lanes.h), an SSE register each.
   for (size_t c = first; c < last; ++c) {
     // {force x, y}, {force z, damping}, {moment x, y}, {lever x, y}, {moment z, lever z}. The
     // damping: the same vertices' 2 D (the largest rate at which the quadratic drag changes
