@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "sim/lanes.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -89,36 +90,40 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+  // The fourteen sums in pairs (lanes.h), an SSE register each.
   for (size_t c = first; c < last; ++c) {
-    double force_x = 0, force_y = 0, force_z = 0, moment_x = 0, moment_y = 0, moment_z = 0;
-    // The same vertices' 2 D (the largest rate at which the quadratic drag changes with the
-    // velocity) and its moment about the joint: the chain's aerodynamic damping.
-    double damping = 0, lever_x = 0, lever_y = 0, lever_z = 0;
-    // Their drag per unit |u| u and its moment: the load of the air the step leaves out.
-    double area = 0, arm_x = 0, arm_y = 0, arm_z = 0;
+    // {force x, y}, {force z, damping}, {moment x, y}, {lever x, y}, {moment z, lever z}. The
+    // damping: the same vertices' 2 D (the largest rate at which the quadratic drag changes
+    // with the velocity) and its moment about the joint, the chain's aerodynamic damping.
+    Pair force_xy = {0, 0}, force_z_damping = {0, 0}, moment_xy = {0, 0}, lever_xy = {0, 0}, z = {0, 0};
+    // {area, arm x}, {arm y, z}: their drag per unit |u| u and its moment, the load of the air
+    // the step leaves out.
+    Pair area_arm_x = {0, 0}, arm_yz = {0, 0};
     const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
     if (!attachment.cluster_flying[c])
       for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
         if (!active[s]) continue;
         const uint32_t v = members[s];
         const double share = double(inv_count[v]);
-        const double gx = double(fx[v]) * share, gy = double(fy[v]) * share, gz = double(fz[v]) * share;
-        force_x += gx, force_y += gy, force_z += gz;
+        const Pair g_xy = Pair{double(fx[v]), double(fy[v])} * share;
+        const Pair g_z_d = Pair{double(fz[v]), 2 * double(drag_damping[v])} * share;
+        force_xy += g_xy, force_z_damping += g_z_d;
+        const double gx = g_xy[0], gy = g_xy[1], gz = g_z_d[0], d = g_z_d[1];
         const double ax = rest[3 * size_t(v)] - jx, ay = rest[3 * size_t(v) + 1] - jy, az = rest[3 * size_t(v) + 2] - jz;
-        moment_x += ay * gz - az * gy, moment_y += az * gx - ax * gz, moment_z += ax * gy - ay * gx;
-        const double d = 2 * double(drag_damping[v]) * share;
-        damping += d, lever_x += d * ax, lever_y += d * ay, lever_z += d * az;
+        moment_xy += Pair{ay, az} * Pair{gz, gx} - Pair{az, ax} * Pair{gy, gz};
+        lever_xy += Pair{ax, ay} * d;
+        z += Pair{ax * gy - ay * gx, d * az};
         if (averaged) {
           const double a = double(drag[v]) * mass[v] * share;
-          area += a, arm_x += a * ax, arm_y += a * ay, arm_z += a * az;
+          area_arm_x += Pair{1, ax} * a, arm_yz += Pair{ay, az} * a;
         }
       }
-    scratch.cluster_load.col(c) = Eigen::Vector3d(force_x, force_y, force_z);
-    scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_x, moment_y, moment_z);
-    scratch.cluster_damping[c] = damping;
-    scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_x, lever_y, lever_z);
-    scratch.cluster_drag_area[c] = area;
-    scratch.cluster_drag_arm.col(c) = Eigen::Vector3d(arm_x, arm_y, arm_z);
+    scratch.cluster_load.col(c) = Eigen::Vector3d(force_xy[0], force_xy[1], force_z_damping[0]);
+    scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_xy[0], moment_xy[1], z[0]);
+    scratch.cluster_damping[c] = force_z_damping[1];
+    scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_xy[0], lever_xy[1], z[1]);
+    scratch.cluster_drag_area[c] = area_arm_x[0];
+    scratch.cluster_drag_arm.col(c) = Eigen::Vector3d(area_arm_x[1], arm_yz[0], arm_yz[1]);
   }
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
@@ -177,40 +182,87 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   }
 }
 
+namespace {
+
+// One cluster's deflected pose, read once per membership or once per run of its vertices.
+struct DeflectedCluster {
+  double R[9];      // its turn, column-major
+  double moved[3];  // m, its joint in the static deflection
+  double joint[3];  // m, its joint at rest
+  double path[3];   // s/m, cluster_damping_path
+  double lever;     // s, cluster_damping_lever
+};
+
+template <typename Real>
+DeflectedCluster deflected_cluster(const SolverModel<Real>& model, const StepScratch<Real>& scratch, size_t c) {
+  DeflectedCluster k;
+  for (int i = 0; i < 9; ++i) k.R[i] = scratch.cluster_static_rotation(i, c);
+  for (int i = 0; i < 3; ++i) {
+    k.moved[i] = scratch.cluster_static_joint(i, c);
+    k.joint[i] = model.chain.cluster_joint(i, c);
+    k.path[i] = scratch.cluster_damping_path(i, c);
+  }
+  k.lever = scratch.cluster_damping_lever[c];
+  return k;
+}
+
+// Rest point (x, y, z) in cluster k => its offset from rest in the deflected pose,
+// R (x0 - joint) + static joint - x0, and sum_j C_j S_j . (x0 - j_j), added to the sums,
+// written out as Eigen evaluated them.
+inline void add_deflected(const DeflectedCluster& k, double x, double y, double z, double& ox, double& oy, double& oz,
+                          double& back) {
+  const double dx = x - k.joint[0], dy = y - k.joint[1], dz = z - k.joint[2];
+  ox += (((k.R[0] * dx + k.R[3] * dy) + k.R[6] * dz) + k.moved[0]) - x;
+  oy += (((k.R[1] * dx + k.R[4] * dy) + k.R[7] * dz) + k.moved[1]) - y;
+  oz += (((k.R[2] * dx + k.R[5] * dy) + k.R[8] * dz) + k.moved[2]) - z;
+  back += ((k.path[0] * dx + k.path[1] * dy) + k.path[2] * dz) + k.lever;
+}
+
+}  // namespace
+
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
                           size_t end) {
   const TreeModel& tree = model.tree;
-  // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest:
-  // R (x0 - joint) + static joint - x0, written out on raw arrays as Eigen evaluates it; and
-  // the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
-  // everything moves with it (docs/solver.md, "Aerodynamic damping").
-  const double *rest = tree.rest_positions.data(), *joint = model.chain.cluster_joint.data();
-  const double *rotation = scratch.cluster_static_rotation.data(), *moved = scratch.cluster_static_joint.data();
+  // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
+  // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
+  // everything moves with it (docs/solver.md, "Aerodynamic damping"). A run of vertices each in
+  // one cluster alone (a mean over one, share 1) is one loop on that cluster's pose, vectorised.
+  const double* rest = tree.rest_positions.data();
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
-  const double *path = scratch.cluster_damping_path.data(), *lever = scratch.cluster_damping_lever.data();
   Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
   Real* compliance = prediction.damping_compliance.data();
-  for (size_t v = begin; v < end; ++v) {
+  for (size_t v = begin; v < end;) {
+    const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
+    if (run_end > v) {
+      const DeflectedCluster k = deflected_cluster(model, scratch, member_cluster[memberships[offsets[v]]]);
+#pragma omp simd
+      for (size_t u = v; u < run_end; ++u) {
+        double ox = 0, oy = 0, oz = 0, back = 0;
+        add_deflected(k, rest[3 * u], rest[3 * u + 1], rest[3 * u + 2], ox, oy, oz, back);
+        gx[u] = static_cast<Real>(ox), gy[u] = static_cast<Real>(oy), gz[u] = static_cast<Real>(oz);
+        // max(back, 0) rounded, tested after the rounding (a conversion under the test stops
+        // GCC's if-conversion): the same value, as back = 0 + term is never -0
+        const Real rounded = static_cast<Real>(back);
+        compliance[u] = rounded <= Real(0) ? Real(0) : rounded;
+      }
+      v = run_end;
+      continue;
+    }
     double ox = 0, oy = 0, oz = 0, back = 0;
-    const double x = rest[3 * v], y = rest[3 * v + 1], z = rest[3 * v + 2];
     for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
       const uint32_t slot = memberships[s];
       if (!active[slot]) continue;
-      const size_t c = member_cluster[slot];
-      const double* R = rotation + 9 * c;  // column-major
-      const double dx = x - joint[3 * c], dy = y - joint[3 * c + 1], dz = z - joint[3 * c + 2];
-      ox += (((R[0] * dx + R[3] * dy) + R[6] * dz) + moved[3 * c]) - x;
-      oy += (((R[1] * dx + R[4] * dy) + R[7] * dz) + moved[3 * c + 1]) - y;
-      oz += (((R[2] * dx + R[5] * dy) + R[8] * dz) + moved[3 * c + 2]) - z;
-      back += ((path[3 * c] * dx + path[3 * c + 1] * dy) + path[3 * c + 2] * dz) + lever[c];
+      add_deflected(deflected_cluster(model, scratch, member_cluster[slot]), rest[3 * v], rest[3 * v + 1],
+                    rest[3 * v + 2], ox, oy, oz, back);
     }
     const double share = double(attachment.vertex_inv_count[v]);
     gx[v] = static_cast<Real>(ox * share), gy[v] = static_cast<Real>(oy * share), gz[v] = static_cast<Real>(oz * share);
     compliance[v] = static_cast<Real>(std::max(back * share, 0.0));
+    ++v;
   }
 }
 

@@ -92,7 +92,8 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     }
   const Real* compliance = prediction.damping_compliance.data() + begin;
   Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
-  const double* rotation = scratch.cluster_rotation_matrix.data();
+  const Real* R[9];  // column-major entries of each cluster's R
+  for (int i = 0; i < 9; ++i) R[i] = scratch.cluster_drag_frame.col(i).data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
   const double* mass = model.tree.vertex_mass.data() + begin;
   const Real limit2 = static_cast<Real>(model.runaway_distance2);
@@ -133,10 +134,9 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
       // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
       // moves with, a drag that opposes a limb's motion then always opposes it, however far
       // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
-      const double* R = rotation + 9 * size_t(c);  // column-major
-      const Real bx = static_cast<Real>(R[0]) * wx + static_cast<Real>(R[1]) * wy + static_cast<Real>(R[2]) * wz;
-      const Real by = static_cast<Real>(R[3]) * wx + static_cast<Real>(R[4]) * wy + static_cast<Real>(R[5]) * wz;
-      const Real bz = static_cast<Real>(R[6]) * wx + static_cast<Real>(R[7]) * wy + static_cast<Real>(R[8]) * wz;
+      const Real bx = R[0][c] * wx + R[1][c] * wy + R[2][c] * wz;
+      const Real by = R[3][c] * wx + R[4][c] * wy + R[5][c] * wz;
+      const Real bz = R[6][c] * wx + R[7][c] * wy + R[8][c] * wz;
       force[0][k] = (air[0][c] - bx) * scale;
       force[1][k] = (air[1][c] - by) * scale;
       force[2][k] = (air[2][c] - bz) * scale;

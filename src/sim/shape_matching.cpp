@@ -8,6 +8,7 @@
 
 #include "common/errors.h"
 #include "sim/kernel_isa.h"
+#include "sim/lanes.h"
 #include "sim/rotation.h"
 #include "sim/solver_step.h"
 
@@ -30,19 +31,24 @@ bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<R
   // exactly 0 and A_pq is the exactly symmetric rest moment: no goal pulls a resting tree.
   // One weight per member serves both sums; they run in Real, with the round-off of the
   // values they sum. q is read here and again by write_corrections, while it is in cache.
-  Real a00 = 0, a01 = 0, a02 = 0, a10 = 0, a11 = 0, a12 = 0, a20 = 0, a21 = 0, a22 = 0;
-  Real sx = 0, sy = 0, sz = 0;
+  // The twelve sums as three rows of four lanes (lanes.h): {a_i0, a_i1, a_i2, s_i} += u_i {w, share},
+  // each lane the scalar sum a_ij += u_i w_j, s_i += share u_i (w_j = share q_j; a product
+  // is the same either way round).
+  using Lanes = typename Lanes4<Real>::type;
+  Lanes row_x = {0, 0, 0, 0}, row_y = {0, 0, 0, 0}, row_z = {0, 0, 0, 0};
+  const Real *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
+             *uz = predicted_offset.col(2).data();
+  const Real *qx = a.member_offset.col(0).data(), *qy = a.member_offset.col(1).data(), *qz = a.member_offset.col(2).data();
   for (uint32_t s = begin; s < end; ++s) {
     const uint32_t v = tree.cluster_members[s];
-    const Real x = predicted_offset(v, 0), y = predicted_offset(v, 1), z = predicted_offset(v, 2);
+    const Real x = ux[v], y = uy[v], z = uz[v];
     const Real share = a.member_centre_weight[s];
-    const Real wx = share * a.member_offset(s, 0), wy = share * a.member_offset(s, 1), wz = share * a.member_offset(s, 2);
-    sx += share * x, sy += share * y, sz += share * z;
-    a00 += x * wx, a01 += x * wy, a02 += x * wz;
-    a10 += y * wx, a11 += y * wy, a12 += y * wz;
-    a20 += z * wx, a21 += z * wy, a22 += z * wz;
+    const Lanes w = Lanes{qx[s], qy[s], qz[s], 1} * share;
+    row_x += x * w, row_y += y * w, row_z += z * w;
   }
-  const Eigen::Vector3d centre_shift(sx, sy, sz);
+  const Real a00 = row_x[0], a01 = row_x[1], a02 = row_x[2], a10 = row_y[0], a11 = row_y[1], a12 = row_y[2];
+  const Real a20 = row_z[0], a21 = row_z[1], a22 = row_z[2];
+  const Eigen::Vector3d centre_shift(row_x[3], row_y[3], row_z[3]);
   const Eigen::Vector3d point = a.cluster_match_point.col(c);
   const Eigen::Vector3d point_shift = pinned_point ? *pinned_point : centre_shift;
   Eigen::Matrix3d A;
@@ -96,6 +102,7 @@ bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attac
   state.cluster_rotations.col(c) = rotation.coeffs();
   state.cluster_shift.col(c) = shift;
   Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
+  scratch.cluster_drag_frame.row(c) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(R.data()).template cast<Real>();
   if (finite) write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
   return finite;
 }

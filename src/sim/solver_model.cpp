@@ -47,6 +47,16 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     a.vertex_pull_row[v] = tree.vertex_memberships[begin];
     if (end - begin > 1) m.shared_vertices.push_back(static_cast<uint32_t>(v));
   }
+  std::vector<uint8_t> alone(m.V, 0);  // (V) 1: in one cluster, whose membership stays
+  for (size_t v = 0; v < m.V; ++v) alone[v] = tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v] == 1;
+  for (size_t l = 0; l < m.L; ++l) alone[tree.leaf_attachment_vertex[l]] = 0;
+  m.vertex_run_end.assign(m.V, 0);
+  for (size_t v = m.V; v-- > 0;) {
+    if (!alone[v]) continue;
+    const bool continues = v + 1 < m.V && alone[v + 1] &&
+                           a.vertex_air_cluster[v + 1] == a.vertex_air_cluster[v];
+    m.vertex_run_end[v] = continues ? m.vertex_run_end[v + 1] : static_cast<uint32_t>(v + 1);
+  }
 }
 
 // Leaves => the membership slots that pin each attached leaf to its branch (attached_leaves.cpp).
@@ -257,6 +267,7 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   member_correction.setZero(m.M + 1, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
+  cluster_drag_frame.setZero(m.C, 9);
   cluster_load.setZero(3, m.C);
   cluster_moment.setZero(3, m.C);
   cluster_static_rotation.setZero(9, m.C);
