@@ -23,6 +23,12 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
   return Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix();
 }
 
+// A joint's turn => the same turn, at most `largest` long (its yield turn).
+Eigen::Vector3d capped_turn(const Eigen::Vector3d& theta, double largest) {
+  const double angle = theta.norm();
+  return angle > largest ? Eigen::Vector3d(theta * (largest / angle)) : theta;
+}
+
 // The air the step's averages left out (AirSample::unresolved) => the six points of an
 // unscented transform about the air, +- sqrt(3) sigma_k (sum of sigma_k sigma_k^T: the
 // covariance). false when nothing is left out.
@@ -47,17 +53,14 @@ bool unresolved_points(const AirSample& air, Eigen::Vector3d (&point)[6]) {
 // would; below yield the mean keeps the quadratic drag's second-order rise.
 Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vector3d& load, double area,
                                   const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double largest) {
-  if (!(area > 0)) return theta.norm() > largest ? Eigen::Vector3d(theta * (largest / theta.norm())) : theta;
+  if (!(area > 0)) return capped_turn(theta, largest);
   const Eigen::Vector3d g = load / area;
   const double size = std::sqrt(g.norm());
   const Eigen::Vector3d u = size > 0 ? Eigen::Vector3d(g / size) : Eigen::Vector3d::Zero();
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& d : point) {
     const Eigen::Vector3d air = u + d;
-    Eigen::Vector3d turn = theta + reach.cross(air.norm() * air - g);
-    const double angle = turn.norm();
-    if (angle > largest) turn *= largest / angle;
-    sum += turn;
+    sum += capped_turn(theta + reach.cross(air.norm() * air - g), largest);
   }
   return sum / 6;
 }
@@ -149,17 +152,16 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
 #pragma omp for schedule(static)
   for (size_t c = 0; c < C; ++c) {
     const double compliance = model.chain.cluster_compliance[c];
-    Eigen::Vector3d theta = compliance * scratch.cluster_moment.col(c);
-    const double angle = theta.norm(), largest = model.chain.cluster_max_turn[c];
+    const Eigen::Vector3d loaded = compliance * scratch.cluster_moment.col(c);
+    const double angle = loaded.norm(), largest = model.chain.cluster_max_turn[c];
     // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
     // for a moment across its turn (none along it): a yielded joint does not move back.
     const double give = angle > largest ? largest / angle : 1.0;
-    if (averaged)
-      theta = mean_yielded_turn(theta, scratch.cluster_load.col(c), scratch.cluster_drag_area[c],
-                                compliance * scratch.cluster_drag_arm.col(c), unresolved, largest);
-    else if (angle > largest)
-      theta *= largest / angle;
-    scratch.cluster_damping_path.col(c) = (model.chain.cluster_compliance[c] * give) * scratch.cluster_damping_moment.col(c);
+    const Eigen::Vector3d theta =
+        averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), scratch.cluster_drag_area[c],
+                                     compliance * scratch.cluster_drag_arm.col(c), unresolved, largest)
+                 : capped_turn(loaded, largest);
+    scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
   }
 #pragma omp single
