@@ -267,7 +267,6 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   member_correction.setZero(m.M + 1, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
-  cluster_drag_frame.setZero(m.C, 9);
   cluster_load.setZero(3, m.C);
   cluster_moment.setZero(3, m.C);
   cluster_static_rotation.setZero(9, m.C);
