@@ -94,7 +94,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
   Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
   const double* rotation = scratch.cluster_rotation_matrix.data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
-  const double* mass = model.tree.vertex_mass.data() + begin;
+  const Real* mass = model.vertex_mass.data() + begin;
   const Real limit2 = static_cast<Real>(model.runaway_distance2);
   Real* offset[3] = {prediction.offset.col(0).data() + begin, prediction.offset.col(1).data() + begin,
                      prediction.offset.col(2).data() + begin};
@@ -138,7 +138,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
         // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
         // the free-flight average over the step (drag_share) would understate it ever more as
         // the step grows (a leaf in a gale at a 0.25 s step: 16x).
-        const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * static_cast<Real>(mass[k]);
+        const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * mass[k];
         drag_damping[k] = scale;
         // The chain takes its moments with rest arms, so its load is the air's push and the
         // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it

@@ -89,6 +89,7 @@ template <typename Real>
 void precompute_drag(SolverModel<Real>& m, const WindOptions& w) {
   const TreeModel& tree = m.tree;
   m.vertex_drag.assign(m.V, 0);
+  m.vertex_mass.assign(tree.vertex_mass.begin(), tree.vertex_mass.end());
   for (size_t v = 0; v < m.V; ++v) {
     const double mass = tree.vertex_mass[v];
     if (tree.vertex_anchored[v] || !(mass > 0)) continue;

@@ -105,6 +105,7 @@ struct SolverModel {
   // 0: a projection (leaves, the per_step stiffness)
   std::vector<uint8_t> vertex_shape_kick;
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  std::vector<Real> vertex_mass;           // (V) kg, the tree's masses rounded to Real, as the drag's force reads them
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   // (V) for a vertex in one cluster alone (and no leaf's shared vertex: that membership is
