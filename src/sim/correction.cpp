@@ -221,9 +221,8 @@ void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& 
 #pragma omp parallel for schedule(static) if (model.parallel)
   for (size_t c = 0; c < model.C; ++c) {
     // The clusters' rotations as the last match left them (the drag's rest frame, prediction.h).
-    const Eigen::Matrix3d R = Eigen::Quaterniond(state.cluster_rotations.col(c)).toRotationMatrix();
-    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
-    scratch.cluster_drag_frame.row(c) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(R.data()).template cast<Real>();
+    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) =
+        Eigen::Quaterniond(state.cluster_rotations.col(c)).toRotationMatrix();
     if (cluster_awake(model, attachment, state, c)) sample_cluster_air(model, attachment, state, scratch, c);
   }
   correct_and_predict(model, attachment, state, scratch, VertexPass::kFromState, frame, 0);

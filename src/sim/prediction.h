@@ -92,60 +92,72 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     }
   const Real* compliance = prediction.damping_compliance.data() + begin;
   Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
-  const Real* R[9];  // column-major entries of each cluster's R
-  for (int i = 0; i < 9; ++i) R[i] = scratch.cluster_drag_frame.col(i).data();
+  const double* rotation = scratch.cluster_rotation_matrix.data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;
-  const double* mass = model.tree.vertex_mass.data() + begin;
+  const Real* mass = model.vertex_mass.data() + begin;
   const Real limit2 = static_cast<Real>(model.runaway_distance2);
   Real* offset[3] = {prediction.offset.col(0).data() + begin, prediction.offset.col(1).data() + begin,
                      prediction.offset.col(2).data() + begin};
   Real* velocity[3] = {prediction.velocity.col(0).data() + begin, prediction.velocity.col(1).data() + begin,
                        prediction.velocity.col(2).data() + begin};
-#pragma omp simd
-  for (int k = 0; k < n; ++k) {
-    const uint32_t row = in.pull_row[k];
-    const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
-    const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
-    const Real ux = offset[0][k] + px * now, uy = offset[1][k] + py * now, uz = offset[2][k] + pz * now;
-    const Real vx = velocity[0][k] + px * now * inv_h, vy = velocity[1][k] + py * now * inv_h,
-               vz = velocity[2][k] + pz * now * inv_h;
-    offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
-    velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+  // With the drag, the block runs in segments of consecutive vertices that feel the air of one
+  // cluster and turn with its R (most of a cluster's vertices are consecutive): its twelve
+  // values are read once per segment, not gathered per lane.
+  for (int first = 0; first < n;) {
+    int stop = n;
+    Real air_c[3] = {}, R[9] = {};  // the segment's cluster: its air, its R (column-major) in Real
     if constexpr (kForce) {
-      // The drag at the step's start, from the velocity there: half a step of damping and of
-      // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
-      // toward the last goal without the part this vertex's velocity took off through its drag,
-      // and that damping is implicit: the velocity is divided by 1 + gamma h / 2, gamma = K c
-      // (docs/solver.md "Aerodynamic damping"): stable at any step, however strong the drag.
-      const uint32_t c = air_cluster[k];
-      const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
-      const Real implicit = 1 / (1 + pull_back * compliance[k]);
-      const Real wx = (vx * half - pull_back * (ux - (in.goal[0][k] + damped[0][k])) + shape * px) * implicit;
-      const Real wy = (vy * half - pull_back * (uy - (in.goal[1][k] + damped[1][k])) + shape * py) * implicit;
-      const Real wz = (vz * half - pull_back * (uz - (in.goal[2][k] + damped[2][k])) + shape * pz) * implicit;
-      damped[0][k] = compliance[k] * wx, damped[1][k] = compliance[k] * wy, damped[2][k] = compliance[k] * wz;
-      const Real rx = air[0][c] - wx, ry = air[1][c] - wy, rz = air[2][c] - wz;
-      // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
-      // the free-flight average over the step (drag_share) would understate it ever more as
-      // the step grows (a leaf in a gale at a 0.25 s step: 16x).
-      const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * static_cast<Real>(mass[k]);
-      drag_damping[k] = scale;
-      // The chain takes its moments with rest arms, so its load is the air's push and the
-      // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
-      // moves with, a drag that opposes a limb's motion then always opposes it, however far
-      // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
-      const Real bx = R[0][c] * wx + R[1][c] * wy + R[2][c] * wz;
-      const Real by = R[3][c] * wx + R[4][c] * wy + R[5][c] * wz;
-      const Real bz = R[6][c] * wx + R[7][c] * wy + R[8][c] * wz;
-      force[0][k] = (air[0][c] - bx) * scale;
-      force[1][k] = (air[1][c] - by) * scale;
-      force[2][k] = (air[2][c] - bz) * scale;
+      const uint32_t c = air_cluster[first];
+      for (stop = first + 1; stop < n && air_cluster[stop] == c;) ++stop;
+      for (int i = 0; i < 3; ++i) air_c[i] = air[i][c];
+      for (int i = 0; i < 9; ++i) R[i] = static_cast<Real>(rotation[9 * size_t(c) + i]);
     }
-    block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
-    Real excess = 0;  // > 0: an attached vertex ran away
-    if constexpr (kEnd)
-      excess = (1 - static_cast<Real>(in.flying[k])) * (ux * ux + uy * uy + uz * uz) - limit2;
-    block.excess[k] = excess;
+#pragma omp simd
+    for (int k = first; k < stop; ++k) {
+      const uint32_t row = in.pull_row[k];
+      const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
+      const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+      const Real ux = offset[0][k] + px * now, uy = offset[1][k] + py * now, uz = offset[2][k] + pz * now;
+      const Real vx = velocity[0][k] + px * now * inv_h, vy = velocity[1][k] + py * now * inv_h,
+                 vz = velocity[2][k] + pz * now * inv_h;
+      offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
+      velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+      if constexpr (kForce) {
+        // The drag at the step's start, from the velocity there: half a step of damping and of
+        // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
+        // toward the last goal without the part this vertex's velocity took off through its drag,
+        // and that damping is implicit: the velocity is divided by 1 + gamma h / 2, gamma = K c
+        // (docs/solver.md "Aerodynamic damping"): stable at any step, however strong the drag.
+        const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
+        const Real implicit = 1 / (1 + pull_back * compliance[k]);
+        const Real wx = (vx * half - pull_back * (ux - (in.goal[0][k] + damped[0][k])) + shape * px) * implicit;
+        const Real wy = (vy * half - pull_back * (uy - (in.goal[1][k] + damped[1][k])) + shape * py) * implicit;
+        const Real wz = (vz * half - pull_back * (uz - (in.goal[2][k] + damped[2][k])) + shape * pz) * implicit;
+        damped[0][k] = compliance[k] * wx, damped[1][k] = compliance[k] * wy, damped[2][k] = compliance[k] * wz;
+        const Real rx = air_c[0] - wx, ry = air_c[1] - wy, rz = air_c[2] - wz;
+        // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
+        // the free-flight average over the step (drag_share) would understate it ever more as
+        // the step grows (a leaf in a gale at a 0.25 s step: 16x).
+        const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * mass[k];
+        drag_damping[k] = scale;
+        // The chain takes its moments with rest arms, so its load is the air's push and the
+        // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
+        // moves with, a drag that opposes a limb's motion then always opposes it, however far
+        // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
+        const Real bx = R[0] * wx + R[1] * wy + R[2] * wz;
+        const Real by = R[3] * wx + R[4] * wy + R[5] * wz;
+        const Real bz = R[6] * wx + R[7] * wy + R[8] * wz;
+        force[0][k] = (air_c[0] - bx) * scale;
+        force[1][k] = (air_c[1] - by) * scale;
+        force[2][k] = (air_c[2] - bz) * scale;
+      }
+      block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
+      Real excess = 0;  // > 0: an attached vertex ran away
+      if constexpr (kEnd)
+        excess = (1 - static_cast<Real>(in.flying[k])) * (ux * ux + uy * uy + uz * uz) - limit2;
+      block.excess[k] = excess;
+    }
+    first = stop;
   }
   return block_flagged(block, n);
 }

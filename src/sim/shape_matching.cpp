@@ -102,7 +102,6 @@ bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attac
   state.cluster_rotations.col(c) = rotation.coeffs();
   state.cluster_shift.col(c) = shift;
   Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
-  scratch.cluster_drag_frame.row(c) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(R.data()).template cast<Real>();
   if (finite) write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
   return finite;
 }

@@ -89,6 +89,7 @@ template <typename Real>
 void precompute_drag(SolverModel<Real>& m, const WindOptions& w) {
   const TreeModel& tree = m.tree;
   m.vertex_drag.assign(m.V, 0);
+  m.vertex_mass.assign(tree.vertex_mass.begin(), tree.vertex_mass.end());
   for (size_t v = 0; v < m.V; ++v) {
     const double mass = tree.vertex_mass[v];
     if (tree.vertex_anchored[v] || !(mass > 0)) continue;
@@ -267,7 +268,6 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   member_correction.setZero(m.M + 1, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
-  cluster_drag_frame.setZero(m.C, 9);
   cluster_load.setZero(3, m.C);
   cluster_moment.setZero(3, m.C);
   cluster_static_rotation.setZero(9, m.C);

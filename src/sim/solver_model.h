@@ -105,6 +105,7 @@ struct SolverModel {
   // 0: a projection (leaves, the per_step stiffness)
   std::vector<uint8_t> vertex_shape_kick;
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
+  std::vector<Real> vertex_mass;           // (V) kg, the tree's masses rounded to Real, as the drag's force reads them
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   // (V) for a vertex in one cluster alone (and no leaf's shared vertex: that membership is
@@ -130,9 +131,6 @@ struct StepScratch {
   Rows3<Real> member_correction;
   Rows3<Real> cluster_air;                 // (C x 3) m/s, air velocity at the cluster for the step being predicted
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of this step's fit, column-major
-  // (C x 9) the same R rounded to Real, an entry (column-major) per column: what the vertex
-  // pass turns the drag with, gathered per vertex by cluster (a vectorised gather each)
-  Eigen::Matrix<Real, Eigen::Dynamic, 9> cluster_drag_frame;
   Eigen::Matrix3Xd cluster_load;           // (3 x C) N, drag on the cluster and everything beyond it
   Eigen::Matrix3Xd cluster_moment;         // (3 x C) N m, its moment about the cluster's joint
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_static_rotation;  // (9 x C) the cluster's turn in the static deflection
