@@ -68,6 +68,36 @@ Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vec
 }  // namespace
 
 template <typename Real>
+void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment) {
+  const TreeModel& tree = model.tree;
+  const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
+  attachment.cluster_drag_area.assign(model.C, 0);
+  attachment.cluster_drag_arm.setZero(3, model.C);
+  for (size_t c = 0; c < model.C; ++c) {
+    if (attachment.cluster_flying[c]) continue;
+    // {area, arm x}, {arm y, z} in pairs, as the step's load sums (lanes.h)
+    Pair area_arm_x = {0, 0}, arm_yz = {0, 0};
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+      if (!attachment.member_active[s]) continue;
+      const uint32_t v = tree.cluster_members[s];
+      const double a = double(model.vertex_drag[v]) * tree.vertex_mass[v] * double(attachment.vertex_inv_count[v]);
+      const double ax = tree.rest_positions(0, v) - joint(0, c), ay = tree.rest_positions(1, v) - joint(1, c),
+                   az = tree.rest_positions(2, v) - joint(2, c);
+      area_arm_x += Pair{1, ax} * a, arm_yz += Pair{ay, az} * a;
+    }
+    attachment.cluster_drag_area[c] = area_arm_x[0];
+    attachment.cluster_drag_arm.col(c) = Eigen::Vector3d(area_arm_x[1], arm_yz[0], arm_yz[1]);
+  }
+  for (size_t c = model.C; c-- > 0;) {
+    const int32_t p = tree.cluster_parent[c];
+    if (p < 0 || attachment.cluster_flying[c]) continue;
+    attachment.cluster_drag_area[p] += attachment.cluster_drag_area[c];
+    attachment.cluster_drag_arm.col(p) +=
+        attachment.cluster_drag_arm.col(c) + (joint.col(c) - joint.col(p)) * attachment.cluster_drag_area[c];
+  }
+}
+
+template <typename Real>
 void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                        StepScratch<Real>& scratch) {
   const TreeModel& tree = model.tree;
@@ -88,20 +118,15 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   const uint8_t* active = attachment.member_active.data();
   const Real* inv_count = attachment.vertex_inv_count.data();
   const Real* drag_damping = scratch.vertex_drag_damping.data();
-  const Real* drag = model.vertex_drag.data();
-  const double* mass = tree.vertex_mass.data();
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-  // The fourteen sums in pairs (lanes.h), an SSE register each.
+  // The ten sums in pairs (lanes.h), an SSE register each.
   for (size_t c = first; c < last; ++c) {
     // {force x, y}, {force z, damping}, {moment x, y}, {lever x, y}, {moment z, lever z}. The
     // damping: the same vertices' 2 D (the largest rate at which the quadratic drag changes
     // with the velocity) and its moment about the joint, the chain's aerodynamic damping.
     Pair force_xy = {0, 0}, force_z_damping = {0, 0}, moment_xy = {0, 0}, lever_xy = {0, 0}, z = {0, 0};
-    // {area, arm x}, {arm y, z}: their drag per unit |u| u and its moment, the load of the air
-    // the step leaves out.
-    Pair area_arm_x = {0, 0}, arm_yz = {0, 0};
     const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
     if (!attachment.cluster_flying[c])
       for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
@@ -116,17 +141,11 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
         moment_xy += Pair{ay, az} * Pair{gz, gx} - Pair{az, ax} * Pair{gy, gz};
         lever_xy += Pair{ax, ay} * d;
         z += Pair{ax * gy - ay * gx, d * az};
-        if (averaged) {
-          const double a = double(drag[v]) * mass[v] * share;
-          area_arm_x += Pair{1, ax} * a, arm_yz += Pair{ay, az} * a;
-        }
       }
     scratch.cluster_load.col(c) = Eigen::Vector3d(force_xy[0], force_xy[1], force_z_damping[0]);
     scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_xy[0], moment_xy[1], z[0]);
     scratch.cluster_damping[c] = force_z_damping[1];
     scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_xy[0], lever_xy[1], z[1]);
-    scratch.cluster_drag_area[c] = area_arm_x[0];
-    scratch.cluster_drag_arm.col(c) = Eigen::Vector3d(area_arm_x[1], arm_yz[0], arm_yz[1]);
   }
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
@@ -139,11 +158,6 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     scratch.cluster_damping[p] += scratch.cluster_damping[c];
     scratch.cluster_damping_moment.col(p) +=
         scratch.cluster_damping_moment.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_damping[c];
-    if (averaged) {
-      scratch.cluster_drag_area[p] += scratch.cluster_drag_area[c];
-      scratch.cluster_drag_arm.col(p) +=
-          scratch.cluster_drag_arm.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_drag_area[c];
-    }
   }
   // 3. Parents before children: each joint turns by its compliance times its moment (in
   // parallel: the sines and cosines), and the turns accumulate from the root (one thread),
@@ -158,8 +172,8 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     // for a moment across its turn (none along it): a yielded joint does not move back.
     const double give = angle > largest ? largest / angle : 1.0;
     const Eigen::Vector3d theta =
-        averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), scratch.cluster_drag_area[c],
-                                     compliance * scratch.cluster_drag_arm.col(c), unresolved, largest)
+        averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), attachment.cluster_drag_area[c],
+                                     compliance * attachment.cluster_drag_arm.col(c), unresolved, largest)
                  : capped_turn(loaded, largest);
     scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
@@ -269,6 +283,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
 }
 
 #define TREEANIM_BEAM_STATICS(Real)                                                                               \
+  template void sum_drag_areas(const SolverModel<Real>&, Attachment<Real>&);                                       \
   template void deflect_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,              \
                                   StepScratch<Real>&);                                                              \
   template void write_static_offsets(const SolverModel<Real>&, const Attachment<Real>&, const StepScratch<Real>&, \

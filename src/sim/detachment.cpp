@@ -64,6 +64,7 @@ void adopt_leaf_flags(const SolverModel<Real>& model, const SimState& state, Att
   attachment = model.all_attached;
   for (size_t l = 0; l < model.L; ++l)
     if (!state.leaf_attached[l]) detach_leaf<Real>(model, attachment, l, nullptr);
+  sum_drag_areas(model, attachment);
 }
 
 // The drag on a leaf is summed over its own vertices in membership order (fixed order).
@@ -72,6 +73,7 @@ void detach_leaves(const SolverModel<Real>& model, Attachment<Real>& attachment,
                    StepScratch<Real>& scratch) {
   const TreeModel& tree = model.tree;
   const Rows3<Real>& drag_force = state.prediction<Real>().drag_force;
+  bool detached = false;
   for (size_t l = 0; l < model.L; ++l) {
     if (!state.leaf_attached[l]) continue;
     const uint32_t c = tree.leaf_cluster[l];
@@ -83,8 +85,10 @@ void detach_leaves(const SolverModel<Real>& model, Attachment<Real>& attachment,
     if (force.norm() > model.options.leaf_detach_force) {
       detach_leaf(model, attachment, l, &scratch.member_correction);
       state.leaf_attached[l] = 0;
+      detached = true;
     }
   }
+  if (detached) sum_drag_areas(model, attachment);
 }
 
 template void adopt_leaf_flags(const SolverModel<float>&, const SimState&, Attachment<float>&);

@@ -4,8 +4,8 @@
 #include <numeric>
 
 #include "common/errors.h"
-#include "sim/solver_model.h"
 #include "sim/bar_chain.h"
+#include "sim/solver_step.h"
 #include "sim/stiffness.h"
 
 namespace treeanim {
@@ -201,6 +201,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   a.cluster_flying.assign(C, 0);
   a.vertex_flying.assign(V, 0);
   a.leaf_attached.assign(L, 1);
+  sum_drag_areas(*this, a);
   // Spatial phases of the wind at the rest centres: the tree moves little against the length
   // scales of the eddies and gusts, so they are evaluated once (flying leaves use their centre).
   const size_t P = size_t(wind.phase_count());
@@ -277,8 +278,6 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   cluster_damping_moment.setZero(3, m.C);
   cluster_damping_path.setZero(3, m.C);
   cluster_damping_lever.assign(m.C, 0);
-  cluster_drag_area.assign(m.C, 0);
-  cluster_drag_arm.setZero(3, m.C);
   island_fell_asleep.assign(m.I, 0);
 }
 

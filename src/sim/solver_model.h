@@ -55,6 +55,11 @@ struct Attachment {
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s (q - o)(q - o)^T, column-major: A_pq at rest
   std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
+  // The drag per unit |u| u of the cluster and everything beyond it (0.5 rho Cd A, kg/m) and
+  // its moment about the cluster's joint (3 x C, kg), with rest arms: the load of the air a
+  // step leaves out (docs/solver.md, "What a step cannot resolve"), fixed by the attachment.
+  std::vector<double> cluster_drag_area;
+  Eigen::Matrix3Xd cluster_drag_arm;
   // --- per vertex (V) ---
   std::vector<Real> vertex_global;         // (V) global rate per step (0: off, anchored, flying)
   std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
@@ -142,9 +147,6 @@ struct StepScratch {
   // (3 x C) s/m, sum over the joints from the root to the cluster's of compliance times damping moment
   Eigen::Matrix3Xd cluster_damping_path;
   std::vector<double> cluster_damping_lever;  // (C) s, the same joints' sum of compliance C_j S_j . (j_c - j_j)
-  // --- the air a step leaves out (docs/solver.md, "What a step cannot resolve") ---
-  std::vector<double> cluster_drag_area;   // (C) kg/m, 0.5 rho Cd A over the cluster and everything beyond it
-  Eigen::Matrix3Xd cluster_drag_arm;       // (3 x C) kg, 0.5 rho Cd A (x0 - joint) over the same vertices
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
   AirSample air;                           // the wind at the time being sampled
 

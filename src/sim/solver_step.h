@@ -37,6 +37,10 @@ void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& 
                         StepScratch<Real>& scratch, long long frame);
 
 // --- beam_statics.cpp ---
+// The attachment's active members and flying clusters => its cluster_drag_area and
+// cluster_drag_arm, summed along the cluster tree (children before parents).
+template <typename Real>
+void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment);
 // Called by every thread of a parallel region (or outside one), after the step's drag
 // (prediction.drag_force) is complete: the loads per cluster, summed and turned along the
 // cluster tree => each cluster's turn and joint in the tree's static deflection
