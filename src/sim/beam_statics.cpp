@@ -65,6 +65,49 @@ Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vec
   return sum / 6;
 }
 
+// A cluster's load sums run in eight fixed lanes: its k-th member is added in lane k % 8, and
+// the lanes are added in one fixed order (sum_lanes), so the sums are the same whatever
+// vector width the loop runs in (docs/solver.md, "Instruction sets").
+constexpr int kLoadLanes = 8;
+
+// Per lane: the force (x, y, z), its moment about the joint (x, y, z), the damping 2 D (the
+// largest rate at which the quadratic drag changes with the velocity) and its moment (x, y, z),
+// the chain's aerodynamic damping.
+template <typename Real>
+struct LoadLanes {
+  Real lane[10][kLoadLanes];
+};
+
+// Where the load sums read: per vertex the drag, its damping D and 1 / (active memberships);
+// per membership whether it is active and its rest arm x0 - joint.
+template <typename Real>
+struct MemberLoads {
+  const Real* force[3];
+  const Real* drag_damping;
+  const Real* inv_count;
+  const uint8_t* active;
+  const Real* arm[3];
+};
+
+// Membership s of vertex v => the vertex's share of the loads and their moments, added in lane l.
+template <typename Real>
+inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, int l, LoadLanes<Real>& sum) {
+  const Real share = in.inv_count[v] * static_cast<Real>(in.active[s]);
+  const Real gx = in.force[0][v] * share, gy = in.force[1][v] * share, gz = in.force[2][v] * share;
+  const Real d = 2 * in.drag_damping[v] * share;
+  const Real ax = in.arm[0][s], ay = in.arm[1][s], az = in.arm[2][s];
+  sum.lane[0][l] += gx, sum.lane[1][l] += gy, sum.lane[2][l] += gz;
+  sum.lane[3][l] += ay * gz - az * gy, sum.lane[4][l] += az * gx - ax * gz, sum.lane[5][l] += ax * gy - ay * gx;
+  sum.lane[6][l] += d;
+  sum.lane[7][l] += ax * d, sum.lane[8][l] += ay * d, sum.lane[9][l] += az * d;
+}
+
+// Eight lanes => their sum in a fixed order, in double.
+template <typename Real>
+inline double sum_lanes(const Real (&lane)[kLoadLanes]) {
+  return double(((lane[0] + lane[4]) + (lane[2] + lane[6])) + ((lane[1] + lane[5]) + (lane[3] + lane[7])));
+}
+
 }  // namespace
 
 template <typename Real>
@@ -108,44 +151,40 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   // potential, where arms of the current pose made it a follower load that chased a bent
   // limb round in circles (docs/solver.md, "Bending"); the yield turn bounds large loads.
   // Each thread sums the clusters whose vertices it corrected (balanced_range), in its cache.
-  // Written out on raw arrays, f = F_v / k_v and moment += (x0 - joint) x f as Eigen
-  // evaluates them, operation for operation.
   const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
-  const Real *fx = prediction.drag_force.col(0).data(), *fy = prediction.drag_force.col(1).data(),
-             *fz = prediction.drag_force.col(2).data();
-  const double* rest = tree.rest_positions.data();
-  const uint32_t* members = tree.cluster_members.data();
-  const uint8_t* active = attachment.member_active.data();
-  const Real* inv_count = attachment.vertex_inv_count.data();
-  const Real* drag_damping = scratch.vertex_drag_damping.data();
+  const MemberLoads<Real> loads = {{prediction.drag_force.col(0).data(), prediction.drag_force.col(1).data(),
+                                    prediction.drag_force.col(2).data()},
+                                   scratch.vertex_drag_damping.data(),
+                                   attachment.vertex_inv_count.data(),
+                                   attachment.member_active.data(),
+                                   {model.member_arm.col(0).data(), model.member_arm.col(1).data(),
+                                    model.member_arm.col(2).data()}};
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-  // The ten sums in pairs (lanes.h), an SSE register each.
   for (size_t c = first; c < last; ++c) {
-    // {force x, y}, {force z, damping}, {moment x, y}, {lever x, y}, {moment z, lever z}. The
-    // damping: the same vertices' 2 D (the largest rate at which the quadratic drag changes
-    // with the velocity) and its moment about the joint, the chain's aerodynamic damping.
-    Pair force_xy = {0, 0}, force_z_damping = {0, 0}, moment_xy = {0, 0}, lever_xy = {0, 0}, z = {0, 0};
-    const double jx = joint(0, c), jy = joint(1, c), jz = joint(2, c);
-    if (!attachment.cluster_flying[c])
-      for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
-        if (!active[s]) continue;
-        const uint32_t v = members[s];
-        const double share = double(inv_count[v]);
-        const Pair g_xy = Pair{double(fx[v]), double(fy[v])} * share;
-        const Pair g_z_d = Pair{double(fz[v]), 2 * double(drag_damping[v])} * share;
-        force_xy += g_xy, force_z_damping += g_z_d;
-        const double gx = g_xy[0], gy = g_xy[1], gz = g_z_d[0], d = g_z_d[1];
-        const double ax = rest[3 * size_t(v)] - jx, ay = rest[3 * size_t(v) + 1] - jy, az = rest[3 * size_t(v) + 2] - jz;
-        moment_xy += Pair{ay, az} * Pair{gz, gx} - Pair{az, ax} * Pair{gy, gz};
-        lever_xy += Pair{ax, ay} * d;
-        z += Pair{ax * gy - ay * gx, d * az};
+    LoadLanes<Real> sum = {};
+    if (!attachment.cluster_flying[c]) {
+      const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+      uint32_t base = begin;
+      const uint32_t* members = tree.cluster_members.data();
+      for (; base + kLoadLanes <= end; base += kLoadLanes) {
+        // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
+        const uint32_t v = members[base];
+        if (members[base + kLoadLanes - 1] == v + kLoadLanes - 1) {
+#pragma omp simd
+          for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, l, sum);
+        } else {
+          for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, base + l, members[base + l], l, sum);
+        }
       }
-    scratch.cluster_load.col(c) = Eigen::Vector3d(force_xy[0], force_xy[1], force_z_damping[0]);
-    scratch.cluster_moment.col(c) = Eigen::Vector3d(moment_xy[0], moment_xy[1], z[0]);
-    scratch.cluster_damping[c] = force_z_damping[1];
-    scratch.cluster_damping_moment.col(c) = Eigen::Vector3d(lever_xy[0], lever_xy[1], z[1]);
+      for (int l = 0; base + l < end; ++l) add_member_load(loads, base + l, members[base + l], l, sum);
+    }
+    scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
+    scratch.cluster_moment.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
+    scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
+    scratch.cluster_damping_moment.col(c) =
+        Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
   }
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it.
@@ -196,42 +235,31 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
         scratch.cluster_static_joint.col(p) + parent * (joint.col(c) - joint.col(p));
     R = turn * parent;
   }
+  // Each cluster's deflected pose as the goal writes read it, in Real: R - I, the joint's move
+  // J - j, the damping path and lever (small numbers: the goal is an offset from rest).
+#pragma omp for schedule(static)
+  for (size_t c = 0; c < C; ++c) {
+    Real* pose = &scratch.cluster_pose(0, c);
+    for (int i = 0; i < 9; ++i) pose[i] = static_cast<Real>(scratch.cluster_static_rotation(i, c) - (i % 4 == 0));
+    for (int i = 0; i < 3; ++i) {
+      pose[9 + i] = static_cast<Real>(scratch.cluster_static_joint(i, c) - joint(i, c));
+      pose[12 + i] = static_cast<Real>(scratch.cluster_damping_path(i, c));
+    }
+    pose[15] = static_cast<Real>(scratch.cluster_damping_lever[c]);
+  }
 }
 
 namespace {
 
-// One cluster's deflected pose, read once per membership or once per run of its vertices.
-struct DeflectedCluster {
-  double R[9];      // its turn, column-major
-  double moved[3];  // m, its joint in the static deflection
-  double joint[3];  // m, its joint at rest
-  double path[3];   // s/m, cluster_damping_path
-  double lever;     // s, cluster_damping_lever
-};
-
+// Rest arm (ax, ay, az) from the joint of a cluster with deflected pose k (StepScratch::
+// cluster_pose) => its offset from rest in the deflected pose, (R - I) a + J - j, and
+// C_j S_j . a + lever, added to the sums.
 template <typename Real>
-DeflectedCluster deflected_cluster(const SolverModel<Real>& model, const StepScratch<Real>& scratch, size_t c) {
-  DeflectedCluster k;
-  for (int i = 0; i < 9; ++i) k.R[i] = scratch.cluster_static_rotation(i, c);
-  for (int i = 0; i < 3; ++i) {
-    k.moved[i] = scratch.cluster_static_joint(i, c);
-    k.joint[i] = model.chain.cluster_joint(i, c);
-    k.path[i] = scratch.cluster_damping_path(i, c);
-  }
-  k.lever = scratch.cluster_damping_lever[c];
-  return k;
-}
-
-// Rest point (x, y, z) in cluster k => its offset from rest in the deflected pose,
-// R (x0 - joint) + static joint - x0, and sum_j C_j S_j . (x0 - j_j), added to the sums,
-// written out as Eigen evaluated them.
-inline void add_deflected(const DeflectedCluster& k, double x, double y, double z, double& ox, double& oy, double& oz,
-                          double& back) {
-  const double dx = x - k.joint[0], dy = y - k.joint[1], dz = z - k.joint[2];
-  ox += (((k.R[0] * dx + k.R[3] * dy) + k.R[6] * dz) + k.moved[0]) - x;
-  oy += (((k.R[1] * dx + k.R[4] * dy) + k.R[7] * dz) + k.moved[1]) - y;
-  oz += (((k.R[2] * dx + k.R[5] * dy) + k.R[8] * dz) + k.moved[2]) - z;
-  back += ((k.path[0] * dx + k.path[1] * dy) + k.path[2] * dz) + k.lever;
+inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Real& oy, Real& oz, Real& back) {
+  ox += ((k[0] * ax + k[3] * ay) + k[6] * az) + k[9];
+  oy += ((k[1] * ax + k[4] * ay) + k[7] * az) + k[10];
+  oz += ((k[2] * ax + k[5] * ay) + k[8] * az) + k[11];
+  back += ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15];
 }
 
 }  // namespace
@@ -244,8 +272,10 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
   // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
   // everything moves with it (docs/solver.md, "Aerodynamic damping"). A run of vertices each in
-  // one cluster alone (a mean over one, share 1) is one loop on that cluster's pose, vectorised.
-  const double* rest = tree.rest_positions.data();
+  // one cluster alone (a mean over one, share 1), whose memberships are consecutive, is one
+  // loop on that cluster's pose, vectorised.
+  const Real *arm_x = model.member_arm.col(0).data(), *arm_y = model.member_arm.col(1).data(),
+             *arm_z = model.member_arm.col(2).data();
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
@@ -254,30 +284,29 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   for (size_t v = begin; v < end;) {
     const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
     if (run_end > v) {
-      const DeflectedCluster k = deflected_cluster(model, scratch, member_cluster[memberships[offsets[v]]]);
+      const uint32_t slot = memberships[offsets[v]];
+      const Real* k = &scratch.cluster_pose(0, member_cluster[slot]);
+      const Real *ax = arm_x + slot - v, *ay = arm_y + slot - v, *az = arm_z + slot - v;
 #pragma omp simd
       for (size_t u = v; u < run_end; ++u) {
-        double ox = 0, oy = 0, oz = 0, back = 0;
-        add_deflected(k, rest[3 * u], rest[3 * u + 1], rest[3 * u + 2], ox, oy, oz, back);
-        gx[u] = static_cast<Real>(ox), gy[u] = static_cast<Real>(oy), gz[u] = static_cast<Real>(oz);
-        // max(back, 0) rounded, tested after the rounding (a conversion under the test stops
-        // GCC's if-conversion): the same value, as back = 0 + term is never -0
-        const Real rounded = static_cast<Real>(back);
-        compliance[u] = rounded <= Real(0) ? Real(0) : rounded;
+        Real ox = 0, oy = 0, oz = 0, back = 0;
+        add_deflected(k, ax[u], ay[u], az[u], ox, oy, oz, back);
+        gx[u] = ox, gy[u] = oy, gz[u] = oz;
+        compliance[u] = back <= Real(0) ? Real(0) : back;
       }
       v = run_end;
       continue;
     }
-    double ox = 0, oy = 0, oz = 0, back = 0;
+    Real ox = 0, oy = 0, oz = 0, back = 0;
     for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
       const uint32_t slot = memberships[s];
       if (!active[slot]) continue;
-      add_deflected(deflected_cluster(model, scratch, member_cluster[slot]), rest[3 * v], rest[3 * v + 1],
-                    rest[3 * v + 2], ox, oy, oz, back);
+      add_deflected(&scratch.cluster_pose(0, member_cluster[slot]), arm_x[slot], arm_y[slot], arm_z[slot], ox, oy,
+                    oz, back);
     }
-    const double share = double(attachment.vertex_inv_count[v]);
-    gx[v] = static_cast<Real>(ox * share), gy[v] = static_cast<Real>(oy * share), gz[v] = static_cast<Real>(oz * share);
-    compliance[v] = static_cast<Real>(std::max(back * share, 0.0));
+    const Real share = attachment.vertex_inv_count[v];
+    gx[v] = ox * share, gy[v] = oy * share, gz[v] = oz * share;
+    compliance[v] = std::max(back * share, Real(0));
     ++v;
   }
 }

@@ -54,7 +54,9 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   for (size_t v = m.V; v-- > 0;) {
     if (!alone[v]) continue;
     const bool continues = v + 1 < m.V && alone[v + 1] &&
-                           a.vertex_air_cluster[v + 1] == a.vertex_air_cluster[v];
+                           a.vertex_air_cluster[v + 1] == a.vertex_air_cluster[v] &&
+                           tree.vertex_memberships[tree.vertex_cluster_offsets[v + 1]] ==
+                               tree.vertex_memberships[tree.vertex_cluster_offsets[v]] + 1;
     m.vertex_run_end[v] = continues ? m.vertex_run_end[v + 1] : static_cast<uint32_t>(v + 1);
   }
 }
@@ -123,6 +125,12 @@ template <typename Real>
 void precompute_beam(SolverModel<Real>& m, const WindOptions& wind) {
   m.vertex_shape_kick.assign(m.V, 0);
   if (!m.beam) return;
+  m.member_arm.resize(m.M, 3);
+  for (size_t s = 0; s < m.M; ++s)
+    m.member_arm.row(s) =
+        (m.tree.rest_positions.col(m.tree.cluster_members[s]) - m.chain.cluster_joint.col(m.member_cluster[s]))
+            .transpose()
+            .template cast<Real>();
   if (m.kick)
     for (size_t v = 0; v < m.V; ++v) m.vertex_shape_kick[v] = m.tree.vertex_leaf[v] < 0 ? 1 : 0;
   for (size_t c = 0; c < m.C; ++c)
@@ -273,6 +281,7 @@ StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
   cluster_moment.setZero(3, m.C);
   cluster_static_rotation.setZero(9, m.C);
   cluster_static_joint.setZero(3, m.C);
+  cluster_pose.setZero(16, m.C);
   vertex_drag_damping.assign(m.V, Real(0));
   cluster_damping.assign(m.C, 0);
   cluster_damping_moment.setZero(3, m.C);

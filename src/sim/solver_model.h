@@ -112,10 +112,11 @@ struct SolverModel {
   std::vector<Real> vertex_drag;           // (V) 1/m, 0.5 rho Cd A / m: drag acceleration per (m/s)^2
   std::vector<Real> vertex_mass;           // (V) kg, the tree's masses rounded to Real, as the drag's force reads them
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
+  Rows3<Real> member_arm;                  // (M x 3) m, with the beam: x0 - the joint of the member's cluster
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
   // (V) for a vertex in one cluster alone (and no leaf's shared vertex: that membership is
-  // never released), the end of the run of consecutive such vertices of the same cluster
-  // that it is in; else 0. The goal writes take a run as one loop on the cluster's values.
+  // never released), the end of the run of consecutive such vertices of the same cluster,
+  // with consecutive memberships, that it is in; else 0. The goal writes take a run as one loop on the cluster's values.
   std::vector<uint32_t> vertex_run_end;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---
@@ -140,6 +141,9 @@ struct StepScratch {
   Eigen::Matrix3Xd cluster_moment;         // (3 x C) N m, its moment about the cluster's joint
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_static_rotation;  // (9 x C) the cluster's turn in the static deflection
   Eigen::Matrix3Xd cluster_static_joint;   // (3 x C) m, where its joint is in the static deflection
+  // (16 x C) the deflected pose the goal writes read: R - I (column-major), the joint's move
+  // (m), cluster_damping_path, cluster_damping_lever
+  Eigen::Matrix<Real, 16, Eigen::Dynamic> cluster_pose;
   // --- the chain's aerodynamic damping (docs/solver.md, "Aerodynamic damping") ---
   std::vector<Real> vertex_drag_damping;   // (V) N s/m, D = 0.5 rho Cd A |air - v|: the drag per m/s of relative velocity
   std::vector<double> cluster_damping;     // (C) N s/m, sum of 2 D over the cluster and everything beyond it
