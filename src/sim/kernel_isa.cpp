@@ -1,5 +1,6 @@
 #include "sim/kernel_isa.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 
@@ -16,12 +17,12 @@ KernelIsa widest_supported() {
   return KernelIsa::kPortable;
 }
 
-// The portable loops unless TREEANIM_ISA names a wider set the CPU runs: on the machines
-// measured the wider sets were slower (docs/solver.md, "Instruction sets").
+// AVX2 where the CPU runs it, unless TREEANIM_ISA names another set: AVX-512 was slower on
+// the machines measured (docs/solver.md, "Instruction sets").
 KernelIsa pick() {
-  const char* asked = std::getenv("TREEANIM_ISA");
-  if (!asked) return KernelIsa::kPortable;
   const KernelIsa widest = widest_supported();
+  const char* asked = std::getenv("TREEANIM_ISA");
+  if (!asked) return std::min(KernelIsa::kAvx2, widest);
   for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
     if (std::string(asked) == kernel_isa_name(isa)) return isa < widest ? isa : widest;
   return KernelIsa::kPortable;

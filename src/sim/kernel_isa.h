@@ -9,8 +9,9 @@ namespace treeanim {
 
 enum class KernelIsa { kPortable, kAvx2, kAvx512 };
 
-// The baseline (x86-64: SSE2), or the set named by the environment variable TREEANIM_ISA
-// (portable, avx2, avx512), narrowed to what this CPU runs. Read on the first call.
+// AVX2 (the baseline, x86-64's SSE2, on a CPU without it), or the set named by the
+// environment variable TREEANIM_ISA (portable, avx2, avx512), narrowed to what this CPU
+// runs. Read on the first call.
 KernelIsa kernel_isa();
 // => "portable", "avx2" or "avx512".
 const char* kernel_isa_name(KernelIsa isa);

@@ -245,31 +245,36 @@ def run_random(binary, count, seed):
 
 
 def run_determinism(binary):
-    """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, at 1, 2 and 4
-    threads with the portable solver loops and at 1 and 2 with each wider instruction set this
-    CPU runs (TREEANIM_ISA, docs/solver.md "Instruction sets"), the solver in double and float."""
+    """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, the solver in
+    double and float, and 4 frames of configs/table1-13548.json (float, clusters of ~50
+    members: the chain's eight-lane sums), each at 1, 2 and 4 threads with the portable solver
+    loops and at 1 and 2 with each wider instruction set this CPU runs (TREEANIM_ISA,
+    docs/solver.md "Instruction sets")."""
+    demo_wind = {"wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
+                 "hsm.leaf_detach_force": 0.3}
     texts = []
-    for precision in ("double", "float"):
+    for scene, precision, frames, extra_sets in (("demo.json", "double", 8, demo_wind),
+                                                  ("demo.json", "float", 8, demo_wind),
+                                                  ("table1-13548.json", "float", 4, {})):
         digests = {}
         with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
-            sets = {"time.frames": 8, "outputs": [{"format": "hdf5", "path": "out.h5"}],
-                    "wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
-                    "hsm.leaf_detach_force": 0.3, "hsm.precision": precision}
+            sets = {"time.frames": frames, "outputs": [{"format": "hdf5", "path": "out.h5"}],
+                    "hsm.precision": precision, **extra_sets}
             runs = [("portable", 1), ("portable", 2), ("portable", 4), ("avx2", 1), ("avx2", 2), ("avx512", 1),
                     ("avx512", 2)]
             for isa, threads in runs:
-                code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", "demo.json"), tmp, sets,
+                code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", scene), tmp, sets,
                                         extra=("--verbose",), threads=threads, isa=isa)
                 if code != 0:
-                    return False, f"{precision}, {isa}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
+                    return False, f"{scene} {precision}, {isa}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
                 ran = re.search(r"solver loops: (\w+)", err)
                 if not ran:
                     return False, f"no 'solver loops:' in the verbose log: {err}"
                 with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
                     digests[(ran.group(1), threads)] = f["/frames/positions"][()].tobytes()
         if len(set(digests.values())) != 1:
-            return False, f"DIFFERENT /frames/positions across {sorted(digests)} ({precision})"
-        texts.append(f"{precision} ({len(next(iter(digests.values())))} bytes)")
+            return False, f"DIFFERENT /frames/positions across {sorted(digests)} ({scene}, {precision})"
+        texts.append(f"{scene} {precision} ({len(next(iter(digests.values())))} bytes)")
     sets_run = sorted({isa for isa, _ in digests})
     return True, f"identical /frames/positions for 1, 2, 4 threads and the loops in {', '.join(sets_run)}: " + \
         ", ".join(texts)
