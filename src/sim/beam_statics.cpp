@@ -9,7 +9,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
-#include "sim/lanes.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -118,18 +117,13 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
   attachment.cluster_drag_arm.setZero(3, model.C);
   for (size_t c = 0; c < model.C; ++c) {
     if (attachment.cluster_flying[c]) continue;
-    // {area, arm x}, {arm y, z} in pairs, as the step's load sums (lanes.h)
-    Pair area_arm_x = {0, 0}, arm_yz = {0, 0};
     for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
       if (!attachment.member_active[s]) continue;
       const uint32_t v = tree.cluster_members[s];
       const double a = double(model.vertex_drag[v]) * tree.vertex_mass[v] * double(attachment.vertex_inv_count[v]);
-      const double ax = tree.rest_positions(0, v) - joint(0, c), ay = tree.rest_positions(1, v) - joint(1, c),
-                   az = tree.rest_positions(2, v) - joint(2, c);
-      area_arm_x += Pair{1, ax} * a, arm_yz += Pair{ay, az} * a;
+      attachment.cluster_drag_area[c] += a;
+      attachment.cluster_drag_arm.col(c) += (tree.rest_positions.col(v) - joint.col(c)) * a;
     }
-    attachment.cluster_drag_area[c] = area_arm_x[0];
-    attachment.cluster_drag_arm.col(c) = Eigen::Vector3d(area_arm_x[1], arm_yz[0], arm_yz[1]);
   }
   for (size_t c = model.C; c-- > 0;) {
     const int32_t p = tree.cluster_parent[c];
@@ -159,6 +153,7 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
                                    attachment.member_active.data(),
                                    {model.member_arm.col(0).data(), model.member_arm.col(1).data(),
                                     model.member_arm.col(2).data()}};
+  const uint32_t* members = tree.cluster_members.data();
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
@@ -166,19 +161,16 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     LoadLanes<Real> sum = {};
     if (!attachment.cluster_flying[c]) {
       const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
-      uint32_t base = begin;
-      const uint32_t* members = tree.cluster_members.data();
-      for (; base + kLoadLanes <= end; base += kLoadLanes) {
+      for (uint32_t base = begin; base < end; base += kLoadLanes) {
         // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
-        const uint32_t v = members[base];
-        if (members[base + kLoadLanes - 1] == v + kLoadLanes - 1) {
+        const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
+        if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
 #pragma omp simd
           for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, l, sum);
         } else {
-          for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, base + l, members[base + l], l, sum);
+          for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], int(l), sum);
         }
       }
-      for (int l = 0; base + l < end; ++l) add_member_load(loads, base + l, members[base + l], l, sum);
     }
     scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
     scratch.cluster_moment.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));

@@ -4,8 +4,6 @@
 // share one register with their values unchanged (docs/solver.md, "Instruction sets").
 namespace treeanim {
 
-using Pair = double __attribute__((vector_size(16)));  // two doubles
-
 // Four lanes of Real.
 template <typename Real>
 struct Lanes4;
