@@ -8,6 +8,67 @@
 
 namespace treeanim {
 
+namespace {
+
+// The trunk is cut until no limb below it holds more than 1/64 of the clusters; the limbs
+// are dealt into 16 groups, largest first, each to the smallest group so far.
+constexpr size_t kWalkLimbShare = 64;
+constexpr size_t kWalkGroups = 16;
+
+// Tree => chain.walk_trunk, walk_group_offsets and walk_groups (BarChain).
+void cut_for_walks(const TreeModel& tree, BarChain& chain) {
+  const size_t C = tree.cluster_count();
+  std::vector<uint32_t> size(C, 1);  // clusters in the subtree of each (a parent's index is below its children's)
+  for (size_t c = C; c-- > 0;)
+    if (tree.cluster_parent[c] >= 0) size[tree.cluster_parent[c]] += size[c];
+  std::vector<std::vector<uint32_t>> children(C);
+  for (size_t c = 0; c < C; ++c)
+    if (tree.cluster_parent[c] >= 0) children[tree.cluster_parent[c]].push_back(static_cast<uint32_t>(c));
+  // The frontier starts at the roots; its largest limb is opened while larger than the share.
+  std::vector<uint8_t> in_trunk(C, 0);
+  auto larger = [&](uint32_t a, uint32_t b) { return size[a] != size[b] ? size[a] < size[b] : a > b; };
+  std::vector<uint32_t> frontier;
+  for (size_t c = 0; c < C; ++c)
+    if (tree.cluster_parent[c] < 0) frontier.push_back(static_cast<uint32_t>(c));
+  std::make_heap(frontier.begin(), frontier.end(), larger);
+  const size_t share = std::max<size_t>(1, C / kWalkLimbShare);
+  while (!frontier.empty() && size[frontier.front()] > share) {
+    std::pop_heap(frontier.begin(), frontier.end(), larger);
+    const uint32_t opened = frontier.back();
+    frontier.pop_back();
+    in_trunk[opened] = 1;
+    for (uint32_t child : children[opened]) {
+      frontier.push_back(child);
+      std::push_heap(frontier.begin(), frontier.end(), larger);
+    }
+  }
+  for (uint32_t root : frontier) in_trunk[root] = 1;
+  for (size_t c = 0; c < C; ++c)
+    if (in_trunk[c]) chain.walk_trunk.push_back(static_cast<uint32_t>(c));
+  // Each limb's root => its group; a cluster below the trunk joins its parent's limb.
+  std::sort(frontier.begin(), frontier.end(), [&](uint32_t a, uint32_t b) { return larger(b, a); });
+  std::vector<size_t> load(kWalkGroups, 0);
+  std::vector<uint32_t> group(C, 0);
+  for (uint32_t root : frontier) {
+    const size_t g = size_t(std::min_element(load.begin(), load.end()) - load.begin());
+    group[root] = static_cast<uint32_t>(g);
+    load[g] += size[root] - 1;
+  }
+  std::vector<std::vector<uint32_t>> members(kWalkGroups);
+  for (size_t c = 0; c < C; ++c) {
+    if (in_trunk[c]) continue;
+    group[c] = group[tree.cluster_parent[c]];
+    members[group[c]].push_back(static_cast<uint32_t>(c));
+  }
+  chain.walk_group_offsets.assign(1, 0);
+  for (const std::vector<uint32_t>& m : members) {
+    chain.walk_groups.insert(chain.walk_groups.end(), m.begin(), m.end());
+    chain.walk_group_offsets.push_back(static_cast<uint32_t>(chain.walk_groups.size()));
+  }
+}
+
+}  // namespace
+
 BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
   const double youngs_modulus = options.youngs_modulus, yield_strain = options.yield_strain;
   const size_t C = tree.cluster_count();
@@ -66,6 +127,7 @@ BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
       chain.cluster_compliance[c] += options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];  // 2 half / L = 1 / (E I)
     }
   }
+  cut_for_walks(tree, chain);
   return chain;
 }
 

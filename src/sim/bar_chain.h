@@ -4,6 +4,7 @@
 // vertex toward the chain's static deflection under the step's drag (beam_statics.cpp); the
 // limbs sway at the chain's own first frequency.
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "sim/sim_options.h"
@@ -18,6 +19,14 @@ struct BarChain {
   // at most a quarter turn (a leaf: a quarter turn, set by the solver). Beyond it the joint turns no further, as a
   // plastic hinge would: a gale folds a limb as far as wood bends, not round in circles.
   std::vector<double> cluster_max_turn;
+  // The cluster tree cut for the chain's two walks (beam_statics.cpp), so that threads walk
+  // disjoint limbs: the trunk (the clusters nearest the roots and the roots of the limbs that
+  // hang from them, ascending) is walked by one thread, the rest in groups of whole limbs
+  // below those roots (each group ascending) in parallel. A parent sums its children in the
+  // same order whatever the cut or the threads, so the walks' results do not depend on them.
+  std::vector<uint32_t> walk_trunk;
+  std::vector<uint32_t> walk_group_offsets;  // (groups + 1) into walk_groups
+  std::vector<uint32_t> walk_groups;
 };
 
 // Tree model + options (Young's modulus, yield strain, root flexibility) => the joints and the

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "sim/kernel_isa.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -179,20 +180,27 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
         Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
   }
 #pragma omp barrier
-  // 2. Children before parents: a joint carries the moment of everything beyond it.
-#pragma omp single
-  for (size_t c = C; c-- > 0;) {
+  // 2. Children before parents: a joint carries the moment of everything beyond it. The
+  // limbs below the trunk in parallel, then the trunk (BarChain::walk_trunk).
+  auto carry_up = [&](uint32_t c) {
     const int32_t p = tree.cluster_parent[c];
-    if (p < 0 || attachment.cluster_flying[c]) continue;
+    if (p < 0 || attachment.cluster_flying[c]) return;
     scratch.cluster_load.col(p) += scratch.cluster_load.col(c);
     scratch.cluster_moment.col(p) += scratch.cluster_moment.col(c) + (joint.col(c) - joint.col(p)).cross(scratch.cluster_load.col(c));
     scratch.cluster_damping[p] += scratch.cluster_damping[c];
     scratch.cluster_damping_moment.col(p) +=
         scratch.cluster_damping_moment.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_damping[c];
-  }
+  };
+  const BarChain& chain = model.chain;
+  const size_t groups = chain.walk_group_offsets.size() - 1;
+#pragma omp for schedule(static)
+  for (size_t g = 0; g < groups; ++g)
+    for (uint32_t k = chain.walk_group_offsets[g + 1]; k-- > chain.walk_group_offsets[g];) carry_up(chain.walk_groups[k]);
+#pragma omp single
+  for (size_t k = chain.walk_trunk.size(); k-- > 0;) carry_up(chain.walk_trunk[k]);
   // 3. Parents before children: each joint turns by its compliance times its moment (in
-  // parallel: the sines and cosines), and the turns accumulate from the root (one thread),
-  // as do the damping's sums over the joints from the root, C_j S_j and C_j S_j . (j_c - j_j)
+  // parallel: the sines and cosines), and the turns accumulate from the root (the trunk, then
+  // the limbs), as do the damping's sums over the joints from the root, C_j S_j and C_j S_j . (j_c - j_j)
   // (about the cluster's own joint: small numbers wherever the tree stands).
 #pragma omp for schedule(static)
   for (size_t c = 0; c < C; ++c) {
@@ -209,14 +217,14 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
   }
-#pragma omp single
-  for (size_t c = 0; c < C; ++c) {
+  // The trunk on one thread, then the limbs below it in parallel.
+  auto carry_down = [&](uint32_t c) {
     const int32_t p = tree.cluster_parent[c];
     Eigen::Map<Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
     if (p < 0 || attachment.cluster_flying[c]) {
       scratch.cluster_static_joint.col(c) = joint.col(c);
       scratch.cluster_damping_lever[c] = 0;
-      continue;
+      return;
     }
     scratch.cluster_damping_path.col(c) += scratch.cluster_damping_path.col(p);
     scratch.cluster_damping_lever[c] =
@@ -226,7 +234,13 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     scratch.cluster_static_joint.col(c) =
         scratch.cluster_static_joint.col(p) + parent * (joint.col(c) - joint.col(p));
     R = turn * parent;
-  }
+  };
+#pragma omp single
+  for (uint32_t c : chain.walk_trunk) carry_down(c);
+#pragma omp for schedule(static)
+  for (size_t g = 0; g < groups; ++g)
+    for (uint32_t k = chain.walk_group_offsets[g]; k < chain.walk_group_offsets[g + 1]; ++k)
+      carry_down(chain.walk_groups[k]);
   // Each cluster's deflected pose as the goal writes read it, in Real: R - I, the joint's move
   // J - j, the damping path and lever (small numbers: the goal is an offset from rest).
 #pragma omp for schedule(static)
@@ -273,34 +287,36 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const uint8_t* active = attachment.member_active.data();
   Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
   Real* compliance = prediction.damping_compliance.data();
-  for (size_t v = begin; v < end;) {
-    const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
-    if (run_end > v) {
-      const uint32_t slot = memberships[offsets[v]];
-      const Real* k = &scratch.cluster_pose(0, member_cluster[slot]);
-      const Real *ax = arm_x + slot - v, *ay = arm_y + slot - v, *az = arm_z + slot - v;
+  with_kernel_isa([&] {
+    for (size_t v = begin; v < end;) {
+      const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
+      if (run_end > v) {
+        const uint32_t slot = memberships[offsets[v]];
+        const Real* k = &scratch.cluster_pose(0, member_cluster[slot]);
+        const Real *ax = arm_x + slot - v, *ay = arm_y + slot - v, *az = arm_z + slot - v;
 #pragma omp simd
-      for (size_t u = v; u < run_end; ++u) {
-        Real ox = 0, oy = 0, oz = 0, back = 0;
-        add_deflected(k, ax[u], ay[u], az[u], ox, oy, oz, back);
-        gx[u] = ox, gy[u] = oy, gz[u] = oz;
-        compliance[u] = back <= Real(0) ? Real(0) : back;
+        for (size_t u = v; u < run_end; ++u) {
+          Real ox = 0, oy = 0, oz = 0, back = 0;
+          add_deflected(k, ax[u], ay[u], az[u], ox, oy, oz, back);
+          gx[u] = ox, gy[u] = oy, gz[u] = oz;
+          compliance[u] = back <= Real(0) ? Real(0) : back;
+        }
+        v = run_end;
+        continue;
       }
-      v = run_end;
-      continue;
+      Real ox = 0, oy = 0, oz = 0, back = 0;
+      for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+        const uint32_t slot = memberships[s];
+        if (!active[slot]) continue;
+        add_deflected(&scratch.cluster_pose(0, member_cluster[slot]), arm_x[slot], arm_y[slot], arm_z[slot], ox, oy,
+                      oz, back);
+      }
+      const Real share = attachment.vertex_inv_count[v];
+      gx[v] = ox * share, gy[v] = oy * share, gz[v] = oz * share;
+      compliance[v] = std::max(back * share, Real(0));
+      ++v;
     }
-    Real ox = 0, oy = 0, oz = 0, back = 0;
-    for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
-      const uint32_t slot = memberships[s];
-      if (!active[slot]) continue;
-      add_deflected(&scratch.cluster_pose(0, member_cluster[slot]), arm_x[slot], arm_y[slot], arm_z[slot], ox, oy,
-                    oz, back);
-    }
-    const Real share = attachment.vertex_inv_count[v];
-    gx[v] = ox * share, gy[v] = oy * share, gz[v] = oz * share;
-    compliance[v] = std::max(back * share, Real(0));
-    ++v;
-  }
+  });
 }
 
 #define TREEANIM_BEAM_STATICS(Real)                                                                               \

@@ -5,11 +5,15 @@
 // it takes a few per cent of the load off the tip.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
+#include "grown_tree.h"
 #include "lsystem/lsystem.h"
+#include "sim/bar_chain.h"
 #include "sim/simulator.h"
 #include "tree/build_tree_model.h"
 
@@ -52,6 +56,60 @@ double deflection_at(const TreeModel& model, const SimState& state, double s) {
       ++count;
     }
   return count ? sum / count : std::nan("");
+}
+
+// The cut for the chain's walks (BarChain::walk_trunk, walk_groups): every cluster once, each
+// list ascending, the trunk closed toward the roots, and all children of a cluster in one
+// place (the trunk or one group), so that no two threads add into one parent.
+void expect_walk_cut(const TreeModel& tree) {
+  const BarChain chain = build_bar_chain(tree, HsmOptions{});
+  const size_t C = tree.cluster_count();
+  std::vector<int> place(C, -2);  // -1: trunk, g: group g
+  ASSERT_TRUE(std::is_sorted(chain.walk_trunk.begin(), chain.walk_trunk.end()));
+  for (uint32_t c : chain.walk_trunk) {
+    ASSERT_LT(c, C);
+    EXPECT_EQ(place[c], -2) << "cluster " << c << " twice";
+    place[c] = -1;
+  }
+  ASSERT_GE(chain.walk_group_offsets.size(), 2u);
+  EXPECT_EQ(chain.walk_group_offsets.back(), chain.walk_groups.size());
+  size_t largest = 0;
+  for (size_t g = 0; g + 1 < chain.walk_group_offsets.size(); ++g) {
+    const auto first = chain.walk_groups.begin() + chain.walk_group_offsets[g];
+    const auto last = chain.walk_groups.begin() + chain.walk_group_offsets[g + 1];
+    EXPECT_TRUE(std::is_sorted(first, last));
+    largest = std::max<size_t>(largest, last - first);
+    for (auto it = first; it != last; ++it) {
+      ASSERT_LT(*it, C);
+      EXPECT_EQ(place[*it], -2) << "cluster " << *it << " twice";
+      place[*it] = int(g);
+    }
+  }
+  std::vector<int> children_place(C, -2);
+  for (size_t c = 0; c < C; ++c) {
+    ASSERT_NE(place[c], -2) << "cluster " << c << " in no walk";
+    const int32_t p = tree.cluster_parent[c];
+    if (p < 0) {
+      EXPECT_EQ(place[c], -1) << "root cluster " << c << " outside the trunk";
+      continue;
+    }
+    if (place[c] == -1) {
+      EXPECT_EQ(place[p], -1) << "trunk cluster " << c << " below a limb";
+    }
+    if (children_place[p] == -2) children_place[p] = place[c];
+    EXPECT_EQ(children_place[p], place[c]) << "children of cluster " << p << " in two walks";
+    if (place[c] >= 0) {
+      EXPECT_TRUE(place[p] == place[c] || place[p] == -1) << "cluster " << c;
+    }
+  }
+  // The limbs are dealt evenly: no group holds much more than its share.
+  EXPECT_LE(largest, C / 16 + C / 64 + 1);
+}
+
+TEST(Beam, WalkCutSplitsTheClusterTreeIntoDisjointLimbs) {
+  expect_walk_cut(testing::grown_tree(5, 2, 2));
+  expect_walk_cut(cantilever(12));
+  expect_walk_cut(cantilever(1));
 }
 
 TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
