@@ -65,6 +65,14 @@ Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vec
   return sum / 6;
 }
 
+// A child's weight w and its first moment about its own joint, offset = j_child - j_parent
+// => added to its parent's weight and moment about the parent's joint: m_p += m + offset w.
+inline void carry_moment(double w, const Eigen::Vector3d& m, const Eigen::Vector3d& offset, double& parent_w,
+                         Eigen::Ref<Eigen::Vector3d> parent_m) {
+  parent_w += w;
+  parent_m += m + offset * w;
+}
+
 // A cluster's load sums run in eight fixed lanes: its k-th member is added in lane k % 8, and
 // the lanes are added in one fixed order (sum_lanes), so the sums are the same whatever
 // vector width the loop runs in (docs/solver.md, "Instruction sets").
@@ -129,9 +137,8 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
   for (size_t c = model.C; c-- > 0;) {
     const int32_t p = tree.cluster_parent[c];
     if (p < 0 || attachment.cluster_flying[c]) continue;
-    attachment.cluster_drag_area[p] += attachment.cluster_drag_area[c];
-    attachment.cluster_drag_arm.col(p) +=
-        attachment.cluster_drag_arm.col(c) + (joint.col(c) - joint.col(p)) * attachment.cluster_drag_area[c];
+    carry_moment(attachment.cluster_drag_area[c], attachment.cluster_drag_arm.col(c), joint.col(c) - joint.col(p),
+                 attachment.cluster_drag_area[p], attachment.cluster_drag_arm.col(p));
   }
 }
 
@@ -187,9 +194,8 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
     if (p < 0 || attachment.cluster_flying[c]) return;
     scratch.cluster_load.col(p) += scratch.cluster_load.col(c);
     scratch.cluster_moment.col(p) += scratch.cluster_moment.col(c) + (joint.col(c) - joint.col(p)).cross(scratch.cluster_load.col(c));
-    scratch.cluster_damping[p] += scratch.cluster_damping[c];
-    scratch.cluster_damping_moment.col(p) +=
-        scratch.cluster_damping_moment.col(c) + (joint.col(c) - joint.col(p)) * scratch.cluster_damping[c];
+    carry_moment(scratch.cluster_damping[c], scratch.cluster_damping_moment.col(c), joint.col(c) - joint.col(p),
+                 scratch.cluster_damping[p], scratch.cluster_damping_moment.col(p));
   };
   const BarChain& chain = model.chain;
   const size_t groups = chain.walk_group_offsets.size() - 1;
