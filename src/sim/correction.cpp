@@ -186,8 +186,10 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
         return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !load, false, any_asleep,
                                  false, goals,
                                  [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                                   return predict_block(model, attachment, scratch, prediction, begin, n, in, kick,
-                                                        block);
+                                   return end ? predict_block<false>(model, attachment, scratch, prediction, begin,
+                                                                     n, in, kick, block)
+                                              : predict_block<true>(model, attachment, scratch, prediction, begin, n,
+                                                                    in, kick, block);
                                  });
       }).first;
       if (my_bad_prediction != kNone) {

@@ -58,6 +58,25 @@ inline Real drag_share(Real drag, Real rx, Real ry, Real rz, Real step) {
   return kuh / (1 + kuh);
 }
 
+// Lane k of a block before its correction (u, v) => after it (Eq. 7: the mean correction p,
+// now unless the step kicks it, v by p / h), and p. Both kernels call it: the correction pass
+// keeps the results in memory only for the state (the last step), the prediction recomputes them.
+template <typename Real>
+struct CorrectedLane {
+  Real ux, uy, uz, vx, vy, vz, px, py, pz, now;
+};
+template <typename Real>
+inline CorrectedLane<Real> correct_lane(const VertexInputs<Real>& in, const Real* const offset[3],
+                                        const Real* const velocity[3], int k, Real inv_h) {
+  const uint32_t row = in.pull_row[k];
+  const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
+  const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+  return {offset[0][k] + px * now,         offset[1][k] + py * now,         offset[2][k] + pz * now,
+          velocity[0][k] + px * now * inv_h, velocity[1][k] + py * now * inv_h, velocity[2][k] + pz * now * inv_h,
+          px,                              py,                              pz,
+          now};
+}
+
 // Block of n lanes => true when some moving lane turned non-finite or ran away; the caller
 // finds which. Kept out of the kernels' loops: a reduction there stops GCC from vectorising
 // them. The order of the sum decides nothing.
@@ -72,10 +91,13 @@ inline bool block_flagged(const VertexBlock<Real>& block, int n) {
   return !(total - total == 0) || worst > 0;
 }
 
-// Predicted vertices [begin, begin + n) => corrected u and v in place (`prediction` then
-// holds the state at the step's end) and, with kForce, the drag each will feel over the next
-// step from its velocity at the step's start (prediction.drag_force, damping_offset;
-// scratch.vertex_drag_damping). With kEnd the runaway limit is checked. Returns block_flagged.
+// Predicted vertices [begin, begin + n) => with kForce, the drag each will feel over the next
+// step from its velocity at the step's start after the correction (prediction.drag_force,
+// damping_offset; scratch.vertex_drag_damping). The corrected u and v are written in place
+// with kEnd (`prediction` then holds the state at the step's end, for the frame's state), and
+// the runaway limit is checked; otherwise predict_block recomputes them, which saves a write
+// of u and v per vertex, and only a flagged block is written (for the caller to find the
+// vertex at fault). Returns block_flagged.
 template <bool kEnd, bool kForce, typename Real>
 inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
@@ -114,14 +136,11 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     }
 #pragma omp simd
     for (int k = first; k < stop; ++k) {
-      const uint32_t row = in.pull_row[k];
-      const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
-      const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
-      const Real ux = offset[0][k] + px * now, uy = offset[1][k] + py * now, uz = offset[2][k] + pz * now;
-      const Real vx = velocity[0][k] + px * now * inv_h, vy = velocity[1][k] + py * now * inv_h,
-                 vz = velocity[2][k] + pz * now * inv_h;
-      offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
-      velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+      const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = correct_lane(in, offset, velocity, k, inv_h);
+      if constexpr (kEnd) {
+        offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
+        velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
+      }
       if constexpr (kForce) {
         // The drag at the step's start, from the velocity there: half a step of damping and of
         // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
@@ -159,14 +178,23 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     }
     first = stop;
   }
-  return block_flagged(block, n);
+  const bool flagged = block_flagged(block, n);
+  if constexpr (!kEnd)
+    if (flagged)
+      for (int k = 0; k < n; ++k) {
+        const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
+        offset[0][k] = lane.ux, offset[1][k] = lane.uy, offset[2][k] = lane.uz;
+        velocity[0][k] = lane.vx, velocity[1][k] = lane.vy, velocity[2][k] = lane.vz;
+      }
+  return flagged;
 }
 
-// Corrected vertices [begin, begin + n) => their prediction for the next step, in place,
-// written for every lane (a still lane maps onto itself). `kick` is 1, or 1/2 when the
+// Corrected vertices [begin, begin + n) (kCorrect: vertices the correction pass left
+// uncorrected, corrected here first, as it would have) => their prediction for the next step,
+// in place, written for every lane (a still lane maps onto itself). `kick` is 1, or 1/2 when the
 // velocities are not staggered (a step from the state: leapfrog's first half kick). The
 // drag's square roots and divisions dominate the loop. Returns block_flagged.
-template <typename Real>
+template <bool kCorrect, typename Real>
 inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
                           const VertexInputs<Real>& in, Real kick, VertexBlock<Real>& block) {
@@ -177,7 +205,7 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
   const Real direct = model.beam ? Real(0) : Real(1);
   // The global term: a kick toward the goal with the beam, else a projection of the prediction.
   const Real kicked = model.kick ? Real(1) : Real(0), projected = Real(1) - kicked;
-  const Real inv_step = static_cast<Real>(1.0 / h);
+  const Real inv_step = static_cast<Real>(1.0 / h);  // also the correction's, as correct_block's inv_h
   const Eigen::Vector3d& gravity = model.options.gravity;
   const Real gravity_step[3] = {static_cast<Real>(gravity.x() * h) * kick, static_cast<Real>(gravity.y() * h) * kick,
                                 static_cast<Real>(gravity.z() * h) * kick};
@@ -191,7 +219,12 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
     const uint32_t c = air_cluster[k];
-    const Real ux = offset[0][k], uy = offset[1][k], uz = offset[2][k];
+    Real ux = offset[0][k], uy = offset[1][k], uz = offset[2][k];
+    Real vx = velocity[0][k], vy = velocity[1][k], vz = velocity[2][k];
+    if constexpr (kCorrect) {
+      const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_step);
+      ux = lane.ux, uy = lane.uy, uz = lane.uz, vx = lane.vx, vy = lane.vy, vz = lane.vz;
+    }
     const Real ax = air[0][c], ay = air[1][c], az = air[2][c];
     // A symmetric (Strang) splitting of the step's velocity change about the kick of the
     // corrected position: half the damping, half the drag, the kick (gravity on a flying leaf,
@@ -200,7 +233,7 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     // h and never overshoots (docs/solver.md, "One step").
     const Real half = in.half_damping[k], falling = static_cast<Real>(in.flying[k]);
     const Real pull_back = in.global[k] * inv_h * kicked, drag = in.drag[k] * std::max(direct, falling);
-    Real vx = velocity[0][k] * half, vy = velocity[1][k] * half, vz = velocity[2][k] * half;
+    vx *= half, vy *= half, vz *= half;
     Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
     const uint32_t row = in.pull_row[k];
