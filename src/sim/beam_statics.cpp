@@ -274,6 +274,43 @@ inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Re
   back += ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15];
 }
 
+// A run [v, run_end) of vertices in the same N clusters (SolverModel::vertex_run_end) => their
+// goals and damping compliances, each the vertex loop's sum over its memberships in order, the
+// lanes vectorised. A mean over one skips the share of 1; in float its max(back, 0) is taken
+// after the rounding (GCC does not if-convert a conversion under a test): the same value, as
+// back = 0 + term is never -0.
+template <int N, typename Real>
+void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachment, const StepScratch<Real>& scratch,
+               StepPrediction<Real>& prediction, size_t v, size_t run_end) {
+  const TreeModel& tree = model.tree;
+  static_assert(N >= 1 && N <= int(kMaxRunClusters));
+  const Real* k[N];
+  const Real *ax[N], *ay[N], *az[N];
+  for (int j = 0; j < N; ++j) {
+    const uint32_t slot = tree.vertex_memberships[tree.vertex_cluster_offsets[v] + j];
+    k[j] = &scratch.cluster_pose(0, model.member_cluster[slot]);
+    ax[j] = model.member_arm.col(0).data() + slot - v;
+    ay[j] = model.member_arm.col(1).data() + slot - v;
+    az[j] = model.member_arm.col(2).data() + slot - v;
+  }
+  const Real* inv_count = attachment.vertex_inv_count.data();
+  Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
+  Real* compliance = prediction.damping_compliance.data();
+#pragma omp simd
+  for (size_t u = v; u < run_end; ++u) {
+    Real ox = 0, oy = 0, oz = 0, back = 0;
+    for (int j = 0; j < N; ++j) add_deflected(k[j], ax[j][u], ay[j][u], az[j][u], ox, oy, oz, back);
+    if constexpr (N == 1) {
+      gx[u] = ox, gy[u] = oy, gz[u] = oz;
+      compliance[u] = back <= Real(0) ? Real(0) : back;
+    } else {
+      const Real share = inv_count[u];
+      gx[u] = ox * share, gy[u] = oy * share, gz[u] = oz * share;
+      compliance[u] = std::max(back * share, Real(0));
+    }
+  }
+}
+
 }  // namespace
 
 template <typename Real>
@@ -283,9 +320,9 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const TreeModel& tree = model.tree;
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
   // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
-  // everything moves with it (docs/solver.md, "Aerodynamic damping"). A run of vertices each in
-  // one cluster alone (a mean over one, share 1), whose memberships are consecutive, is one
-  // loop on that cluster's pose, vectorised.
+  // everything moves with it (docs/solver.md, "Aerodynamic damping"). A run of vertices in the
+  // same clusters, whose memberships are consecutive in each (SolverModel::vertex_run_end), is
+  // one loop on those clusters' poses, vectorised, with the operations of the vertex loop.
   const Real *arm_x = model.member_arm.col(0).data(), *arm_y = model.member_arm.col(1).data(),
              *arm_z = model.member_arm.col(2).data();
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
@@ -297,15 +334,11 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
     for (size_t v = begin; v < end;) {
       const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
       if (run_end > v) {
-        const uint32_t slot = memberships[offsets[v]];
-        const Real* k = &scratch.cluster_pose(0, member_cluster[slot]);
-        const Real *ax = arm_x + slot - v, *ay = arm_y + slot - v, *az = arm_z + slot - v;
-#pragma omp simd
-        for (size_t u = v; u < run_end; ++u) {
-          Real ox = 0, oy = 0, oz = 0, back = 0;
-          add_deflected(k, ax[u], ay[u], az[u], ox, oy, oz, back);
-          gx[u] = ox, gy[u] = oy, gz[u] = oz;
-          compliance[u] = back <= Real(0) ? Real(0) : back;
+        switch (offsets[v + 1] - offsets[v]) {
+          case 1: write_run<1>(model, attachment, scratch, prediction, v, run_end); break;
+          case 2: write_run<2>(model, attachment, scratch, prediction, v, run_end); break;
+          case 3: write_run<3>(model, attachment, scratch, prediction, v, run_end); break;
+          default: write_run<kMaxRunClusters>(model, attachment, scratch, prediction, v, run_end); break;
         }
         v = run_end;
         continue;

@@ -47,17 +47,24 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     a.vertex_pull_row[v] = tree.vertex_memberships[begin];
     if (end - begin > 1) m.shared_vertices.push_back(static_cast<uint32_t>(v));
   }
-  std::vector<uint8_t> alone(m.V, 0);  // (V) 1: in one cluster, whose membership stays
-  for (size_t v = 0; v < m.V; ++v) alone[v] = tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v] == 1;
-  for (size_t l = 0; l < m.L; ++l) alone[tree.leaf_attachment_vertex[l]] = 0;
+  const std::vector<uint32_t>& offsets = tree.vertex_cluster_offsets;
+  std::vector<uint8_t> runs(m.V, 0);  // (V) 1: in 1 to kMaxRunClusters clusters, whose memberships stay
+  for (size_t v = 0; v < m.V; ++v) runs[v] = offsets[v + 1] > offsets[v] && offsets[v + 1] - offsets[v] <= kMaxRunClusters;
+  for (size_t l = 0; l < m.L; ++l) runs[tree.leaf_attachment_vertex[l]] = 0;
+  // v and v + 1 => whether v + 1 continues v's run: the same clusters, the next membership in each.
+  auto continues = [&](size_t v) {
+    const uint32_t n = offsets[v + 1] - offsets[v];
+    if (!runs[v + 1] || offsets[v + 2] - offsets[v + 1] != n) return false;
+    for (uint32_t j = 0; j < n; ++j) {
+      const uint32_t slot = tree.vertex_memberships[offsets[v] + j], next = tree.vertex_memberships[offsets[v + 1] + j];
+      if (next != slot + 1 || m.member_cluster[next] != m.member_cluster[slot]) return false;
+    }
+    return true;
+  };
   m.vertex_run_end.assign(m.V, 0);
   for (size_t v = m.V; v-- > 0;) {
-    if (!alone[v]) continue;
-    const bool continues = v + 1 < m.V && alone[v + 1] &&
-                           a.vertex_air_cluster[v + 1] == a.vertex_air_cluster[v] &&
-                           tree.vertex_memberships[tree.vertex_cluster_offsets[v + 1]] ==
-                               tree.vertex_memberships[tree.vertex_cluster_offsets[v]] + 1;
-    m.vertex_run_end[v] = continues ? m.vertex_run_end[v + 1] : static_cast<uint32_t>(v + 1);
+    if (!runs[v]) continue;
+    m.vertex_run_end[v] = v + 1 < m.V && continues(v) ? m.vertex_run_end[v + 1] : static_cast<uint32_t>(v + 1);
   }
 }
 

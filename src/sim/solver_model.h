@@ -26,6 +26,10 @@ constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 template <typename Real>
 using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;
 
+// The most clusters a vertex of a run may be in (SolverModel::vertex_run_end): a branch's
+// vertices are in one, the rings where two clusters overlap in two.
+constexpr uint32_t kMaxRunClusters = 4;
+
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,
 // and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
 // detachment.cpp changes it when a leaf detaches, and rebuilds it from the model for a state
@@ -114,9 +118,10 @@ struct SolverModel {
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   Rows3<Real> member_arm;                  // (M x 3) m, with the beam: x0 - the joint of the member's cluster
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
-  // (V) for a vertex in one cluster alone (and no leaf's shared vertex: that membership is
-  // never released), the end of the run of consecutive such vertices of the same cluster,
-  // with consecutive memberships, that it is in; else 0. The goal writes take a run as one loop on the cluster's values.
+  // (V) for a vertex in 1 to kMaxRunClusters clusters (and no leaf's shared vertex, whose
+  // memberships may be released), the end of the run it is in: consecutive vertices in the
+  // same clusters, in the same order, with consecutive memberships in each; else 0. The goal
+  // writes take a run as one loop on its clusters' values.
   std::vector<uint32_t> vertex_run_end;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---

@@ -15,6 +15,7 @@
 #include "lsystem/lsystem.h"
 #include "sim/bar_chain.h"
 #include "sim/simulator.h"
+#include "sim/solver_model.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {
@@ -110,6 +111,47 @@ TEST(Beam, WalkCutSplitsTheClusterTreeIntoDisjointLimbs) {
   expect_walk_cut(testing::grown_tree(5, 2, 2));
   expect_walk_cut(cantilever(12));
   expect_walk_cut(cantilever(1));
+}
+
+TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
+  // The goal writes take a run as one loop on its clusters' poses and the next arm of each
+  // (beam_statics.cpp): every vertex of a run must be in the same clusters, in the same order,
+  // at the next membership of each, and none a leaf's shared vertex (whose memberships may be
+  // released). Overlap rings make runs of vertices in two clusters.
+  const TreeModel tree = testing::grown_tree(5, 2, 2);
+  const SolverModel<float> model(tree, HsmOptions{}, WindOptions{}, 1.0 / 24, 2);
+  std::vector<uint8_t> leaf_shared(tree.vertex_count(), 0);
+  for (uint32_t v : tree.leaf_attachment_vertex) leaf_shared[v] = 1;
+  const auto& offsets = tree.vertex_cluster_offsets;
+  size_t in_runs = 0, shared_in_runs = 0;
+  for (size_t v = 0; v < tree.vertex_count();) {
+    const size_t end = model.vertex_run_end[v];
+    if (end == 0) {
+      ++v;
+      continue;
+    }
+    ASSERT_GT(end, v);
+    ASSERT_LE(end, tree.vertex_count());
+    const uint32_t n = offsets[v + 1] - offsets[v];
+    ASSERT_GE(n, 1u);
+    ASSERT_LE(n, kMaxRunClusters);
+    for (size_t u = v; u < end; ++u) {
+      ASSERT_EQ(model.vertex_run_end[u], end) << u;
+      ASSERT_FALSE(leaf_shared[u]) << u;
+      ASSERT_EQ(offsets[u + 1] - offsets[u], n) << u;
+      for (uint32_t j = 0; j < n; ++j) {
+        const uint32_t first = tree.vertex_memberships[offsets[v] + j], slot = tree.vertex_memberships[offsets[u] + j];
+        ASSERT_EQ(slot, first + (u - v)) << u;
+        ASSERT_EQ(model.member_cluster[slot], model.member_cluster[first]) << u;
+        ASSERT_EQ(tree.cluster_members[slot], u);
+      }
+    }
+    in_runs += end - v;
+    if (n > 1) shared_in_runs += end - v;
+    v = end;
+  }
+  EXPECT_GT(in_runs, tree.vertex_count() * 9 / 10);
+  EXPECT_GT(shared_in_runs, 0u);
 }
 
 TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
