@@ -206,8 +206,9 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
   if (runaway != kNone) {
     char distances[160];
-    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than twice the tree's size (%.3g m, its reach along the branches or its extent)",
-                  prediction.offset.row(runaway).template cast<double>().norm(), std::sqrt(model.runaway_distance2) / 2);
+    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
+                  prediction.offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
+                  std::sqrt(model.runaway_distance2) / kRunawaySizes);
     throw SimulationError(where(runaway) + distances +
                           ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
   }

@@ -1,5 +1,6 @@
 // Precompute (libigl's split of a solver into precompute + solve): TreeModel + options =>
 // SolverModel, whose Attachment has every leaf attached; and the per-step scratch.
+#include <cmath>
 #include <numbers>
 #include <numeric>
 
@@ -200,7 +201,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   chain = build_bar_chain(t, o);
   const double size = std::max(extent, tree_reach(t, chain));
   const bool anchored = std::any_of(t.vertex_anchored.begin(), t.vertex_anchored.end(), [](auto a) { return a != 0; });
-  runaway_distance2 = anchored && size > 0 ? 4 * size * size : std::numeric_limits<double>::infinity();
+  runaway_distance2 = anchored && size > 0 ? std::pow(kRunawaySizes * size, 2) : std::numeric_limits<double>::infinity();
   Attachment<Real>& a = all_attached;
   precompute_members(*this, a);
   precompute_pins(*this, a);

@@ -26,6 +26,11 @@ constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 template <typename Real>
 using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;
 
+// An attached vertex farther from rest than this many times the tree's size stops the bake
+// (SolverModel::runaway_distance2): twice is the farthest a connected rigid pose reaches (a
+// half turn at the root), the rest a margin for a swing past it and the clusters' stretch.
+constexpr double kRunawaySizes = 2.5;
+
 // The most clusters a vertex of a run may be in (SolverModel::vertex_run_end): a branch's
 // vertices are in one, the rings where two clusters overlap in two.
 constexpr uint32_t kMaxRunClusters = 4;
@@ -83,9 +88,9 @@ struct SolverModel {
   double frame_dt;                         // s
   int substeps;
   double h;                                // s, one substep
-  // m^2: (2 x the tree's size)^2, its size the larger of the rest mesh's extent and its reach
-  // along the branches (tree_reach). An attached vertex of an anchored tree farther than that
-  // from rest means the tree came apart (docs/solver.md, "Runaway").
+  // m^2: (kRunawaySizes x the tree's size)^2, its size the larger of the rest mesh's extent and
+  // its reach along the branches (tree_reach). An attached vertex of an anchored tree farther
+  // than that from rest means the tree came apart (docs/solver.md, "Runaway").
   // Infinite without anchors (a free body may travel) and for a single-point model.
   double runaway_distance2;
   size_t V, C, M, L, I;
