@@ -274,14 +274,26 @@ inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Re
   back += ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15];
 }
 
+// Where the goal writes go: per vertex its goal (prediction.goal) and damping compliance.
+template <typename Real>
+struct GoalRows {
+  Real *x, *y, *z, *compliance;
+};
+
+// Vertex v's sums over its clusters and share = 1 / their number => its goal, the mean, and
+// its damping compliance, never below 0.
+template <typename Real>
+inline void store_goal(const GoalRows<Real>& out, size_t v, Real ox, Real oy, Real oz, Real back, Real share) {
+  out.x[v] = ox * share, out.y[v] = oy * share, out.z[v] = oz * share;
+  out.compliance[v] = std::max(back * share, Real(0));
+}
+
 // A run [v, run_end) of vertices in the same N clusters (SolverModel::vertex_run_end) => their
 // goals and damping compliances, each the vertex loop's sum over its memberships in order, the
-// lanes vectorised. A mean over one skips the share of 1; in float its max(back, 0) is taken
-// after the rounding (GCC does not if-convert a conversion under a test): the same value, as
-// back = 0 + term is never -0.
+// lanes vectorised. A mean over one takes the share 1 as a constant.
 template <int N, typename Real>
 void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachment, const StepScratch<Real>& scratch,
-               StepPrediction<Real>& prediction, size_t v, size_t run_end) {
+               const GoalRows<Real>& out, size_t v, size_t run_end) {
   const TreeModel& tree = model.tree;
   static_assert(N >= 1 && N <= int(kMaxRunClusters));
   const Real* k[N];
@@ -294,20 +306,11 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
     az[j] = model.member_arm.col(2).data() + slot - v;
   }
   const Real* inv_count = attachment.vertex_inv_count.data();
-  Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
-  Real* compliance = prediction.damping_compliance.data();
 #pragma omp simd
   for (size_t u = v; u < run_end; ++u) {
     Real ox = 0, oy = 0, oz = 0, back = 0;
     for (int j = 0; j < N; ++j) add_deflected(k[j], ax[j][u], ay[j][u], az[j][u], ox, oy, oz, back);
-    if constexpr (N == 1) {
-      gx[u] = ox, gy[u] = oy, gz[u] = oz;
-      compliance[u] = back <= Real(0) ? Real(0) : back;
-    } else {
-      const Real share = inv_count[u];
-      gx[u] = ox * share, gy[u] = oy * share, gz[u] = oz * share;
-      compliance[u] = std::max(back * share, Real(0));
-    }
+    store_goal(out, u, ox, oy, oz, back, N == 1 ? Real(1) : inv_count[u]);
   }
 }
 
@@ -328,17 +331,17 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
-  Real *gx = prediction.goal.col(0).data(), *gy = prediction.goal.col(1).data(), *gz = prediction.goal.col(2).data();
-  Real* compliance = prediction.damping_compliance.data();
+  const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
+                              prediction.goal.col(2).data(), prediction.damping_compliance.data()};
   with_kernel_isa([&] {
     for (size_t v = begin; v < end;) {
       const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
       if (run_end > v) {
         switch (offsets[v + 1] - offsets[v]) {
-          case 1: write_run<1>(model, attachment, scratch, prediction, v, run_end); break;
-          case 2: write_run<2>(model, attachment, scratch, prediction, v, run_end); break;
-          case 3: write_run<3>(model, attachment, scratch, prediction, v, run_end); break;
-          default: write_run<kMaxRunClusters>(model, attachment, scratch, prediction, v, run_end); break;
+          case 1: write_run<1>(model, attachment, scratch, out, v, run_end); break;
+          case 2: write_run<2>(model, attachment, scratch, out, v, run_end); break;
+          case 3: write_run<3>(model, attachment, scratch, out, v, run_end); break;
+          default: write_run<kMaxRunClusters>(model, attachment, scratch, out, v, run_end); break;
         }
         v = run_end;
         continue;
@@ -350,9 +353,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
         add_deflected(&scratch.cluster_pose(0, member_cluster[slot]), arm_x[slot], arm_y[slot], arm_z[slot], ox, oy,
                       oz, back);
       }
-      const Real share = attachment.vertex_inv_count[v];
-      gx[v] = ox * share, gy[v] = oy * share, gz[v] = oz * share;
-      compliance[v] = std::max(back * share, Real(0));
+      store_goal(out, v, ox, oy, oz, back, attachment.vertex_inv_count[v]);
       ++v;
     }
   });
