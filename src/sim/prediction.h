@@ -77,6 +77,13 @@ inline CorrectedLane<Real> correct_lane(const VertexInputs<Real>& in, const Real
           now};
 }
 
+// A corrected lane => u and v of vertex k in memory.
+template <typename Real>
+inline void store_lane(Real* const offset[3], Real* const velocity[3], int k, const CorrectedLane<Real>& lane) {
+  offset[0][k] = lane.ux, offset[1][k] = lane.uy, offset[2][k] = lane.uz;
+  velocity[0][k] = lane.vx, velocity[1][k] = lane.vy, velocity[2][k] = lane.vz;
+}
+
 // Block of n lanes => true when some moving lane turned non-finite or ran away; the caller
 // finds which. Kept out of the kernels' loops: a reduction there stops GCC from vectorising
 // them. The order of the sum decides nothing.
@@ -136,11 +143,9 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     }
 #pragma omp simd
     for (int k = first; k < stop; ++k) {
-      const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = correct_lane(in, offset, velocity, k, inv_h);
-      if constexpr (kEnd) {
-        offset[0][k] = ux, offset[1][k] = uy, offset[2][k] = uz;
-        velocity[0][k] = vx, velocity[1][k] = vy, velocity[2][k] = vz;
-      }
+      const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
+      if constexpr (kEnd) store_lane(offset, velocity, k, lane);
+      const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = lane;
       if constexpr (kForce) {
         // The drag at the step's start, from the velocity there: half a step of damping and of
         // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
@@ -181,11 +186,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
   const bool flagged = block_flagged(block, n);
   if constexpr (!kEnd)
     if (flagged)
-      for (int k = 0; k < n; ++k) {
-        const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
-        offset[0][k] = lane.ux, offset[1][k] = lane.uy, offset[2][k] = lane.uz;
-        velocity[0][k] = lane.vx, velocity[1][k] = lane.vy, velocity[2][k] = lane.vz;
-      }
+      for (int k = 0; k < n; ++k) store_lane(offset, velocity, k, correct_lane(in, offset, velocity, k, inv_h));
   return flagged;
 }
 
