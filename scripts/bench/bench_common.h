@@ -7,14 +7,14 @@
 #include <functional>
 #include <string>
 
-#include "cli/progress.h"
+#include "common/seconds_since.h"
 #include "lsystem/lsystem.h"
 #include "scene/scene.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim::bench {
 
-using treeanim::seconds_since;  // cli/progress.h
+using treeanim::seconds_since;  // common/seconds_since.h
 
 // argv = NAME SCENE [options], `usage` its options => false (after a message) when the scene
 // is missing or an option is unknown. "--frames N" sets `frames`; `option(arg, i)` takes

@@ -23,8 +23,8 @@ struct RunRequest {
   Verbosity verbosity = Verbosity::kNormal;
 };
 
-// Bakes the scene: simulate and write every output, with checkpoints and resume
-// (docs/checkpoint.md). Returns 0, or 130/143 on a signal.
+// Bakes the scene (bake/): simulate and write every output, with checkpoints and resume
+// (docs/checkpoint.md); prints its progress and summary. Returns 0, or 130/143 on a signal.
 int run_command(const RunRequest& request);
 // Loads, derives and builds the model without simulating; prints counts.
 int validate_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides);
@@ -55,9 +55,5 @@ int farm_submit_command(const FarmRequest& request);
 // Checks every tree's bake is complete and writes OUT/forest.json; else names what is missing
 // (with the tasks and their logs) and returns 4.
 int farm_gather_command(const FarmRequest& request);
-
-// "START:END" => inclusive range within [first, last]; throws InputError naming --frames.
-std::pair<long long, long long> parse_frame_range(const std::string& text, long long first,
-                                                  long long last);
 
 }  // namespace treeanim

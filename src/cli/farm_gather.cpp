@@ -2,9 +2,9 @@
 #include <cstdio>
 #include <map>
 
+#include "bake/forest_manifest.h"
+#include "bake/forest_tasks.h"
 #include "cli/commands.h"
-#include "cli/forest_manifest.h"
-#include "cli/forest_tasks.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
 
@@ -14,7 +14,7 @@ int farm_gather_command(const FarmRequest& request) {
   const Scene scene = load_scene(request.scene, request.overrides);
   if (!scene.forest) throw InputError(request.scene.string() + ": no /forest: farm gather collects a forest's trees");
   const Forest& forest = *scene.forest;
-  const GatherReport report = gather_forest(scene, request.out_dir);
+  const GatherReport report = gather_forest(scene, request.out_dir, treeanim_generator());
   if (report.missing.empty()) {
     std::printf("forest: all %zu trees complete; manifest %s\n", forest.trees.size(),
                 forest_manifest_path(request.out_dir).string().c_str());

@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "bake/forest_tasks.h"
 #include "cli/commands.h"
-#include "cli/forest_tasks.h"
 #include "common/errors.h"
 #include "io/text_output.h"
 

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <system_error>
 
+#include "bake/forest_tasks.h"
 #include "cli/commands.h"
-#include "cli/forest_tasks.h"
 #include "cli/run_program.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
@@ -121,6 +121,23 @@ std::string trimmed(const std::string& text) {
   return last == std::string::npos ? "" : text.substr(0, last + 1);
 }
 
+// Both jobs are in: their ids, scripts, logs and manifest; with --wait, how the gather job ended
+// (its exit status is the command's).
+int report_submitted(const FarmJob& job, bool wait, const std::string& array_id, const std::string& gather_id,
+                     int gather_status, const fs::path& array, const fs::path& gather) {
+  std::printf("submitted job array %s (%zu tasks, logs %s) and gather job %s after it\n  scripts %s, %s\n",
+              array_id.c_str(), job.tasks, (job.logs / "task-<I>.log").c_str(), gather_id.c_str(),
+              array.c_str(), gather.c_str());
+  if (!wait) {
+    std::printf("  the manifest will be %s; the gather's report: %s\n", (job.out / "forest.json").c_str(),
+                (job.logs / "gather.log").c_str());
+    return 0;
+  }
+  std::printf("gather job %s ended with exit %d; its report: %s\n", gather_id.c_str(), gather_status,
+              (job.logs / "gather.log").c_str());
+  return gather_status;
+}
+
 int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
   const fs::path sbatch = find_on_path("sbatch");
   if (sbatch.empty())
@@ -173,17 +190,7 @@ int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
   fs::rename(array_temporary, array, error);
   if (!error) fs::rename(gather_temporary, gather, error);
   if (error) throw OutputError(array.string() + ": cannot rename the job script into place: " + error.message());
-  std::printf("submitted job array %s (%zu tasks, logs %s) and gather job %s after it\n  scripts %s, %s\n",
-              array_id.c_str(), job.tasks, (job.logs / "task-<I>.log").c_str(), gather_id.c_str(), array.c_str(),
-              gather.c_str());
-  if (!request.wait) {
-    std::printf("  the manifest will be %s; the gather's report: %s\n", (job.out / "forest.json").c_str(),
-                (job.logs / "gather.log").c_str());
-    return 0;
-  }
-  std::printf("gather job %s ended with exit %d; its report: %s\n", gather_id.c_str(), second.status,
-              (job.logs / "gather.log").c_str());
-  return second.status;
+  return report_submitted(job, request.wait, array_id, gather_id, second.status, array, gather);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #include <cstdio>
 #include <iostream>
 
+#include "bake/forest_tasks.h"
+#include "bake/prepare_tree.h"
 #include "cli/commands.h"
-#include "cli/forest_tasks.h"
-#include "cli/prepare_tree.h"
 
 namespace treeanim {
 

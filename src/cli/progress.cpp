@@ -64,8 +64,4 @@ void Progress::finish() {
   if (enabled_ && terminal_) std::fprintf(out_, "\n");
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 }  // namespace treeanim

@@ -6,9 +6,6 @@
 
 namespace treeanim {
 
-// Seconds elapsed since `start` on the steady clock.
-double seconds_since(std::chrono::steady_clock::time_point start);
-
 enum class Verbosity { kQuiet, kNormal, kVerbose };
 
 class Progress {

@@ -1,4 +1,4 @@
-#include "cli/signals.h"
+#include "bake/signals.h"
 
 #include <csignal>
 

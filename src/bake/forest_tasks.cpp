@@ -1,12 +1,10 @@
-#include "cli/forest_tasks.h"
+#include "bake/forest_tasks.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <numeric>
 #include <queue>
 
-#include "cli/prepare_tree.h"
-#include "common/errors.h"
+#include "bake/prepare_tree.h"
 #include "io/output_estimate.h"
 
 namespace treeanim {
@@ -57,26 +55,11 @@ std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost,
   return assigned;
 }
 
-Shard parse_shard(const std::string& text) {
-  const std::string expected = "--shard '" + text +
-                               "': expected I/N with 0 <= I < N, the 0-based task of N (I may be 'auto', "
-                               "which reads $SLURM_ARRAY_TASK_ID)";
-  const size_t slash = text.find('/');
-  if (slash == std::string::npos) throw InputError(expected);
-  std::string index = text.substr(0, slash);
-  if (index == "auto") {
-    const char* env = std::getenv("SLURM_ARRAY_TASK_ID");
-    if (!env) throw InputError("--shard '" + text + "': SLURM_ARRAY_TASK_ID is not set (not a Slurm array task): give I/N");
-    index = env;
-  }
-  const auto parse = [&](const std::string& digits) {
-    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
-      throw InputError(expected);
-    return static_cast<size_t>(std::stoul(digits));
-  };
-  Shard shard{parse(index), parse(text.substr(slash + 1))};
-  if (shard.count == 0 || shard.index >= shard.count) throw InputError(expected);
-  return shard;
+std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard) {
+  if (shard) return assign_tasks(estimate_forest(scene).tree_cost, shard->count)[shard->index];
+  std::vector<size_t> trees(scene.forest->trees.size());
+  std::iota(trees.begin(), trees.end(), size_t{0});
+  return trees;
 }
 
 }  // namespace treeanim

@@ -1,10 +1,8 @@
-#include "cli/forest_manifest.h"
+#include "bake/forest_manifest.h"
 
 #include "common/json_text.h"
 #include "common/read_text_file.h"
-#include "io/checkpoint.h"
 #include "io/text_output.h"
-#include "treeanim_version.h"
 
 namespace treeanim {
 
@@ -41,12 +39,9 @@ fs::path tree_part_path(const fs::path& out_dir, const std::string& id) {
 
 fs::path forest_manifest_path(const fs::path& out_dir) { return out_dir / "forest.json"; }
 
-std::string tree_bake_key(const Scene& tree_scene) {
-  return scene_hash(tree_scene.resolved.dump(2), std::string("treeanim ") + TREEANIM_VERSION);
-}
-
-void write_tree_part(const fs::path& out_dir, const Scene& forest_scene, size_t index, const Scene& tree_scene,
+void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t index, const Scene& tree_scene,
                      const TreeBakeResult& result) {
+  const fs::path& out_dir = config.out_dir;
   const ForestTree& tree = forest_scene.forest->trees[index];
   Json outputs = Json::array();
   for (size_t k = 0; k < tree_scene.outputs.size(); ++k) {
@@ -63,11 +58,11 @@ void write_tree_part(const fs::path& out_dir, const Scene& forest_scene, size_t 
       {"scale", tree.scale},
       {"matrix", placement_matrix(make_tree_placement(tree.position, tree.rotation))},
       {"bounds", {{"min", vector_json(result.bounds.min())}, {"max", vector_json(result.bounds.max())}}},
-      {"frame_start", result.frame_start},
-      {"frame_count", result.frame_count},
+      {"frame_start", result.written.first},
+      {"frame_count", result.written.count()},
       {"vertices", result.vertices},
       {"outputs", std::move(outputs)},
-      {"bake", tree_bake_key(tree_scene)}};
+      {"bake", bake_key(tree_scene, config.generator)}};
   write_text_output(tree_part_path(out_dir, tree.id), part.dump(2) + "\n");
 }
 
@@ -102,13 +97,13 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
   return part;
 }
 
-GatherReport gather_forest(const Scene& scene, const fs::path& out_dir) {
+GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator) {
   GatherReport report;
   Json trees = Json::array();
   for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
     std::string why;
     const Scene one = tree_scene(scene, t);
-    auto part = complete_tree_part(out_dir, scene.forest->trees[t].id, tree_bake_key(one), why);
+    auto part = complete_tree_part(out_dir, scene.forest->trees[t].id, bake_key(one, generator), why);
     if (!part) {
       report.missing.push_back(t);
       report.reasons.push_back(why);
@@ -119,7 +114,7 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir) {
   if (!report.missing.empty()) return report;
   const Json manifest = {{"format", "treeanim-forest"},
                          {"format_version", 1},
-                         {"generator", std::string("treeanim ") + TREEANIM_VERSION},
+                         {"generator", generator},
                          {"units", "m"},
                          {"up_axis", "Y"},
                          {"fps", scene.time.fps},

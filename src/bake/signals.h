@@ -1,6 +1,7 @@
 #pragma once
-// SIGINT / SIGTERM during a bake: the handler only records the signal; the run loop polls it
-// between frames, aborts the outputs (removing temporaries) and exits 130 / 143.
+// SIGINT / SIGTERM during a bake: the handler only records the signal; the frame loop
+// (run_frames) polls it between frames, aborts the outputs (removing temporaries) and the
+// command exits 130 / 143.
 
 namespace treeanim {
 

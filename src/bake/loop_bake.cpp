@@ -1,4 +1,4 @@
-#include "cli/loop_bake.h"
+#include "bake/loop_bake.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,8 +46,7 @@ LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, 
     if (log)
       std::fprintf(log, "treeanim: loop warm-up period %d: the state changed by %.3g of the median frame step\n",
                    warmup.periods, warmup.change);
-    // A tenth of a frame's motion: the seam is then a frame step within 10 %.
-    if (warmup.change <= 0.1) {
+    if (warmup.change <= kLoopRepeatChange) {
       warmup.converged = true;
       break;
     }

@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "cli/bake_tree.h"
+#include "bake/bake_config.h"
+#include "bake/bake_tree.h"
 #include "scene/scene.h"
 
 namespace treeanim {
@@ -18,13 +19,10 @@ std::filesystem::path tree_part_path(const std::filesystem::path& out_dir, const
 // out_dir => the forest manifest.
 std::filesystem::path forest_manifest_path(const std::filesystem::path& out_dir);
 
-// A tree's one-tree scene => the key of its bake: the checkpoint's scene hash (resolved scene
-// and treeanim version). A part of another key belongs to an older bake.
-std::string tree_bake_key(const Scene& tree_scene);
-
-// Writes tree `index`'s part (atomically) after its outputs are all in place.
-void write_tree_part(const std::filesystem::path& out_dir, const Scene& forest_scene, size_t index,
-                     const Scene& tree_scene, const TreeBakeResult& result);
+// Writes tree `index`'s part in config.out_dir (atomically) after its outputs are all in place;
+// it carries the tree's bake_key(), and a part of another key belongs to an older bake.
+void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t index, const Scene& tree_scene,
+                     const TreeBakeResult& result);
 
 // The tree's part when its bake is complete: the part is there, of this key, and every file it
 // lists exists; else nullopt, with the reason in `why`.
@@ -36,8 +34,9 @@ struct GatherReport {
   std::vector<std::string> reasons;  // (missing) why
 };
 
-// Every tree complete => writes OUT/forest.json and returns no missing trees; else writes
-// nothing and returns them. Throws OutputError when the manifest cannot be written.
-GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir);
+// Every tree complete (its part of this generator's key) => writes OUT/forest.json and returns
+// no missing trees; else writes nothing and returns them. Throws OutputError when the manifest
+// cannot be written.
+GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir, const std::string& generator);
 
 }  // namespace treeanim

@@ -1,9 +1,9 @@
-#include "cli/prepare_tree.h"
+#include "bake/prepare_tree.h"
 
 #include <chrono>
 #include <limits>
 
-#include "cli/progress.h"
+#include "common/seconds_since.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {

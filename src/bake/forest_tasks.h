@@ -2,9 +2,10 @@
 // A forest split into farm tasks (docs/farm.md "Shards"): each tree's cost estimated, the trees
 // dealt to tasks so that every task costs about the same, and which task a process runs.
 #include <cstdint>
-#include <string>
+#include <optional>
 #include <vector>
 
+#include "bake/bake_config.h"
 #include "scene/scene.h"
 
 namespace treeanim {
@@ -28,12 +29,7 @@ ForestEstimate estimate_forest(const Scene& scene);
 // least cost so far (ties: the lower index); deterministic, so every shard of a farm job agrees.
 std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost, size_t tasks);
 
-struct Shard {
-  size_t index = 0;  // 0-based task
-  size_t count = 1;  // tasks
-};
-
-// "I/N" (or "auto/N": I from $SLURM_ARRAY_TASK_ID) => shard; InputError unless 0 <= I < N.
-Shard parse_shard(const std::string& text);
+// A forest, a shard (none: every tree) => the trees that this process bakes, ascending.
+std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard);
 
 }  // namespace treeanim

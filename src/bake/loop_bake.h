@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <vector>
 
-#include "io/outputs.h"
 #include "sim/simulator.h"
 
 namespace treeanim {
@@ -14,15 +13,19 @@ namespace treeanim {
 // a few; a tree that never repeats is baked anyway and its seam reported).
 constexpr int kMaxLoopWarmupPeriods = 32;
 
+// A loop repeats when a period changes the state by at most this fraction of the median frame
+// step (RMS over vertices): the seam is then a frame step within 10 %.
+constexpr double kLoopRepeatChange = 0.1;
+
 struct LoopWarmup {
   int periods = 0;        // whole periods run before the baked one
   double change = 0;      // RMS change of the state over the last period, / the median frame step
-  bool converged = false; // change below kLoopRepeats
+  bool converged = false; // change at most kLoopRepeatChange
 };
 
-// Runs `frames`-frame periods from `state` (at the loop's first frame `first`) until the state
-// after a period differs from the one before it by less than a tenth of the median frame-to-
-// frame motion (RMS over vertices), at most kMaxLoopWarmupPeriods. Notes each period on `log`.
+// Runs `frames`-frame periods from `state` (at the loop's first frame `first`) until a period
+// changes the state by at most kLoopRepeatChange, at most kMaxLoopWarmupPeriods. Notes each
+// period on `log`.
 LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log);
 
 // The seam of a baked loop: the step from its last frame back to its first, against the median

@@ -4,8 +4,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include "cli/forest_tasks.h"
-#include "common/errors.h"
+#include "bake/forest_tasks.h"
 
 namespace treeanim {
 namespace {
@@ -44,15 +43,28 @@ TEST(ForestTasks, MoreTasksThanTrees) {
   EXPECT_TRUE(tasks[3].empty());
 }
 
-TEST(ForestTasks, ParseShard) {
-  EXPECT_EQ(parse_shard("3/8").index, 3u);
-  EXPECT_EQ(parse_shard("3/8").count, 8u);
-  for (const char* bad : {"8/8", "1", "-1/4", "a/4", "0/0", "1/", "/4"})
-    EXPECT_THROW(parse_shard(bad), InputError) << bad;
-  setenv("SLURM_ARRAY_TASK_ID", "2", 1);
-  EXPECT_EQ(parse_shard("auto/4").index, 2u);
-  unsetenv("SLURM_ARRAY_TASK_ID");
-  EXPECT_THROW(parse_shard("auto/4"), InputError);
+// Five trees of two variants whose costs differ by their vertex counts.
+Scene forest_scene() {
+  return load_scene_text(R"({"lsystem": {"axiom": "FFFF", "iterations": 0}, "forest": {
+      "variants": [{"name": "tall"}, {"name": "short", "lsystem": {"axiom": "F", "iterations": 0}}],
+      "trees": [{"id": "a", "variant": "tall", "position": [0, 0, 0]},
+                {"id": "b", "variant": "short", "position": [3, 0, 0]},
+                {"id": "c", "variant": "short", "position": [6, 0, 0]},
+                {"id": "d", "variant": "tall", "position": [9, 0, 0]},
+                {"id": "e", "variant": "short", "position": [12, 0, 0]}]},
+    "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]})",
+                         "forest.json", "/scenes", {});
+}
+
+TEST(ForestTasks, ShardTreesSplitTheForest) {
+  const Scene scene = forest_scene();
+  EXPECT_EQ(shard_trees(scene, std::nullopt), (std::vector<size_t>{0, 1, 2, 3, 4}));
+  const ForestEstimate estimate = estimate_forest(scene);
+  EXPECT_GT(estimate.tree_cost[0], estimate.tree_cost[1]);
+  EXPECT_EQ(estimate.tree_cost[0], estimate.tree_cost[3]);
+  // Longest first (a, d), then each short tree to the task with less so far, ties to task 0.
+  EXPECT_EQ(shard_trees(scene, Shard{0, 2}), (std::vector<size_t>{0, 1, 4}));
+  EXPECT_EQ(shard_trees(scene, Shard{1, 2}), (std::vector<size_t>{2, 3}));
 }
 
 }  // namespace

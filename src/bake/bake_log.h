@@ -1,0 +1,27 @@
+#pragma once
+// What a bake tells as it goes. The command line prints; a bake only calls these, and each says
+// nothing unless it is set.
+#include <cstddef>
+#include <cstdio>
+#include <functional>
+
+namespace treeanim {
+
+struct PreparedTree;
+struct TreeBakeResult;
+
+struct BakeLog {
+  std::FILE* notes = nullptr;  // resumes, removed checkpoints, warm-up periods; null: quiet
+  std::function<void(const PreparedTree&)> prepared = [](const PreparedTree&) {};  // grown and built
+  std::function<void(long long total)> frames_begin = [](long long) {};  // the frame loop will simulate `total`
+  std::function<void(long long done)> frame_done = [](long long) {};     // `done` frames of the loop are complete
+  std::function<void()> frames_end = [] {};                              // the loop ended or was interrupted
+  std::function<void(int signal, long long frame)> interrupted = [](int, long long) {};  // outputs already removed
+  std::function<void(const TreeBakeResult&)> baked = [](const TreeBakeResult&) {};      // a tree's outputs are final
+  // A forest: tree `tree`, the `i`th (from 0) of the `count` this process bakes, is next;
+  // `complete`: its part says it is baked already, and it is skipped.
+  std::function<void(size_t i, size_t count, size_t tree, bool complete)> forest_tree =
+      [](size_t, size_t, size_t, bool) {};
+};
+
+}  // namespace treeanim

@@ -1,0 +1,36 @@
+#include "bake/bake_plan.h"
+
+namespace treeanim {
+
+BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
+  BakePlan plan;
+  plan.first = scene.time.start;
+  plan.last = scene.time.start + scene.time.frames - 1;
+  plan.written = config.frames.value_or(FrameRange{plan.first, plan.last});
+  plan.frame_dt = 1.0 / scene.time.fps;
+  plan.loop = scene.time.loop;
+  // Only a bake of the whole loop closes it; --frames writes a part of it.
+  plan.closes_loop = scene.time.loop && plan.written.first == plan.first && plan.written.last == plan.last;
+  plan.use_checkpoints = config.checkpoints.resume || config.frames.has_value();
+  plan.checkpoints = config.checkpoints;
+  plan.key = {bake_key(scene, config.generator), config.generator, scene.hsm.precision == Precision::kFloat};
+  return plan;
+}
+
+double frame_time(const BakePlan& plan, long long frame) { return static_cast<double>(frame) * plan.frame_dt; }
+
+BakeInfo bake_info(const Scene& scene, const BakePlan& plan) {
+  BakeInfo info;
+  info.scene_json = scene.resolved.dump(2);
+  info.generator = plan.key.generator;
+  info.fps = scene.time.fps;
+  info.frame_start = plan.written.first;
+  info.frame_count = plan.written.count();
+  info.substeps = scene.time.substeps;
+  info.seed = scene.seed;
+  info.loop = plan.closes_loop;
+  info.loop_end_time = double(plan.last + 1) / scene.time.fps;
+  return info;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,36 @@
+#pragma once
+// The plan of one tree's bake: which frames it simulates and writes, and where its
+// checkpoints live (docs/checkpoint.md).
+#include <filesystem>
+
+#include "bake/bake_config.h"
+#include "io/checkpoint.h"
+#include "io/outputs.h"
+#include "scene/scene.h"
+
+namespace treeanim {
+
+struct BakePlan {
+  long long first = 0;         // time.start: the frame of the initial state
+  long long last = 0;          // the scene's last frame
+  FrameRange written;          // the frames written (--frames, else first to last)
+  double frame_dt = 0;         // s
+  bool loop = false;           // time.loop: the wind is periodic and whole periods run first
+  bool closes_loop = false;    // a loop baked whole: the last frame flows into the first
+  bool use_checkpoints = false;  // --resume or --frames: look for a checkpoint at all
+  CheckpointPolicy checkpoints;
+  CheckpointKey key;
+};
+
+// scene, config => the plan. --frames only chooses what is written: the simulation starts at
+// time.start (or at a checkpoint of this bake), so frame k of a split bake is bit-identical to
+// frame k of the whole bake.
+BakePlan plan_bake(const Scene& scene, const BakeConfig& config);
+
+// The simulation time of `frame` (s).
+double frame_time(const BakePlan& plan, long long frame);
+
+// scene, plan => what the outputs record of the bake.
+BakeInfo bake_info(const Scene& scene, const BakePlan& plan);
+
+}  // namespace treeanim

@@ -1,0 +1,163 @@
+#include "bake/bake_tree.h"
+
+#include <omp.h>
+
+#include <chrono>
+#include <csignal>
+
+#include "bake/prepare_tree.h"
+#include "bake/signals.h"
+#include "common/errors.h"
+#include "common/seconds_since.h"
+#include "io/checkpoint.h"
+#include "sim/simulator.h"
+
+namespace treeanim {
+
+namespace {
+
+// Solver state (double) => the float frame the outputs write; a placed tree's in its own frame.
+FrameData output_frame(const SimState& state, long long frame, bool with_velocities, const TreePlacement* placement) {
+  FrameData data;
+  data.frame = frame;
+  data.time = state.time;
+  if (placement) {
+    const Eigen::Matrix3d back = placement->rotation.transpose();
+    const size_t V = size_t(state.positions.cols());
+    data.positions.resize(3 * V);
+    if (with_velocities) data.velocities.resize(3 * V);
+    for (size_t v = 0; v < V; ++v) {
+      const Eigen::Vector3d p = back * (state.positions.col(v) - placement->translation);
+      for (int k = 0; k < 3; ++k) data.positions[3 * v + k] = static_cast<float>(p[k]);
+      if (!with_velocities) continue;
+      const Eigen::Vector3d u = back * state.velocities.col(v);
+      for (int k = 0; k < 3; ++k) data.velocities[3 * v + k] = static_cast<float>(u[k]);
+    }
+  } else {
+    data.positions.assign(state.positions.data(), state.positions.data() + state.positions.size());
+    if (with_velocities)
+      data.velocities.assign(state.velocities.data(), state.velocities.data() + state.velocities.size());
+  }
+  data.leaf_attached = state.leaf_attached;
+  return data;
+}
+
+// The frame `start.state` holds, converted, journalled when the bake writes checkpoints, pushed.
+void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
+                 const TreePlacement* placement) {
+  FrameData data = output_frame(start.state, frame, frames.outputs.wants_velocities(), placement);
+  if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
+  if (plan.checkpoints.every > 0) start.journal->append(data);
+  frames.push(std::move(data));
+}
+
+// A box in the tree's own frame => the world box holding it.
+Eigen::AlignedBox3d world_bounds(const Eigen::AlignedBox3d& own, const TreePlacement* placement) {
+  Eigen::AlignedBox3d world;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = own.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    world.extend(placement ? Eigen::Vector3d(placement->rotation * p + placement->translation) : p);
+  }
+  return world;
+}
+
+}  // namespace
+
+BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model)
+    : info(bake_info(scene, plan)),
+      output_count(scene.outputs.size()),
+      outputs(scene.outputs, config.out_dir, model, info) {}
+
+void BakeFrames::push(FrameData data) {
+  if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
+  for (size_t i = 0; i + 2 < data.positions.size(); i += 3)
+    bounds.extend(Eigen::Vector3d(data.positions[i], data.positions[i + 1], data.positions[i + 2]));
+  outputs.push(std::move(data));
+}
+
+JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities) {
+  return {plan.key.scene_hash, plan.written.first, model.vertex_count(), model.leaf_count(), velocities};
+}
+
+LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes) {
+  if (!plan.loop || !start.checkpoint.empty()) return {};
+  return warm_up_loop(simulator, start.state, plan.first, plan.last - plan.first + 1, notes);
+}
+
+void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart& start, BakeFrames& frames,
+                    std::FILE* notes) {
+  open_bake_journal(plan, layout, start, notes);
+  frames.outputs.begin();
+  for (long long k = plan.written.first; k < start.frame && k <= plan.written.last; ++k)
+    frames.push(start.journal->read(k - plan.written.first));
+}
+
+int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
+               const TreePlacement* placement, const BakeLog& log) {
+  log.frames_begin(plan.written.last - start.frame + 1);
+  for (long long frame = start.frame; frame <= plan.written.last; ++frame) {
+    if (frame > start.frame) simulator.advance_frame(start.state, frame);
+    if (const int signal_number = pending_signal()) {
+      frames.outputs.abort();
+      log.frames_end();
+      log.interrupted(signal_number, frame);
+      return signal_number == SIGINT ? kExitSigint : kExitSigterm;
+    }
+    if (frame >= plan.written.first) write_frame(plan, start, frames, frame, placement);
+    // The journal reaches the disk before the checkpoint that names its frames as written.
+    if (plan.checkpoints.every > 0 && frame > start.frame && (frame - plan.first) % plan.checkpoints.every == 0) {
+      start.journal->sync();
+      write_checkpoint(checkpoint_path(plan.checkpoints.dir, frame), start.state, frame, plan.key);
+    }
+    log.frame_done(frame - start.frame + 1);
+  }
+  return 0;
+}
+
+TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,
+                           BakeFrames& frames, const TreePlacement* placement, const BakeLog& log) {
+  frames.outputs.finish();
+  log.frames_end();
+  TreeBakeResult result;
+  result.written = plan.written;
+  result.substeps = (plan.written.last - start.frame) * frames.info.substeps;
+  result.final_paths = frames.outputs.final_paths();
+  result.reports = frames.outputs.reports();
+  for (size_t k = 0; k < frames.output_count; ++k) result.files.push_back(frames.outputs.files(k));
+  if (plan.closes_loop)
+    result.loop = LoopSummary{warmup, !start.checkpoint.empty(), frames.seam.seam(), frames.seam.median_step()};
+  result.bounds = world_bounds(frames.bounds, placement);
+  return result;
+}
+
+TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const TreePlacement* placement,
+                         const BakeLog& log) {
+  const auto began = std::chrono::steady_clock::now();
+  if (config.threads > 0) omp_set_num_threads(config.threads);
+  const BakePlan plan = plan_bake(scene, config);
+  const PreparedTree tree = prepare_tree(scene);
+  log.prepared(tree);
+  BakeFrames frames(scene, config, plan, tree.model);
+  // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
+  const std::optional<TreeModel> placed =
+      placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
+  Simulator simulator(placed ? *placed : tree.model, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
+  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
+
+  BakeStart start = start_bake(plan, layout, simulator, log.notes);
+  const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes);
+  replay_journal(plan, layout, start, frames, log.notes);
+  const auto run_began = std::chrono::steady_clock::now();
+  TreeBakeResult result;
+  result.exit_code = run_frames(plan, simulator, start, frames, placement, log);
+  if (result.exit_code != 0) return result;
+  result = finish_bake(plan, start, warmup, frames, placement, log);
+  result.vertices = tree.model.vertex_count();
+  result.clusters = tree.model.cluster_count();
+  result.seconds = seconds_since(began);
+  result.run_seconds = seconds_since(run_began);
+  log.baked(result);
+  return result;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,89 @@
+#pragma once
+// One tree's bake (docs/checkpoint.md) as named stages over a plan: plan (bake_plan.h), start
+// from a checkpoint or afresh (bake_start.h), warm up (loops), replay the journal, run the frame
+// loop, finish. `treeanim run` of a one-tree scene is one bake_tree; a forest bakes each tree.
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/bake_config.h"
+#include "bake/bake_log.h"
+#include "bake/bake_plan.h"
+#include "bake/bake_start.h"
+#include "bake/loop_bake.h"
+#include "io/outputs.h"
+#include "scene/scene.h"
+#include "tree/tree_placement.h"
+
+namespace treeanim {
+
+// Where the frames of a bake go: its outputs, and what the summary and the manifest measure.
+struct BakeFrames {
+  // Checks every output target (InputError, OutputError) before anything is simulated.
+  BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model);
+  // A frame measured (bounds, a whole loop's seam), then queued to the outputs.
+  void push(FrameData data);
+
+  const BakeInfo info;
+  const size_t output_count;
+  OutputSet outputs;
+  SeamMeter seam;              // a loop baked whole: every frame
+  Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame
+};
+
+// A loop baked whole: how it was brought to repeat and how well it closes.
+struct LoopSummary {
+  LoopWarmup warmup;
+  bool resumed = false;      // from a checkpoint: the warm-up ran in an earlier process
+  double seam = 0;           // m
+  double median_step = 0;    // m
+};
+
+// What a finished bake did and wrote: its summary and the forest manifest's part.
+struct TreeBakeResult {
+  int exit_code = 0;                                      // 0, or 130/143 when interrupted
+  FrameRange written;                                     // the frames written
+  size_t vertices = 0;
+  size_t clusters = 0;
+  long long substeps = 0;                                 // simulated by this process
+  double seconds = 0;                                     // s, the whole bake
+  double run_seconds = 0;                                 // s, the frame loop and the outputs' finish
+  std::vector<std::filesystem::path> final_paths;         // an output's file, or its sequence's first
+  std::vector<std::pair<std::filesystem::path, std::string>> reports;  // (path, what its output says)
+  std::vector<std::vector<std::filesystem::path>> files;  // (outputs) every file of each output
+  std::optional<LoopSummary> loop;                        // a loop baked whole
+  Eigen::AlignedBox3d bounds;                             // m, world box of every written frame's vertices
+};
+
+// The journal of `plan` for a model whose outputs want velocities or not.
+JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities);
+
+// Warm up: a loop that starts afresh (not from a checkpoint, which lies past the warm-up) runs
+// whole periods until the tree's motion repeats; else nothing.
+LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes);
+
+// Replay: this bake's journal opened when it writes checkpoints (open_bake_journal), the outputs
+// begun, and the frames written before start.frame, which no checkpoint holds, pushed from the journal.
+void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart& start, BakeFrames& frames,
+                    std::FILE* notes);
+
+// Run: frames start.frame to written.last simulated and pushed (a placed tree's in its own frame),
+// journalled and checkpointed when the plan says. Returns 0, or 130/143 after a signal, the
+// outputs then removed.
+int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
+               const TreePlacement* placement, const BakeLog& log);
+
+// Finish: the outputs' final names, and what the bake wrote (bounds in the world).
+TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,
+                           BakeFrames& frames, const TreePlacement* placement, const BakeLog& log);
+
+// Bakes `scene` as `config` says. With a placement the tree is simulated where it stands and its
+// outputs are written in its own frame. Throws InputError, SimulationError, OutputError; nothing
+// of a failed bake keeps a final name.
+TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const TreePlacement* placement,
+                         const BakeLog& log);
+
+}  // namespace treeanim

@@ -1,0 +1,83 @@
+#include "cli/bake_printer.h"
+
+#include <csignal>
+#include <cstdio>
+
+#include "bake/bake_tree.h"
+#include "bake/forest_manifest.h"
+#include "bake/prepare_tree.h"
+#include "sim/kernel_isa.h"
+
+namespace treeanim {
+
+BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std::filesystem::path& scene_file,
+                         Verbosity verbosity)
+    : scene_(scene), config_(config), scene_file_(scene_file), verbosity_(verbosity) {
+  const bool quiet = verbosity == Verbosity::kQuiet;
+  log_.notes = quiet ? nullptr : stderr;
+  if (verbosity == Verbosity::kVerbose)
+    log_.prepared = [](const PreparedTree& tree) {
+      std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters; solver loops: %s\n",
+                   tree.grow_seconds, tree.model_seconds, tree.model.vertex_count(), tree.model.cluster_count(),
+                   kernel_isa_name(kernel_isa()));
+    };
+  log_.frames_begin = [this](long long total) { progress_.emplace(total, verbosity_, stderr); };
+  log_.frame_done = [this](long long done) { progress_->update(done); };
+  log_.frames_end = [this] { progress_->finish(); };
+  log_.interrupted = [this](int signal_number, long long frame) {
+    std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept%s\n",
+                 signal_number == SIGINT ? "SIGINT" : "SIGTERM", frame,
+                 config_.checkpoints.every > 0 ? " (--resume continues from the last checkpoint)" : "");
+  };
+  if (quiet) return;
+  log_.baked = [this](const TreeBakeResult& result) { print_summary(result); };
+  log_.forest_tree = [this](size_t i, size_t count, size_t tree, bool complete) { print_tree(i, count, tree, complete); };
+}
+
+void BakePrinter::print_summary(const TreeBakeResult& result) const {
+  std::printf("baked %lld frames: %zu vertices, %zu clusters, %lld substeps in %.2f s (simulation + writing %.2f s)\n",
+              result.written.count(), result.vertices, result.clusters, result.substeps, result.seconds,
+              result.run_seconds);
+  for (const auto& path : result.final_paths) std::printf("  wrote %s\n", path.string().c_str());
+  for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
+  if (!result.loop) return;
+  const LoopSummary& loop = *result.loop;
+  std::printf("  loop: %d warm-up period%s%s; seam %.3g m, %.2f x the median frame step (%.3g m)\n",
+              loop.warmup.periods, loop.warmup.periods == 1 ? "" : "s",
+              loop.warmup.converged || loop.resumed ? "" : " (the motion did not repeat: baked as it stands)",
+              loop.seam, loop.median_step > 0 ? loop.seam / loop.median_step : 0.0, loop.median_step);
+}
+
+void BakePrinter::print_tree(size_t i, size_t count, size_t index, bool complete) const {
+  const Forest& forest = *scene_.forest;
+  const ForestTree& tree = forest.trees[index];
+  if (complete) {
+    std::printf("tree %zu/%zu %s: complete, skipped\n", i + 1, count, tree.id.c_str());
+    return;
+  }
+  std::printf("tree %zu/%zu %s (%s, seed %llu) at (%.2f, %.2f, %.2f)\n", i + 1, count, tree.id.c_str(),
+              forest.variants[tree.variant].name.c_str(), static_cast<unsigned long long>(tree.seed),
+              tree.position.x(), tree.position.y(), tree.position.z());
+  std::fflush(stdout);
+}
+
+void BakePrinter::shard_begins(const std::vector<size_t>& trees) const {
+  if (verbosity_ == Verbosity::kQuiet || !config_.shard) return;
+  std::printf("shard %zu/%zu: %zu of the forest's %zu trees\n", config_.shard->index, config_.shard->count,
+              trees.size(), scene_.forest->trees.size());
+}
+
+void BakePrinter::forest_baked(const ForestBakeResult& result) const {
+  if (verbosity_ == Verbosity::kQuiet) return;
+  const std::filesystem::path& out = config_.out_dir;
+  if (config_.shard)
+    std::printf("shard %zu/%zu: %zu trees baked, %zu complete before; once every shard is done: treeanim farm "
+                "gather %s%s%s\n",
+                config_.shard->index, config_.shard->count, result.baked, result.skipped, scene_file_.string().c_str(),
+                out.empty() ? "" : " -o ", out.string().c_str());
+  else
+    std::printf("forest: %zu trees (%zu baked, %zu complete before); manifest %s\n", scene_.forest->trees.size(),
+                result.baked, result.skipped, forest_manifest_path(out).string().c_str());
+}
+
+}  // namespace treeanim

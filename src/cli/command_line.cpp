@@ -1,0 +1,203 @@
+// The treeanim command line (CLI11): the subcommands' arguments, the dispatch to
+// cli/commands.h, and the error types of common/errors.h mapped to the exit codes of DESIGN.md.
+#include "cli/command_line.h"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.h"
+#include "common/errors.h"
+#include "treeanim_version.h"
+
+namespace treeanim {
+
+namespace {
+
+// What the subcommands parse into.
+struct Arguments {
+  RunRequest run;
+  bool quiet = false, verbose = false;
+  std::filesystem::path validate_scene;
+  std::vector<std::string> validate_overrides;
+  std::filesystem::path info_scene;
+  std::vector<std::string> info_overrides;
+  bool info_json = false, info_resolved = false;
+  FarmRequest farm;
+};
+
+// The subcommands, to tell which one was given.
+struct Subcommands {
+  CLI::App* run = nullptr;
+  CLI::App* validate = nullptr;
+  CLI::App* info = nullptr;
+  CLI::App* plan = nullptr;    // farm plan
+  CLI::App* submit = nullptr;  // farm submit
+  CLI::App* gather = nullptr;  // farm gather
+};
+
+CLI::App* add_run(CLI::App& app, Arguments& args) {
+  CLI::App* run_app = app.add_subcommand("run", "Simulate a scene and write its outputs");
+  run_app->add_option("scene", args.run.scene, "Scene file (JSON)")->required();
+  run_app->add_option("-o,--out", args.run.out_dir,
+                      "Folder that relative output paths are resolved against (created if needed)");
+  run_app->add_option("--frames", args.run.frames,
+                      "Write only frames START:END (inclusive); the simulation still starts at "
+                      "time.start");
+  run_app->add_option("--threads", args.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
+      ->check(CLI::Range(1, 1024));
+  run_app->add_option("--set", args.run.overrides,
+                      "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
+                      "JSON or a plain string; repeatable");
+  run_app->add_option("--checkpoint-every", args.run.checkpoint_every,
+                      "Write the complete simulation state every N frames (docs/checkpoint.md)")
+      ->check(CLI::Range(1LL, 1'000'000'000LL));
+  run_app->add_option("--checkpoint-dir", args.run.checkpoint_dir,
+                      "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)");
+  run_app->add_flag("--resume", args.run.resume,
+                    "Continue from the newest usable checkpoint and complete every output; without "
+                    "one, bake from the start");
+  run_app->add_option("--shard", args.run.shard,
+                      "Bake only task I of N of a forest's trees (0-based, balanced by estimated cost; I may be "
+                      "'auto' for $SLURM_ARRAY_TASK_ID); docs/farm.md");
+  CLI::Option* quiet_flag = run_app->add_flag("-q,--quiet", args.quiet, "No progress or summary");
+  run_app->add_flag("-v,--verbose", args.verbose, "Stage timings and details")->excludes(quiet_flag);
+  run_app->footer(
+      "Examples:\n"
+      "  treeanim run configs/demo.json\n"
+      "  treeanim run configs/demo.json -o out/ --frames 0:47 --threads 2\n"
+      "  treeanim run configs/demo.json -o out/ --checkpoint-every 24 --resume\n"
+      "  treeanim run configs/forest-demo.json -o out/ --shard 2/4 --checkpoint-every 8 --resume\n"
+      "  treeanim run scene.json --set lsystem.iterations=6 --set time.substeps=8 --quiet");
+  return run_app;
+}
+
+CLI::App* add_validate(CLI::App& app, Arguments& args) {
+  CLI::App* validate_app =
+      app.add_subcommand("validate", "Load the scene, derive the tree and build the model; no simulation");
+  validate_app->add_option("scene", args.validate_scene, "Scene file (JSON)")->required();
+  validate_app->add_option("--set", args.validate_overrides, "Override a scene value: PATH=VALUE");
+  validate_app->footer(
+      "Examples:\n"
+      "  treeanim validate configs/demo.json\n"
+      "  treeanim validate scene.json --set lsystem.iterations=8");
+  return validate_app;
+}
+
+CLI::App* add_info(CLI::App& app, Arguments& args) {
+  CLI::App* info_app = app.add_subcommand("info", "Print counts (modules, segments, vertices, clusters) and estimates");
+  info_app->add_option("scene", args.info_scene, "Scene file (JSON)")->required();
+  info_app->add_option("--set", args.info_overrides, "Override a scene value: PATH=VALUE");
+  CLI::Option* json_flag = info_app->add_flag("--json", args.info_json, "Print one JSON object");
+  info_app->add_flag("--resolved-scene", args.info_resolved,
+                     "Print the scene with every default filled in (what outputs record)")
+      ->excludes(json_flag);
+  info_app->footer(
+      "Examples:\n"
+      "  treeanim info configs/table1-13548.json\n"
+      "  treeanim info configs/demo.json --json | jq .mesh.vertices\n"
+      "  treeanim info configs/demo.json --resolved-scene --set time.fps=30");
+  return info_app;
+}
+
+void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
+  submit->add_option("--engine", farm.engine, "slurm: write sbatch scripts and submit them; script: a plain shell script for any queue")
+      ->required()->check(CLI::IsMember({"slurm", "script"}));
+  submit->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(CLI::Range(1, 1'000'000));
+  submit->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)");
+  submit->add_flag("--wait", farm.wait, "Wait for the gather job and exit with its status (slurm)");
+  submit->add_option("--checkpoint-every", farm.checkpoint_every, "Frames between checkpoints (default: frames / 8)")
+      ->check(CLI::Range(1LL, 1'000'000'000LL));
+  submit->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(CLI::Range(1, 1024));
+  submit->add_option("--sbatch-arg", farm.sbatch_args, "An extra #SBATCH option, e.g. --partition=bake; repeatable");
+  submit->footer(
+      "Examples:\n"
+      "  treeanim farm submit configs/forest-demo.json --engine slurm --tasks 4 -o /shared/out --wait\n"
+      "  treeanim farm submit configs/forest-demo.json --engine script --tasks 4 -o out/");
+}
+
+void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
+  CLI::App* farm_app = app.add_subcommand("farm", "Bake a forest on a render farm: plan, submit, gather (docs/farm.md)");
+  farm_app->require_subcommand(1);
+  commands.plan = farm_app->add_subcommand("plan", "Split a forest into tasks balanced by estimated cost; print them");
+  commands.submit = farm_app->add_subcommand("submit", "Write the farm job scripts (a task per shard, then a gather) and submit them");
+  commands.gather = farm_app->add_subcommand("gather", "Check every tree of a forest is baked and write OUT/forest.json");
+  for (CLI::App* sub : {commands.plan, commands.submit, commands.gather}) {
+    sub->add_option("scene", farm.scene, "Scene file (JSON) with a /forest")->required();
+    sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE");
+  }
+  commands.plan->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(CLI::Range(1, 1'000'000));
+  commands.plan->add_option("--json", farm.json, "Also write the plan as JSON to this file");
+  commands.plan->footer("Example:\n  treeanim farm plan configs/forest-demo.json --tasks 4 --json plan.json");
+  add_farm_submit(commands.submit, farm);
+  commands.gather->add_option("-o,--out", farm.out_dir, "Output folder of the tasks (default: the working folder)");
+  commands.gather->add_option("--tasks", farm.tasks, "Tasks the forest was split into: name the task of each missing tree")
+      ->check(CLI::Range(1, 1'000'000));
+  commands.gather->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks");
+}
+
+int dispatch(const Subcommands& commands, Arguments& args) {
+  if (*commands.run) {
+    args.run.verbosity = args.quiet ? Verbosity::kQuiet : args.verbose ? Verbosity::kVerbose : Verbosity::kNormal;
+    return run_command(args.run);
+  }
+  if (*commands.validate) return validate_command(args.validate_scene, args.validate_overrides);
+  if (*commands.plan) return farm_plan_command(args.farm);
+  if (*commands.submit) return farm_submit_command(args.farm);
+  if (*commands.gather) return farm_gather_command(args.farm);
+  return info_command(args.info_scene, args.info_overrides,
+                      args.info_resolved ? InfoFormat::kResolvedScene
+                      : args.info_json   ? InfoFormat::kJson
+                                         : InfoFormat::kText);
+}
+
+int report(const char* kind, const std::exception& error, int code) {
+  std::fprintf(stderr, "treeanim: %s%s\n", kind, error.what());
+  return code;
+}
+
+// Runs the subcommand; a failure's exception => its message and exit code.
+int run_reporting_errors(const Subcommands& commands, Arguments& args) {
+  try {
+    return dispatch(commands, args);
+  } catch (const InputError& error) {
+    return report("error: ", error, kExitInput);
+  } catch (const SimulationError& error) {
+    return report("simulation failed: ", error, kExitSimulation);
+  } catch (const OutputError& error) {
+    return report("output failed: ", error, kExitOutput);
+  } catch (const std::bad_alloc& error) {
+    return report("out of memory: ", error, kExitSimulation);
+  } catch (const std::exception& error) {
+    // Not a documented failure: a bug. Report it rather than abort with a core dump.
+    return report("internal error: ", error, kExitSimulation);
+  }
+}
+
+}  // namespace
+
+int run_command_line(int argc, char** argv) {
+  CLI::App app{"treeanim " TREEANIM_VERSION
+               " - grows trees from L-systems and bakes their motion in wind with hierarchical "
+               "shape matching"};
+  app.set_version_flag("--version", "treeanim " TREEANIM_VERSION);
+  app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success, 2 bad input, 3 simulation failed, 4 output failed, 130/143 "
+      "interrupted.\nRun 'treeanim SUBCOMMAND --help' for examples.");
+  Arguments args;
+  Subcommands commands;
+  commands.run = add_run(app, args);
+  commands.validate = add_validate(app, args);
+  commands.info = add_info(app, args);
+  add_farm(app, args.farm, commands);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  return run_reporting_errors(commands, args);
+}
+
+}  // namespace treeanim

@@ -1,0 +1,209 @@
+// The stages of one tree's bake (bake/bake_tree.h): plan, start, warm up, replay, run, finish.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "bake/bake_tree.h"
+#include "bake/prepare_tree.h"
+#include "io/checkpoint.h"
+#include "sim/simulator.h"
+#include "temp_folder_test.h"
+
+namespace treeanim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Three unit segments straight up, 5 frames from frame 10, one HDF5 output.
+const char* kLine = R"({
+  "lsystem": {"axiom": "FFF", "iterations": 0},
+  "time": {"fps": 24, "start": 10, "frames": 5, "substeps": 2},
+  "wind": {"keys": [{"time": 0, "speed": 4, "direction": [1, 0, 0]}]},
+  "outputs": [{"format": "hdf5", "path": "bake.h5"}]
+})";
+
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// What a stage wrote to its notes.
+class Notes {
+ public:
+  Notes() : file_(std::tmpfile()) {}
+  ~Notes() { std::fclose(file_); }
+  std::FILE* file() const { return file_; }
+  std::string text() const {
+    std::fflush(file_);
+    std::rewind(file_);
+    std::string text;
+    for (int c; (c = std::fgetc(file_)) != EOF;) text += char(c);
+    return text;
+  }
+
+ private:
+  std::FILE* file_;
+};
+
+class BakeStages : public TempFolderTest {
+ protected:
+  BakeStages() : TempFolderTest("treeanim-bake") {}
+
+  Scene scene(const std::vector<std::string>& overrides = {}) const {
+    return load_scene_text(kLine, "line.json", dir_, overrides);
+  }
+  BakeConfig config() const {
+    BakeConfig config;
+    config.out_dir = dir_ / "out";
+    config.checkpoints.dir = dir_ / "checkpoints";
+    return config;
+  }
+};
+
+TEST_F(BakeStages, PlanOfAFrameRange) {
+  const Scene line = scene({"time.loop=true"});
+  BakeConfig part = config();
+  part.frames = FrameRange{12, 13};
+  const BakePlan plan = plan_bake(line, part);
+  EXPECT_EQ(plan.first, 10);
+  EXPECT_EQ(plan.last, 14);
+  EXPECT_EQ(plan.written.first, 12);
+  EXPECT_EQ(plan.written.count(), 2);
+  EXPECT_TRUE(plan.loop);
+  EXPECT_FALSE(plan.closes_loop);  // a part of a loop does not close it
+  EXPECT_TRUE(plan.use_checkpoints);  // --frames starts from a checkpoint at or before its first frame
+  EXPECT_EQ(plan.key.scene_hash, bake_key(line, treeanim_generator()));
+  EXPECT_EQ(plan.key.generator.rfind("treeanim ", 0), 0u);
+  EXPECT_EQ(frame_time(plan, 12), 12.0 * (1.0 / 24));
+  const BakeInfo info = bake_info(line, plan);
+  EXPECT_EQ(info.frame_start, 12);
+  EXPECT_EQ(info.frame_count, 2);
+  EXPECT_FALSE(info.loop);
+  EXPECT_EQ(info.loop_end_time, 15.0 / 24);
+
+  const BakePlan whole = plan_bake(line, config());
+  EXPECT_EQ(whole.written.first, 10);
+  EXPECT_EQ(whole.written.last, 14);
+  EXPECT_TRUE(whole.closes_loop);
+  EXPECT_FALSE(whole.use_checkpoints);
+}
+
+TEST_F(BakeStages, StartFreshThenFromACheckpoint) {
+  const Scene line = scene();
+  BakeConfig resume = config();
+  resume.checkpoints.resume = true;
+  const BakePlan plan = plan_bake(line, resume);
+  const PreparedTree tree = prepare_tree(line);
+  Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
+  const JournalLayout layout = journal_layout(plan, tree.model, false);
+  Notes notes;
+  BakeStart fresh = start_bake(plan, layout, simulator, notes.file());
+  EXPECT_EQ(fresh.frame, 10);
+  EXPECT_TRUE(fresh.checkpoint.empty());
+  EXPECT_EQ(fresh.state.time, frame_time(plan, 10));
+  EXPECT_EQ(notes.text(), "treeanim: no usable checkpoint in " + (dir_ / "checkpoints").string() +
+                              ": baking from frame 10\n");
+
+  // A checkpoint after the first written frame needs the journal of the frames before it: none here.
+  simulator.advance_frame(fresh.state, 11);
+  fs::create_directories(dir_ / "checkpoints");
+  const fs::path checkpoint = checkpoint_path(dir_ / "checkpoints", 11);
+  write_checkpoint(checkpoint, fresh.state, 11, plan.key);
+  Notes skipped;
+  EXPECT_EQ(start_bake(plan, layout, simulator, skipped.file()).frame, 10);
+  EXPECT_NE(skipped.text().find("treeanim: not resuming from " + checkpoint.string() + ": "), std::string::npos)
+      << skipped.text();
+
+  // --frames 11:14: the checkpoint at its first frame is where it starts, no journal needed.
+  BakeConfig part = config();
+  part.frames = FrameRange{11, 14};
+  const BakePlan part_plan = plan_bake(line, part);
+  Notes resumed;
+  const BakeStart start = start_bake(part_plan, journal_layout(part_plan, tree.model, false), simulator, resumed.file());
+  EXPECT_EQ(start.frame, 11);
+  EXPECT_EQ(start.checkpoint, checkpoint);
+  EXPECT_EQ(start.state.positions, fresh.state.positions);
+  EXPECT_EQ(resumed.text(), "treeanim: resuming at frame 11 from " + checkpoint.string() + "\n");
+}
+
+TEST_F(BakeStages, RunAFewFramesAndFinish) {
+  const Scene line = scene();
+  const BakeConfig whole = config();
+  const BakePlan plan = plan_bake(line, whole);
+  const PreparedTree tree = prepare_tree(line);
+  BakeFrames frames(line, whole, plan, tree.model);
+  Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
+  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
+  BakeStart start = start_bake(plan, layout, simulator, nullptr);
+  EXPECT_EQ(warm_up(plan, simulator, start, nullptr).periods, 0);  // not a loop
+  replay_journal(plan, layout, start, frames, nullptr);
+  std::vector<long long> done;
+  BakeLog log;
+  log.frame_done = [&](long long frames_done) { done.push_back(frames_done); };
+  ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log), 0);
+  EXPECT_EQ(done, (std::vector<long long>{1, 2, 3, 4, 5}));
+  const TreeBakeResult result = finish_bake(plan, start, {}, frames, nullptr, log);
+  EXPECT_EQ(result.written.first, 10);
+  EXPECT_EQ(result.written.count(), 5);
+  EXPECT_EQ(result.substeps, 4 * 2);
+  ASSERT_EQ(result.files.size(), 1u);
+  EXPECT_EQ(result.files[0], std::vector<fs::path>{dir_ / "out" / "bake.h5"});
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / "bake.h5"));
+  EXPECT_FALSE(result.loop);
+  // The stem stands at the origin, three units tall.
+  EXPECT_NEAR(result.bounds.min().y(), 0.0, 1e-3);
+  EXPECT_GT(result.bounds.max().y(), 2.9);
+}
+
+TEST_F(BakeStages, FinishGivesTheBoundsInTheWorld) {
+  const Scene line = scene();
+  const TreeBakeResult own = bake_tree(line, config(), nullptr, BakeLog{});
+  const TreePlacement placement = make_tree_placement(Eigen::Vector3d(5, 0, -2), 0);
+  const TreeBakeResult placed = bake_tree(line, config(), &placement, BakeLog{});
+  EXPECT_NEAR(placed.bounds.min().x(), own.bounds.min().x() + 5, 1e-4);
+  EXPECT_NEAR(placed.bounds.max().z(), own.bounds.max().z() - 2, 1e-4);
+  EXPECT_NEAR(placed.bounds.max().y(), own.bounds.max().y(), 1e-4);
+}
+
+TEST_F(BakeStages, AResumedBakeWritesTheSameBytes) {
+  const Scene line = scene();
+  BakeConfig checkpointed = config();
+  checkpointed.checkpoints.every = 2;
+  std::vector<long long> totals;
+  BakeLog log;
+  log.frames_begin = [&](long long total) { totals.push_back(total); };
+  ASSERT_EQ(bake_tree(line, checkpointed, nullptr, log).exit_code, 0);
+  const std::string whole = slurp(dir_ / "out" / "bake.h5");
+  EXPECT_TRUE(fs::exists(checkpoint_path(dir_ / "checkpoints", 14)));
+  // From the newest checkpoint (frame 14): the journal gives the frames before it back.
+  checkpointed.checkpoints.resume = true;
+  Notes notes;
+  log.notes = notes.file();
+  const TreeBakeResult resumed = bake_tree(line, checkpointed, nullptr, log);
+  EXPECT_EQ(resumed.substeps, 0);
+  EXPECT_EQ(totals, (std::vector<long long>{5, 1}));
+  EXPECT_EQ(notes.text(), "treeanim: resuming at frame 14 from " +
+                              checkpoint_path(dir_ / "checkpoints", 14).string() + "\n");
+  EXPECT_EQ(slurp(dir_ / "out" / "bake.h5"), whole);
+}
+
+TEST_F(BakeStages, ALoopWarmsUpWholePeriods) {
+  const Scene line = scene({"time.loop=true"});
+  const BakePlan plan = plan_bake(line, config());
+  const PreparedTree tree = prepare_tree(line);
+  Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
+  BakeStart start = start_bake(plan, journal_layout(plan, tree.model, false), simulator, nullptr);
+  Notes notes;
+  const LoopWarmup warmup = warm_up(plan, simulator, start, notes.file());
+  EXPECT_GE(warmup.periods, 1);
+  EXPECT_LE(warmup.periods, kMaxLoopWarmupPeriods);
+  EXPECT_EQ(notes.text().rfind("treeanim: loop warm-up period 1: the state changed by ", 0), 0u) << notes.text();
+  EXPECT_EQ(warmup.converged, warmup.change <= kLoopRepeatChange);
+}
+
+}  // namespace
+}  // namespace treeanim
