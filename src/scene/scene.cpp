@@ -5,7 +5,10 @@
 #include "common/errors.h"
 #include "common/json_text.h"
 #include "common/read_text_file.h"
+#include "scene/lsystem_section.h"
+#include "scene/output_section.h"
 #include "scene/sim_sections.h"
+#include "scene/tree_section.h"
 #include "sim/wind_keys.h"
 
 namespace treeanim {
