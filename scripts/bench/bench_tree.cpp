@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "common/errors.h"
-#include "common/scene_reader.h"
 #include "lsystem/lsystem.h"
+#include "scene/lsystem_section.h"
+#include "scene/tree_section.h"
 #include "tree/build_tree_model.h"
 
 namespace {

@@ -2,6 +2,7 @@
 
 #include "common/json_text.h"
 #include "common/read_text_file.h"
+#include "io/output_formats.h"
 #include "io/text_output.h"
 
 namespace treeanim {
@@ -47,7 +48,7 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
   for (size_t k = 0; k < tree_scene.outputs.size(); ++k) {
     Json files = Json::array();
     for (const fs::path& file : result.files[k]) files.push_back(manifest_name(file, out_dir));
-    outputs.push_back({{"format", tree_scene.outputs[k].format}, {"files", std::move(files)}});
+    outputs.push_back({{"format", tree_scene.outputs[k].format->name}, {"files", std::move(files)}});
   }
   const Json part = {
       {"id", tree.id},

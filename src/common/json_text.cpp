@@ -142,4 +142,14 @@ Json parse_json_text(const std::string& text, const std::string& name, const std
   return document;
 }
 
+std::string escape_pointer_token(const std::string& token) {
+  std::string out;
+  for (char c : token) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
 }  // namespace treeanim

@@ -3,12 +3,14 @@
 // repeated keys. Every walk over a parsed document (copies, dump(), the unknown-key check) is
 // recursive, so a document nested tens of thousands deep would overflow the stack; the depth is
 // therefore checked on the text, by a scan that keeps its own stack, before anything parses it.
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "common/errors.h"
-#include "common/scene_reader.h"
 
 namespace treeanim {
+
+using Json = nlohmann::ordered_json;
 
 // Deepest nesting of arrays and objects in a scene, counted from its root. The deepest key a
 // scene reads is three levels down (/outputs/0/path); 256 leaves room for any free-form value.
@@ -30,5 +32,8 @@ Json parse_json_text(const std::string& text, const std::string& name, const std
 
 // Byte offset => "line:column" (1-based).
 std::string line_column(const std::string& text, size_t offset);
+
+// JSON-pointer escaping of one reference token ("~" => "~0", "/" => "~1").
+std::string escape_pointer_token(const std::string& token);
 
 }  // namespace treeanim

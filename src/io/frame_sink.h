@@ -65,22 +65,4 @@ struct SequencePattern {
 SequencePattern sequence_pattern(const std::filesystem::path& path, const std::string& extension,
                                  const std::string& pointer);
 
-// The sink for `options.format`; `path` is the output path resolved against the out folder.
-std::unique_ptr<FrameSink> make_hdf5_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                          const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_obj_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                         const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_gltf_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                          const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                         const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                         const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                                 const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                         const TreeModel& model, const BakeInfo& info);
-std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,
-                                         const TreeModel& model, const BakeInfo& info);
-
 }  // namespace treeanim

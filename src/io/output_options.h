@@ -1,14 +1,16 @@
 #pragma once
-// Scene /outputs elements (docs/scene.md). Owned by io/; fields are added as sinks need.
+// Scene /outputs elements (docs/scene.md), read by scene/ (src/scene/output_section.h); the keys
+// each format takes are its row of the format table (src/io/output_formats.h).
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
-#include "common/scene_reader.h"
-
 namespace treeanim {
 
+struct OutputFormatRow;
+
 struct OutputOptions {
-  std::string format;              // one of kOutputFormats
+  const OutputFormatRow* format = nullptr;  // its row of output_formats(), set by the reader
   std::filesystem::path path;      // as written in the scene; resolved by OutputSet
   int frame_step = 1;              // write every k-th frame
   int compression = 0;             // hdf5: 0 none, 1..9 shuffle + deflate level
@@ -20,12 +22,5 @@ struct OutputOptions {
   bool vat_half = false;           // vat: half-float textures (else float)
   std::string pointer;             // "/outputs/N", for messages about this element
 };
-
-// The formats /outputs/N/format accepts.
-inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd", "vat", "skinned_glb"};
-
-// One element of /outputs => options. Keys that do not apply to the format are left
-// undeclared, so the scene reader reports them as unknown.
-OutputOptions read_output_options(SceneObject element);
 
 }  // namespace treeanim

@@ -15,6 +15,7 @@
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/output_formats.h"
 #include "io/staged_files.h"
 #include "io/vertex_normals.h"
 
@@ -33,19 +34,6 @@ constexpr int kWriterNice = 5;
 // Frames a sink may lag behind the solver. Enough to absorb a slow frame (a compressed chunk,
 // a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
 constexpr size_t kQueueFrames = 8;
-
-std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,
-                                     const BakeInfo& info) {
-  if (options.format == "hdf5") return make_hdf5_sink(options, path, model, info);
-  if (options.format == "obj") return make_obj_sink(options, path, model, info);
-  if (options.format == "gltf") return make_gltf_sink(options, path, model, info);
-  if (options.format == "glb") return make_glb_sink(options, path, model, info);
-  if (options.format == "pc2") return make_pc2_sink(options, path, model, info);
-  if (options.format == "mdd") return make_mdd_sink(options, path, model, info);
-  if (options.format == "vat") return make_vat_sink(options, path, model, info);
-  if (options.format == "skinned_glb") return make_skinned_glb_sink(options, path, model, info);
-  throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
-}
 
 // One sink, its thread and its queue of frames still to write.
 struct Worker {
@@ -111,7 +99,7 @@ struct OutputSet::Impl {
   bool velocities = false;
   bool normals = false;
   std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
-  bool has_hdf5 = false;
+  bool leaf_flags = false;  // some output writes the leaves' attached flags
   bool done = false;  // finished or aborted
 
   explicit Impl(const TreeModel& m) : model(m) {}
@@ -164,17 +152,14 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
                      const BakeInfo& info)
     : impl_(std::make_unique<Impl>(model)) {
   for (const OutputOptions& options : outputs) {
-    if (options.frame_step < 1)
-      throw InputError(options.pointer + "/frame_step: expected an integer >= 1, got " +
-                       std::to_string(options.frame_step));
     auto worker = std::make_unique<Worker>();
-    worker->sink = make_sink(options, resolve(options.path, out_dir), model, info);
+    worker->sink = options.format->make(options, resolve(options.path, out_dir), model, info);
     worker->selection = {info.frame_start, info.frame_count, options.frame_step};
     const auto summary = worker->sink->summary_paths();
     worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();
     impl_->velocities = impl_->velocities || options.velocities;
     impl_->normals = impl_->normals || options.normals;
-    impl_->has_hdf5 = impl_->has_hdf5 || options.format == "hdf5";
+    impl_->leaf_flags = impl_->leaf_flags || options.format->leaf_flags;
     impl_->workers.push_back(std::move(worker));
   }
   check_targets(impl_->workers, outputs);
@@ -200,7 +185,7 @@ void OutputSet::begin() {
 void OutputSet::push(FrameData frame) {
   const size_t n = 3 * impl_->model.vertex_count();
   if (frame.positions.size() != n || (impl_->velocities && frame.velocities.size() != n) ||
-      (impl_->has_hdf5 && frame.leaf_attached.size() != impl_->model.leaf_count()))
+      (impl_->leaf_flags && frame.leaf_attached.size() != impl_->model.leaf_count()))
     throw std::logic_error("OutputSet::push: frame " + std::to_string(frame.frame) +
                            " does not match the model (positions " + std::to_string(frame.positions.size()) +
                            ", velocities " + std::to_string(frame.velocities.size()) + ", leaf flags " +

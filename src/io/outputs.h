@@ -42,8 +42,10 @@ struct FrameData {
 class OutputSet {
  public:
   // Resolves relative paths against out_dir (when not empty), checks every target (folder
-  // exists or can be made, writable, format limits such as 4 GiB GLB) before simulation.
-  // Throws InputError for bad options, OutputError naming the path for unwritable targets.
+  // exists or can be made, writable, format limits such as 4 GiB GLB) before simulation. The
+  // options are as the scene reader checked them. Throws InputError for a target no output may
+  // write (a directory, one written twice, a GLB past 4 GiB), OutputError naming the path for
+  // unwritable targets.
   OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
             const TreeModel& model, const BakeInfo& info);
   ~OutputSet();  // abort()s when finish() was not reached

@@ -1,13 +1,12 @@
 #pragma once
-// Scene section /lsystem (docs/scene.md). Owned by lsystem/; more fields may be added.
+// Scene section /lsystem (docs/scene.md), read by scene/ (src/scene/lsystem_section.h).
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include "common/scene_reader.h"
 
 namespace treeanim {
 
@@ -28,8 +27,5 @@ struct LsystemOptions {
   std::optional<int> surface_precision;          // quads per patch along s and t of every view-file surface (1 ... 10)
   std::string inline_name = "<scene>/lsystem";   // names inline rules in messages (+ "/axiom", "/productions/3")
 };
-
-// /lsystem section => options. scene_seed is the top-level /seed (the default for lsystem.seed).
-LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed);
 
 }  // namespace treeanim

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "common/scene_reader.h"
 #include "lsystem/lsystem_options.h"
+#include "scene/scene_reader.h"
 #include "tree/tree_options.h"
 
 namespace treeanim {

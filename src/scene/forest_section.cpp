@@ -8,6 +8,8 @@
 #include "common/errors.h"
 #include "scene/forest.h"
 #include "scene/forest_layout.h"
+#include "scene/lsystem_section.h"
+#include "scene/tree_section.h"
 
 namespace treeanim {
 

@@ -1,13 +1,15 @@
 #include "scene/scene.h"
 
-#include <cmath>
 #include <sstream>
 
 #include "common/errors.h"
 #include "common/json_text.h"
-#include "sim/wind.h"
 #include "common/read_text_file.h"
+#include "scene/lsystem_section.h"
+#include "scene/output_section.h"
 #include "scene/sim_sections.h"
+#include "scene/tree_section.h"
+#include "sim/wind_keys.h"
 
 namespace treeanim {
 
@@ -44,16 +46,13 @@ void prepare_loop(SceneObject time_section, Scene& scene) {
     time_section.fail("loop", "leaves that detach never come back, so the bake cannot repeat; set "
                               "/hsm/leaf_detach_force to 0 or leave the loop out");
   const double start = double(time.start) / time.fps, period = double(time.frames) / time.fps;
-  const WindField wind(scene.wind);
-  const Eigen::Vector3d first = wind.mean(start), last = wind.mean(start + period);
-  const double first_gust = wind.gust_amplitude(start), last_gust = wind.gust_amplitude(start + period);
-  const double tolerance = 1e-9 * std::max(1.0, first.norm() + first_gust);
-  if ((first - last).norm() > tolerance || std::fabs(first_gust - last_gust) > tolerance) {
+  const WindSeam seam = wind_loop_seam(scene.wind, start, period);
+  if (!seam.periodic) {
     std::ostringstream message;
     message << "the wind cannot be made periodic over the loop (" << period << " s): at its end (t = "
-            << start + period << " s) it is " << vector_text(last) << " m/s with gusts of " << last_gust
-            << " m/s, at its start (t = " << start << " s) " << vector_text(first) << " m/s with gusts of "
-            << first_gust << " m/s; give the wind " << (scene.wind.file ? "file" : "keys")
+            << start + period << " s) it is " << vector_text(seam.last) << " m/s with gusts of " << seam.last_gust
+            << " m/s, at its start (t = " << start << " s) " << vector_text(seam.first) << " m/s with gusts of "
+            << seam.first_gust << " m/s; give the wind " << (scene.wind.file ? "file" : "keys")
             << " the same value at both ends (a key at t = " << start + period << " equal to the wind at t = "
             << start << ")";
     time_section.fail("loop", message.str());

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "common/scene_reader.h"
 #include "io/output_options.h"
 #include "lsystem/lsystem_options.h"
 #include "scene/forest.h"
+#include "scene/scene_reader.h"
 #include "sim/sim_options.h"
 #include "tree/tree_options.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "common/scene_reader.h"
+#include "scene/scene_reader.h"
 #include "sim/sim_options.h"
 
 namespace treeanim {

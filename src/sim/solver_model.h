@@ -21,6 +21,10 @@ namespace treeanim {
 
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 
+// Memberships from which the solver's loops run on several threads: below, the fork/join
+// costs more than the work (results are identical either way).
+constexpr size_t kParallelMemberships = 4096;
+
 // Arrays of 3-vectors that the step reads or writes are (n x 3): a column per axis
 // (structure of arrays), so that the vertex pass and the goal writes run on SIMD packets.
 template <typename Real>
@@ -102,9 +106,7 @@ struct SolverModel {
   // of the step (second order); otherwise both move the predicted positions (the paper's Eq. 7, 8).
   bool kick;
   bool store_drag_force;                   // the prediction keeps each vertex's drag (detachment, beam)
-  // Threads only pay off above a few thousand memberships; below, the fork/join costs more
-  // than the work (results are identical either way).
-  bool parallel;
+  bool parallel;                           // at least kParallelMemberships: the loops run on several threads
 
   std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
   std::vector<double> cluster_alpha;       // (C) local rate per step

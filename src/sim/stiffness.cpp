@@ -126,11 +126,12 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
         capped += rates.cluster_alpha[c] == 1.0;
       }
       // The limb (global) frequency has its own, lower cap: measured against a 256-substep
-      // reference (scripts/bench-accuracy), limb modes above ~1.3 Hz are what the default
-      // 16 substeps resolve worst, while the local cap holds branch shapes in a gale. And a
-      // floor, the bottom of the sway band of trees (0.2 Hz): the beam model gives a limb
-      // of vanishing radius, or a zig-zag bush taken as a straight beam of its longest path,
-      // a frequency near 0, and nothing then holds it in a gale (docs/benchmarks.md, limit B).
+      // reference (scripts/bench-accuracy), limb modes above ~1.3 Hz are what a coarse step
+      // resolves worst (measured at 16 substeps; the default is 2), while the local cap holds
+      // branch shapes in a gale. And a floor, the bottom of the sway band of trees (0.2 Hz):
+      // the beam model gives a limb of vanishing radius, or a zig-zag bush taken as a straight
+      // beam of its longest path, a frequency near 0, and nothing then holds it in a gale
+      // (docs/benchmarks.md, limit B).
       const double w = std::min(std::max(rates.cluster_limb_frequency[c], options.min_limb_frequency),
                                 options.max_limb_frequency);
       cluster_global[c] = global_rate(std::sqrt(options.global_scale) * w, h);

@@ -21,16 +21,6 @@ Eigen::Vector3d random_unit(std::mt19937_64& rng) {
   return {s * std::cos(phi), s * std::sin(phi), z};
 }
 
-// Index k of the key interval [k, k+1) holding t, for 0 <= k < K-1; t must lie inside.
-size_t interval_of(const std::vector<double>& times, double t) {
-  size_t lo = 0, hi = times.size() - 1;
-  while (hi - lo > 1) {
-    const size_t mid = (lo + hi) / 2;
-    (times[mid] <= t ? lo : hi) = mid;
-  }
-  return lo;
-}
-
 // Wave vector k, drift per period D (non-zero) => k with its component along D rounded to a
 // whole number of cycles over D, so that sin(k . (x - D(t)) + ...) repeats with the loop.
 Eigen::Vector3d whole_cycles_along(const Eigen::Vector3d& k, const Eigen::Vector3d& drift) {
@@ -42,18 +32,16 @@ Eigen::Vector3d whole_cycles_along(const Eigen::Vector3d& k, const Eigen::Vector
 }  // namespace
 
 WindField::WindField(const WindOptions& options)
-    : intensity(options.turbulence_intensity), loop_period(options.loop_period), loop_start(options.loop_start) {
-  for (const WindKey& k : options.keys) {
-    key_time.push_back(k.time);
-    key_wind.push_back(k.speed * k.direction);
-    key_gust.push_back(k.gust);
-  }
+    : keys(wind_key_series(options.keys)),
+      intensity(options.turbulence_intensity),
+      loop_period(options.loop_period),
+      loop_start(options.loop_start) {
   // Exact integral of the piecewise-linear mean wind (trapezoids), for the advection of the
   // frozen patterns: a function of t alone, so the field does not depend on the step.
-  key_advection.assign(key_time.size(), Eigen::Vector3d::Zero());
-  for (size_t k = 1; k < key_time.size(); ++k)
+  key_advection.assign(keys.time.size(), Eigen::Vector3d::Zero());
+  for (size_t k = 1; k < keys.time.size(); ++k)
     key_advection[k] = key_advection[k - 1] +
-                       0.5 * (key_time[k] - key_time[k - 1]) * (key_wind[k - 1] + key_wind[k]);
+                       0.5 * (keys.time[k] - keys.time[k - 1]) * (keys.wind[k - 1] + keys.wind[k]);
 
   std::mt19937_64 rng(options.seed ^ 0x7475726275ull);  // "turbu": the turbulence stream
   const int n = options.turbulence_modes;
@@ -97,15 +85,15 @@ void WindField::make_gust_waves(const double* rates, const double* tilts) {
   // vectors point upwind: in a steady wind from the first key on, each wave at the origin is
   // sin(w (t - t_first) + phi), the gust signal of a single point.
   size_t fastest = 0;
-  for (size_t k = 1; k < key_wind.size(); ++k)
-    if (key_wind[k].norm() > key_wind[fastest].norm()) fastest = k;
-  const double speed = key_wind.empty() ? 0.0 : key_wind[fastest].norm();
+  for (size_t k = 1; k < keys.wind.size(); ++k)
+    if (keys.wind[k].norm() > keys.wind[fastest].norm()) fastest = k;
+  const double speed = keys.wind.empty() ? 0.0 : keys.wind[fastest].norm();
   const int n = mode_turbulence;
   if (!(speed > 0)) {  // calm throughout: there are no gusts to carry
     mode_wave.rightCols(kGustWaves).setZero();
     return;
   }
-  const Eigen::Vector3d along = key_wind[fastest] / speed;
+  const Eigen::Vector3d along = keys.wind[fastest] / speed;
   Eigen::Vector3d across = along.cross(Eigen::Vector3d::UnitY());
   across = across.norm() > 1e-6 ? across.normalized() : along.unitOrthogonal();  // a vertical wind
   for (int j = 0; j < kGustWaves; ++j)
@@ -144,25 +132,9 @@ double WindField::key_time_of(double t) const {
   return loop_start + (t - loop_start) - loop_period * std::floor((t - loop_start) / loop_period);
 }
 
-Eigen::Vector3d WindField::mean(double t) const {
-  t = key_time_of(t);
-  if (key_time.empty()) return Eigen::Vector3d::Zero();
-  if (t <= key_time.front()) return key_wind.front();
-  if (t >= key_time.back()) return key_wind.back();
-  const size_t k = interval_of(key_time, t);
-  const double s = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
-  return (1 - s) * key_wind[k] + s * key_wind[k + 1];
-}
+Eigen::Vector3d WindField::mean(double t) const { return key_mean_wind(keys, key_time_of(t)); }
 
-double WindField::gust_amplitude(double t) const {
-  t = key_time_of(t);
-  if (key_time.empty()) return 0;
-  if (t <= key_time.front()) return key_gust.front();
-  if (t >= key_time.back()) return key_gust.back();
-  const size_t k = interval_of(key_time, t);
-  const double s = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
-  return (1 - s) * key_gust[k] + s * key_gust[k + 1];
-}
+double WindField::gust_amplitude(double t) const { return key_gust_amplitude(keys, key_time_of(t)); }
 
 bool WindField::calm(double t) const { return mean(t).squaredNorm() == 0; }
 
@@ -174,12 +146,12 @@ Eigen::Vector3d WindField::advection(double t) const {
 }
 
 Eigen::Vector3d WindField::key_advection_at(double t) const {
-  if (key_time.empty()) return Eigen::Vector3d::Zero();
-  if (t <= key_time.front()) return (t - key_time.front()) * key_wind.front();
-  if (t >= key_time.back()) return key_advection.back() + (t - key_time.back()) * key_wind.back();
-  const size_t k = interval_of(key_time, t);
-  const double s = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
-  return key_advection[k] + 0.5 * (t - key_time[k]) * (key_wind[k] + ((1 - s) * key_wind[k] + s * key_wind[k + 1]));
+  if (keys.time.empty()) return Eigen::Vector3d::Zero();
+  if (t <= keys.time.front()) return (t - keys.time.front()) * keys.wind.front();
+  if (t >= keys.time.back()) return key_advection.back() + (t - keys.time.back()) * keys.wind.back();
+  const size_t k = key_interval(keys.time, t);
+  const double s = (t - keys.time[k]) / (keys.time[k + 1] - keys.time[k]);
+  return key_advection[k] + 0.5 * (t - keys.time[k]) * (keys.wind[k] + ((1 - s) * keys.wind[k] + s * keys.wind[k + 1]));
 }
 
 void WindField::spatial_phases(const Eigen::Vector3d& x, double* sin_a, double* cos_a) const {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim/sim_options.h"
+#include "sim/wind_keys.h"
 
 namespace treeanim {
 
@@ -65,9 +66,7 @@ class WindField {
   // Rounds rates and wave numbers to whole cycles per loop period (constructor, loops only).
   void make_periodic();
 
-  std::vector<double> key_time;          // (K) s
-  std::vector<Eigen::Vector3d> key_wind; // (K) m/s, speed * direction
-  std::vector<double> key_gust;          // (K) m/s
+  WindKeySeries keys;                    // the mean wind and gust amplitude between keys
   std::vector<Eigen::Vector3d> key_advection;  // (K) m, integral of the mean wind up to key k
   double intensity;                      // turbulence rms per component / mean speed
   int mode_turbulence = 0;               // N, turbulence modes; phases N .. N + kGustWaves - 1 are the gust's

@@ -2,41 +2,6 @@
 
 namespace treeanim {
 
-// /tree/leaf object => leaf options (defaults written back into the scene).
-static LeafOptions read_leaf_options(SceneObject section) {
-  LeafOptions o;
-  o.size = section.number("size", o.size, Range::positive());
-  o.aspect = section.number("aspect", o.aspect, Range::positive());
-  o.petiole = section.number("petiole", o.petiole, Range::non_negative());
-  o.areal_density = section.number("areal_density", o.areal_density, Range::positive());
-  o.mesh = section.optional_path("mesh");
-  return o;
-}
-
-// /tree/cluster object => cluster options.
-static ClusterOptions read_cluster_options(SceneObject section) {
-  ClusterOptions o;
-  o.segments_per_cluster =
-      int(section.integer("segments_per_cluster", o.segments_per_cluster, 1, 1'000'000));
-  o.target_vertices = int(section.integer("target_vertices", o.target_vertices, 0, 100'000'000));
-  return o;
-}
-
-TreeOptions read_tree_options(SceneObject section) {
-  TreeOptions o;
-  o.scale = section.number("scale", o.scale, Range::positive());
-  o.width_scale = section.number("width_scale", o.width_scale, Range::positive());
-  o.ring_sides = int(section.integer("ring_sides", o.ring_sides, 3, 256));
-  o.trunk_radius = section.number("trunk_radius", o.trunk_radius, Range::positive());
-  o.min_radius = section.number("min_radius", o.min_radius, Range::positive());
-  o.wood_density = section.number("wood_density", o.wood_density, Range::positive());
-  o.pipe_exponent = section.number("pipe_exponent", o.pipe_exponent, Range::between(1.0, 4.0));
-  o.tip_taper = section.number("tip_taper", o.tip_taper, Range::between(0.0, 1.0));
-  o.leaf = read_leaf_options(section.object("leaf"));
-  o.cluster = read_cluster_options(section.object("cluster"));
-  return o;
-}
-
 TreeOptions scaled_tree_options(TreeOptions options, double factor) {
   options.scale *= factor;
   options.trunk_radius *= factor;

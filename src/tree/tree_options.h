@@ -1,9 +1,7 @@
 #pragma once
-// Scene section /tree (docs/scene.md). Owned by tree/; fields are added as the mesher needs.
+// Scene section /tree (docs/scene.md), read by scene/ (src/scene/tree_section.h).
 #include <filesystem>
 #include <optional>
-
-#include "common/scene_reader.h"
 
 namespace treeanim {
 
@@ -35,8 +33,6 @@ struct TreeOptions {
   ClusterOptions cluster;
 };
 
-// /tree section => options.
-TreeOptions read_tree_options(SceneObject section);
 // options, factor => the options of the same tree `factor` times as large: every length (scale,
 // radii, leaf size and petiole) multiplied, so masses follow the volume and the sway the size.
 TreeOptions scaled_tree_options(TreeOptions options, double factor);

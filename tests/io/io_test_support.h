@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "io/output_formats.h"
 #include "io/outputs.h"
 #include "tree/tree_model.h"
 
@@ -174,7 +175,7 @@ inline std::vector<float> rest_f32(const TreeModel& m) {
 
 inline OutputOptions output(const std::string& format, const std::string& path, int frame_step = 1) {
   OutputOptions o;
-  o.format = format;
+  o.format = find_output_format(format);
   o.path = path;
   o.frame_step = frame_step;
   o.pointer = "/outputs/0";

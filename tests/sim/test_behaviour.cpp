@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "sim/simulator.h"
+#include "sim/solver_model.h"
 #include "sim/stiffness.h"
 #include "correlation.h"
 #include "grown_tree.h"
@@ -266,7 +267,7 @@ TEST(Behaviour, TheTreeDownwindSwaysLikeTheOneUpwindLater) {
 
 TEST(Behaviour, IdenticalBytesFor1And2And4Threads) {
   const TreeModel model = grown_tree(7, 2, 2);
-  ASSERT_GE(model.membership_count(), 4096u);  // large enough to run in parallel
+  ASSERT_GE(model.membership_count(), kParallelMemberships);  // large enough to run in parallel
   WindOptions wind = gust_then_calm(18, 1, 1.5);
   for (Precision precision : {Precision::kDouble, Precision::kFloat}) {
     SCOPED_TRACE(precision == Precision::kFloat ? "float" : "double");

@@ -10,6 +10,7 @@
 
 #include "grown_tree.h"
 #include "sim/simulator.h"
+#include "sim/solver_model.h"
 
 namespace treeanim {
 namespace {
@@ -59,7 +60,7 @@ TEST(Resume, StateSavedAtAnyFrameContinuesBitIdenticallyInAFreshSimulator) {
   // second, then calm: the tree falls asleep (heavily damped, coarse thresholds, so within
   // the bake) while the leaves still fall.
   const TreeModel model = grown_tree(7, 2, 2);
-  ASSERT_GE(model.membership_count(), 4096u);
+  ASSERT_GE(model.membership_count(), kParallelMemberships);
   const WindOptions wind = rising_gale();
   const int saved_threads = omp_get_max_threads();
   for (Precision precision : {Precision::kDouble, Precision::kFloat}) {

@@ -4,11 +4,13 @@
 // period, everywhere (mean, gusts and the advected turbulence).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "correlation.h"
 #include "sim/wind.h"
+#include "sim/wind_keys.h"
 
 namespace treeanim {
 namespace {
@@ -191,6 +193,52 @@ TEST(Wind, WithoutALoopTheFieldDoesNotRepeat) {
   const WindField field(gusty_wind());
   const Eigen::Vector3d x(0, 1, 0);
   EXPECT_GT((field.velocity(x, 1.0) - field.velocity(x, 1.0 + 9.5)).norm(), 1e-3);
+}
+
+// The loop check as scene/ made it on the field: mean wind and gusts of a WindField (not yet
+// periodic) at both ends of the loop, equal within 1e-9 of the wind's size.
+bool field_is_periodic(const WindOptions& wind, double start, double period) {
+  const WindField field(wind);
+  const Eigen::Vector3d first = field.mean(start), last = field.mean(start + period);
+  const double first_gust = field.gust_amplitude(start), last_gust = field.gust_amplitude(start + period);
+  const double tolerance = 1e-9 * std::max(1.0, first.norm() + first_gust);
+  return !((first - last).norm() > tolerance || std::fabs(first_gust - last_gust) > tolerance);
+}
+
+TEST(Wind, TheLoopSeamOfTheKeysAgreesWithTheField) {
+  const Eigen::Vector3d x(1, 0, 0), slanted = Eigen::Vector3d(1, 0, 0.3).normalized();
+  struct Case {
+    const char* name;
+    std::vector<WindKey> keys;
+    double start, period;
+    bool periodic;
+  };
+  const Case cases[] = {
+      {"calm", {}, 0.0, 5.0, true},
+      {"one key", {{0.0, 6.0, x, 2.0}}, -3.0, 5.0, true},
+      {"the same wind at both ends", gusty_wind().keys, 0.0, 10.0, true},
+      {"a key between the ends", gusty_wind().keys, 0.0, 4.0, false},
+      {"ends held past the keys", gusty_wind().keys, -2.0, 14.0, true},
+      {"only the gusts differ", {{0.0, 6.0, x, 2.0}, {5.0, 6.0, x, 2.5}}, 0.0, 5.0, false},
+      {"only the direction differs", {{0.0, 6.0, x, 0.0}, {5.0, 6.0, slanted, 0.0}}, 0.0, 5.0, false},
+      {"within the tolerance", {{0.0, 6.0, x, 2.0}, {5.0, 6.0 + 1e-12, x, 2.0}}, 0.0, 5.0, true},
+      {"just past the tolerance", {{0.0, 6.0, x, 2.0}, {5.0, 6.0 + 1e-7, x, 2.0}}, 0.0, 5.0, false},
+      {"ends inside intervals", {{0.0, 4.0, x, 1.0}, {2.0, 8.0, x, 1.0}, {4.0, 4.0, x, 1.0}, {6.0, 8.0, x, 1.0}}, 1.0,
+       4.0, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    WindOptions wind;
+    wind.keys = c.keys;
+    const WindSeam seam = wind_loop_seam(wind, c.start, c.period);
+    EXPECT_EQ(seam.periodic, c.periodic);
+    EXPECT_EQ(seam.periodic, field_is_periodic(wind, c.start, c.period));
+    const WindField field(wind);
+    EXPECT_EQ(seam.first, field.mean(c.start));
+    EXPECT_EQ(seam.last, field.mean(c.start + c.period));
+    EXPECT_EQ(seam.first_gust, field.gust_amplitude(c.start));
+    EXPECT_EQ(seam.last_gust, field.gust_amplitude(c.start + c.period));
+  }
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
-#include "lsystem/lsystem_options.h"
+#include "scene/lsystem_section.h"
 
 namespace treeanim {
 namespace {

@@ -1,4 +1,4 @@
-#include "common/scene_reader.h"
+#include "scene/scene_reader.h"
 
 #include <algorithm>
 #include <cmath>
@@ -47,16 +47,6 @@ std::string describe_json(const Json& value) {
   std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
   if (text.size() > 60) text = text.substr(0, 57) + "...";
   return text;
-}
-
-std::string escape_pointer_token(const std::string& token) {
-  std::string out;
-  for (char c : token) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
 }
 
 SceneObject::SceneObject(SceneReader* reader, Json* node, std::string pointer)

@@ -3,7 +3,7 @@
 
 #include "common/errors.h"
 #include "common/did_you_mean.h"
-#include "common/scene_reader.h"
+#include "scene/scene_reader.h"
 
 namespace treeanim {
 namespace {

@@ -1,7 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
-#include "io/output_options.h"
+#include "io/output_formats.h"
+#include "scene/output_section.h"
 
 namespace treeanim {
 namespace {
@@ -29,7 +30,7 @@ std::string error_of(const std::string& text) {
 TEST(OutputOptions, DefaultsAreFilledIn) {
   Json resolved;
   const OutputOptions o = read_first(R"({"outputs": [{"format": "hdf5", "path": "bake.h5"}]})", &resolved);
-  EXPECT_EQ(o.format, "hdf5");
+  EXPECT_EQ(o.format, find_output_format("hdf5"));
   EXPECT_EQ(o.path, "bake.h5");
   EXPECT_EQ(o.frame_step, 1);
   EXPECT_EQ(o.compression, 0);

@@ -4,8 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "common/scene_reader.h"
 #include "lsystem/lsystem.h"
+#include "scene/lsystem_section.h"
+#include "scene/tree_section.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {

@@ -13,14 +13,13 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-namespace treeanim {
+#include "common/json_text.h"
 
-using Json = nlohmann::ordered_json;
+namespace treeanim {
 
 // Inclusive or exclusive bounds of a numeric value.
 struct Range {
@@ -116,7 +115,5 @@ class SceneReader {
 
 // Compact one-line rendering of a JSON value for messages (strings quoted, long values cut).
 std::string describe_json(const Json& value);
-// JSON-pointer escaping of one reference token ("~" => "~0", "/" => "~1").
-std::string escape_pointer_token(const std::string& token);
 
 }  // namespace treeanim

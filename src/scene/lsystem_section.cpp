@@ -1,4 +1,4 @@
-#include "lsystem/lsystem_options.h"
+#include "scene/lsystem_section.h"
 
 #include <cctype>
 

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
-#include "tree/tree_options.h"
+#include "scene/tree_section.h"
 
 namespace treeanim {
 namespace {

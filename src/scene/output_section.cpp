@@ -1,0 +1,62 @@
+#include "scene/output_section.h"
+
+#include <algorithm>
+#include <optional>
+#include <vector>
+
+#include "io/output_formats.h"
+
+namespace treeanim {
+
+namespace {
+
+// A key of the element's format => its value (its default when absent) stored in `options`.
+void read_format_key(SceneObject& element, const OutputKey& key, OutputOptions& options) {
+  std::optional<double> value;
+  switch (key.type) {
+    case OutputKey::Type::kBoolean:
+      value = element.boolean(key.name, key.fallback != 0) ? 1.0 : 0.0;
+      break;
+    case OutputKey::Type::kInteger: {
+      const auto lo = static_cast<long long>(key.lo), hi = static_cast<long long>(key.hi);
+      if (!key.optional) value = double(element.integer(key.name, static_cast<long long>(key.fallback), lo, hi));
+      else if (auto n = element.optional_integer(key.name, lo, hi)) value = double(*n);
+      break;
+    }
+    case OutputKey::Type::kNumber: {
+      const Range range = Range::between(key.lo, key.hi);
+      value = key.optional ? element.optional_number(key.name, range) : element.number(key.name, key.fallback, range);
+      break;
+    }
+    case OutputKey::Type::kChoice: {
+      const std::string chosen = element.choice(key.name, key.choices.at(size_t(key.fallback)), key.choices);
+      value = double(std::find(key.choices.begin(), key.choices.end(), chosen) - key.choices.begin());
+      break;
+    }
+  }
+  if (value) key.store(options, *value);
+}
+
+}  // namespace
+
+OutputOptions read_output_options(SceneObject element) {
+  OutputOptions options;
+  options.pointer = element.pointer();
+  std::vector<std::string> formats;
+  for (const OutputFormatRow& row : output_formats()) formats.emplace_back(row.name);
+  if (!element.has("format")) {
+    std::string listed;
+    for (const std::string& format : formats) listed += (listed.empty() ? "" : ", ") + format;
+    element.fail("format", "required (one of " + listed + ")");
+  }
+  options.format = find_output_format(element.choice("format", "", formats));
+  const auto path = element.optional_string("path");
+  if (!path || path->empty()) element.fail_expected("path", "a non-empty path string");
+  options.path = *path;
+  options.frame_step = static_cast<int>(element.integer("frame_step", 1, 1, 1000000));
+  for (const OutputKey& key : options.format->keys) read_format_key(element, key, options);
+  if (options.format->always_normals) options.normals = true;
+  return options;
+}
+
+}  // namespace treeanim

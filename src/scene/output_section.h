@@ -1,0 +1,13 @@
+#pragma once
+// Scene /outputs elements (docs/scene.md) => the io stage's options; the keys a format takes
+// are its row of the format table (io/output_formats.h).
+#include "io/output_options.h"
+#include "scene/scene_reader.h"
+
+namespace treeanim {
+
+// One element of /outputs => options. Keys that do not apply to the format are left
+// undeclared, so the scene reader reports them as unknown.
+OutputOptions read_output_options(SceneObject element);
+
+}  // namespace treeanim
