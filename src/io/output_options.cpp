@@ -25,14 +25,16 @@ OutputOptions read_output_options(SceneObject element) {
     // 1 nm is far below float32's resolution of a tree's coordinates; 1 m is no shape at all.
     options.quantize = element.optional_number("quantize", Range{1e-9, 1.0, false, false}).value_or(0.0);
   }
-  if (options.format == "hdf5" || options.format == "obj" || options.format == "gltf" || options.format == "glb")
+  if (options.format == "hdf5" || options.format == "obj" || options.format == "gltf" || options.format == "glb" ||
+      options.format == "usd")
     options.normals = element.boolean("normals", false);
   if (options.format == "vat") {
     options.normals = true;  // the normals texture
     options.texture_width = static_cast<size_t>(element.integer("texture_width", 0, 0, 8192));
     options.vat_half = element.choice("precision", "float", {"float", "half"}) == "half";
   }
-  if (options.format == "skinned_glb")
+  if (options.format == "usd") options.skinned = element.boolean("skinned", false);
+  if (options.format == "skinned_glb" || options.skinned)
     options.max_joints = static_cast<size_t>(element.optional_integer("max_joints", 1, 65535).value_or(0));
   return options;
 }
