@@ -1,8 +1,11 @@
 #include "io/output_estimate.h"
 
+#include <algorithm>
+
 namespace treeanim {
 
-double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, long long frames) {
+double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, size_t clusters,
+                              long long frames) {
   const double written = double((frames + output.frame_step - 1) / output.frame_step);
   const double vectors = 12.0 * double(vertices);  // one float32 [x, y, z] per vertex
   const double normals = output.normals ? vectors : 0;
@@ -15,7 +18,10 @@ double estimated_output_bytes(const OutputOptions& output, size_t vertices, size
   if (output.format == "glb" || output.format == "pc2" || output.format == "mdd") return written * (vectors + normals);
   if (output.format == "vat")  // offsets and normals, RGBA texels
     return written * (output.vat_half ? 8.0 : 16.0) * 2.0 * double(vertices);
-  return 0;  // skinned_glb: keys per joint, small beside the mesh
+  const double joints = double(output.max_joints > 0 ? std::min(output.max_joints, clusters) : clusters);
+  if (output.format == "usd")  // text: ~36 characters a point, ~38 a normal, ~96 a joint's translation and rotation
+    return written * (output.skinned ? 96.0 * joints : (36.0 + (output.normals ? 38.0 : 0.0)) * double(vertices));
+  return written * 28.0 * joints;  // skinned_glb: a float translation and rotation per joint
 }
 
 }  // namespace treeanim
