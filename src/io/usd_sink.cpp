@@ -1,4 +1,4 @@
-// USD ("usd", docs/outputs.md "USD"): one .usda text layer. Without "skinned", a Mesh whose
+// USD ("usd", docs/outputs.md "USD layer"): one .usda text layer. Without "skinned", a Mesh whose
 // points carry a time sample per written frame, streamed as the frames come (extents and normals
 // follow the points: the extents are kept, the normals' samples go to a scratch file beside the
 // output and are copied in at the end). With "skinned", the same tree as UsdSkel: the rest mesh

@@ -1,5 +1,5 @@
 #pragma once
-// USDA text (docs/outputs.md "USD"): values printed as USD's text form reads them, floats in the
+// USDA text (docs/outputs.md "USD layer"): values printed as USD's text form reads them, floats in the
 // shortest text that reads back as the same float32 (std::to_chars), so a reader gets every
 // value bit for bit.
 #include <Eigen/Core>
