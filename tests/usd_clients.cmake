@@ -25,3 +25,11 @@ foreach(reader three tinyusdz)
   endif()
   set_tests_properties(usd_clients_${reader} PROPERTIES LABELS "usd;clients" FIXTURES_REQUIRED usd_bake TIMEOUT 300)
 endforeach()
+
+# The farm's gather writes the same forest.usda as `run`: the forest baked as three shards, then gathered.
+set(usd_farm_dir ${usd_bake_dir}/forest-farm)
+set(usd_forest_scene ${CMAKE_SOURCE_DIR}/tests/clients/scenes/forest_usd.json)
+add_test(NAME usd_forest_gather
+         COMMAND sh -c "rm -rf '${usd_farm_dir}' && for shard in 0/3 1/3 2/3; do '$<TARGET_FILE:treeanim>' run '${usd_forest_scene}' -o '${usd_farm_dir}' --quiet --shard $shard || exit 1; done; test ! -e '${usd_farm_dir}/forest.usda' && '$<TARGET_FILE:treeanim>' farm gather '${usd_forest_scene}' -o '${usd_farm_dir}' && cmp '${usd_farm_dir}/forest.usda' '${usd_bake_dir}/forest/forest.usda'"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(usd_forest_gather PROPERTIES LABELS "usd;clients" FIXTURES_REQUIRED usd_bake TIMEOUT 120)
