@@ -26,6 +26,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Where a sample's line starts: inside the Mesh, inside the SkelAnimation.
+constexpr const char* kSampleIndent = "            ";
+constexpr const char* kKeyIndent = "                ";
+
 // Surface colours in sRGB, until the tree options carry them.
 constexpr std::array<double, 3> kBarkColor = {0.35, 0.25, 0.17};
 constexpr std::array<double, 3> kLeafColor = {0.23, 0.42, 0.12};
@@ -52,6 +56,15 @@ std::string layer_header(const BakeInfo& info, const FrameSelection& selection, 
   append_usd_number(out, info.fps);
   out += "\n    upAxis = \"Y\"\n)\n\n";
   return out;
+}
+
+// One time sample of an array: "<indent><time code>: [...],\n".
+void append_sample(std::string& out, const char* indent, long long code, const float* values, size_t count,
+                   int width) {
+  out += indent;
+  out += std::to_string(code) + ": ";
+  append_usd_tuples(out, values, count, width);
+  out += ",\n";
 }
 
 void append_color(std::string& out, const std::array<double, 3>& srgb) {
@@ -167,14 +180,12 @@ class UsdSink final : public FrameSink {
       extent[3 + i % 3] = std::max(extent[3 + i % 3], frame.positions[i]);
     }
     extents_.push_back({frame.frame, extent});
-    text_ = "            " + std::to_string(frame.frame) + ": ";
-    append_usd_tuples(text_, frame.positions.data(), model_.vertex_count(), 3);
-    text_ += ",\n";
+    text_.clear();
+    append_sample(text_, kSampleIndent, frame.frame, frame.positions.data(), model_.vertex_count(), 3);
     file_->write(text_);
     if (normals_) {
-      text_ = "            " + std::to_string(frame.frame) + ": ";
-      append_usd_tuples(text_, frame.normals.data(), model_.vertex_count(), 3);
-      text_ += ",\n";
+      text_.clear();
+      append_sample(text_, kSampleIndent, frame.frame, frame.normals.data(), model_.vertex_count(), 3);
       scratch_->write(text_);
     }
   }
@@ -185,11 +196,7 @@ class UsdSink final : public FrameSink {
       file_->write(skinned_layer());
     } else {
       std::string out = "        }\n        float3[] extent.timeSamples = {\n";
-      for (const auto& [frame, extent] : extents_) {
-        out += "            " + std::to_string(frame) + ": ";
-        append_usd_tuples(out, extent.data(), 2, 3);
-        out += ",\n";
-      }
+      for (const auto& [frame, extent] : extents_) append_sample(out, kSampleIndent, frame, extent.data(), 2, 3);
       file_->write(out + "        }\n");
       if (normals_) {
         scratch_->write("        }\n");
@@ -283,20 +290,16 @@ class UsdSink final : public FrameSink {
     out += "        def SkelAnimation \"Wind\"\n        {\n            uniform token[] joints = " + joint_list + "\n";
     out += "            float3[] translations.timeSamples = {\n";
     const size_t frames = track_.times.size();
-    for (size_t f = 0; f < frames; ++f) {
-      out += "                " + std::to_string(selection_.start + (long long)f * selection_.step) + ": ";
-      append_usd_tuples(out, track_.translations.data() + 3 * joints * f, joints, 3);
-      out += ",\n";
-    }
+    const auto code = [&](size_t f) { return selection_.start + (long long)f * selection_.step; };
+    for (size_t f = 0; f < frames; ++f)
+      append_sample(out, kKeyIndent, code(f), track_.translations.data() + 3 * joints * f, joints, 3);
     out += "            }\n            quatf[] rotations.timeSamples = {\n";
     std::vector<float> wxyz(4 * joints);
     for (size_t f = 0; f < frames; ++f) {
       const float* xyzw = track_.rotations.data() + 4 * joints * f;
       for (size_t j = 0; j < joints; ++j)
         for (size_t c = 0; c < 4; ++c) wxyz[4 * j + c] = xyzw[4 * j + (c + 3) % 4];  // USD's real part first
-      out += "                " + std::to_string(selection_.start + (long long)f * selection_.step) + ": ";
-      append_usd_tuples(out, wxyz.data(), joints, 4);
-      out += ",\n";
+      append_sample(out, kKeyIndent, code(f), wxyz.data(), joints, 4);
     }
     const std::vector<float> ones(3 * joints, 1.0f);
     out += "            }\n            half3[] scales = ";
