@@ -1,14 +1,16 @@
 # USD layers (docs/outputs.md "USD layer") read by two independent readers from npm, in Node: three.js's
 # USDLoader and TinyUSDZ's wasm parser (tests/clients/usd, installed by `scripts/setup test`).
 # Labels "usd;clients". The golden tree is baked once into HDF5 and both USD forms, frames 2 to 11
-# (time codes from 2), and a forest of three turned trees with a layer each and forest.usda.
+# (time codes from 2), again every third frame (skinned with 5 joints), and a forest of three
+# turned trees with a layer each and forest.usda.
 set(usd_bake_dir ${CMAKE_BINARY_DIR}/usd_clients)
 set(usd_clients ${CMAKE_SOURCE_DIR}/tests/clients/usd)
 set(usd_outputs "[{\"format\":\"hdf5\",\"path\":\"tree.h5\"},{\"format\":\"usd\",\"path\":\"tree.usda\",\"normals\":true},\
-{\"format\":\"usd\",\"path\":\"skinned.usda\",\"skinned\":true}]")
+{\"format\":\"usd\",\"path\":\"skinned.usda\",\"skinned\":true},{\"format\":\"hdf5\",\"path\":\"step3.h5\",\"frame_step\":3},\
+{\"format\":\"usd\",\"path\":\"step3.usda\",\"frame_step\":3},{\"format\":\"usd\",\"path\":\"step3-skinned.usda\",\"frame_step\":3,\"skinned\":true,\"max_joints\":5}]")
 find_program(TREEANIM_SYSTEM_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
 add_test(NAME usd_clients_bake
-         COMMAND sh -c "rm -rf '${usd_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${CMAKE_SOURCE_DIR}/tests/golden/small_tree.json' -o '${usd_bake_dir}' --quiet --frames 2:11 --set 'outputs=${usd_outputs}' && '$<TARGET_FILE:treeanim>' run '${CMAKE_SOURCE_DIR}/tests/clients/scenes/forest_usd.json' -o '${usd_bake_dir}/forest' --quiet && exec '${TREEANIM_SYSTEM_PYTHON}' '${usd_clients}/export_frames.py' '${usd_bake_dir}/tree.h5' '${usd_bake_dir}/frames'"
+         COMMAND sh -c "rm -rf '${usd_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${CMAKE_SOURCE_DIR}/tests/golden/small_tree.json' -o '${usd_bake_dir}' --quiet --frames 2:11 --set 'outputs=${usd_outputs}' && '$<TARGET_FILE:treeanim>' run '${CMAKE_SOURCE_DIR}/tests/clients/scenes/forest_usd.json' -o '${usd_bake_dir}/forest' --quiet && '${TREEANIM_SYSTEM_PYTHON}' '${usd_clients}/export_frames.py' '${usd_bake_dir}/step3.h5' '${usd_bake_dir}/step3' && exec '${TREEANIM_SYSTEM_PYTHON}' '${usd_clients}/export_frames.py' '${usd_bake_dir}/tree.h5' '${usd_bake_dir}/frames'"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(usd_clients_bake PROPERTIES LABELS "usd;clients" FIXTURES_SETUP usd_bake TIMEOUT 120)
 
@@ -16,8 +18,7 @@ find_program(TREEANIM_USD_NODE node)  # not TREEANIM_NODE, which io_clients.cmak
 foreach(reader three tinyusdz)
   if(TREEANIM_USD_NODE AND EXISTS ${usd_clients}/node_modules/${reader})
     add_test(NAME usd_clients_${reader}
-             COMMAND ${TREEANIM_USD_NODE} ${usd_clients}/check_usd_${reader}.mjs --bake ${usd_bake_dir}/frames
-                     --points ${usd_bake_dir}/tree.usda --skinned ${usd_bake_dir}/skinned.usda --forest ${usd_bake_dir}/forest
+             COMMAND sh -c "'${TREEANIM_USD_NODE}' '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/frames' --points '${usd_bake_dir}/tree.usda' --skinned '${usd_bake_dir}/skinned.usda' --forest '${usd_bake_dir}/forest' && exec '${TREEANIM_USD_NODE}' '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/step3' --points '${usd_bake_dir}/step3.usda' --skinned '${usd_bake_dir}/step3-skinned.usda'"
              WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   else()  # a missing reader fails with the reason instead of silently passing
     add_test(NAME usd_clients_${reader}

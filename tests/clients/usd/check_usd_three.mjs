@@ -7,7 +7,7 @@
 //                                 place OUT/forest.json gives it
 import fs from 'node:fs';
 import path from 'node:path';
-import { AnimationMixer, Matrix4, Vector3 } from 'three';
+import { AnimationMixer, LoopOnce, Matrix4, Vector3 } from 'three';
 import { USDAParser } from 'three/examples/jsm/loaders/usd/USDAParser.js';
 import { USDLoader } from 'three/examples/jsm/loaders/USDLoader.js';
 import { zipSync, strToU8 } from 'three/examples/jsm/libs/fflate.module.js';
@@ -104,7 +104,12 @@ if (skinnedFile) {
   vertexOf.forEach((v, c) => { if (!cornerOf.has(v)) cornerOf.set(v, c); });
   expect(cornerOf.size === bake.vertices, `${skinnedFile}: ${cornerOf.size} of ${bake.vertices} vertices drawn`);
   const mixer = new AnimationMixer(group);
-  mixer.clipAction(group.animations[0]).play();
+  // Played once and held at the end: repeating, the last frame's time, a float32 key time
+  // rounded below the double frame / fps, would wrap round to the first key.
+  const action = mixer.clipAction(group.animations[0]);
+  action.setLoop(LoopOnce);
+  action.clampWhenFinished = true;
+  action.play();
   const p = new Vector3();
   let worst = 0, worstFrame = 0;
   for (let k = 0; k < bake.frames.length; ++k) {

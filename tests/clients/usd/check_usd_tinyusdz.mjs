@@ -59,7 +59,8 @@ function checkWriteBack(file, attributes) {
 const pointsFile = option('--points');
 if (pointsFile) {
   checkStage(pointsFile);
-  checkWriteBack(pointsFile, ['/Tree/Mesh.points', '/Tree/Mesh.extent', '/Tree/Mesh.normals']);
+  const withNormals = fs.readFileSync(pointsFile, 'utf8').includes('normal3f[] normals.timeSamples');
+  checkWriteBack(pointsFile, ['/Tree/Mesh.points', '/Tree/Mesh.extent', ...(withNormals ? ['/Tree/Mesh.normals'] : [])]);
 }
 
 const skinnedFile = option('--skinned');
