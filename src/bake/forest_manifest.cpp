@@ -1,9 +1,12 @@
 #include "bake/forest_manifest.h"
 
+#include <algorithm>
+
 #include "common/json_text.h"
 #include "common/read_text_file.h"
 #include "io/output_formats.h"
 #include "io/text_output.h"
+#include "io/usd_forest.h"
 
 namespace treeanim {
 
@@ -30,6 +33,22 @@ Json placement_matrix(const TreePlacement& placement) {
                        : column == 3 ? placement.translation[row]
                                      : placement.rotation(row, column));
   return matrix;
+}
+
+// The parts' trees with their first USD layer each, or none unless every tree has one.
+std::vector<ForestStageTree> usd_stage_trees(const Json& trees) {
+  std::vector<ForestStageTree> stage;
+  for (const Json& tree : trees) {
+    const Json& outputs = tree.at("outputs");
+    const auto usd =
+        std::find_if(outputs.begin(), outputs.end(), [](const Json& o) { return o.at("format") == "usd"; });
+    if (usd == outputs.end()) return {};
+    const Json& position = tree.at("position");
+    stage.push_back({tree.at("id").get<std::string>(), usd->at("files").at(0).get<std::string>(),
+                     Eigen::Vector3d(position[0].get<double>(), position[1].get<double>(), position[2].get<double>()),
+                     tree.at("rotation").get<double>()});
+  }
+  return stage;
 }
 
 }  // namespace
@@ -113,6 +132,12 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
     }
   }
   if (!report.missing.empty()) return report;
+  // Before the manifest, which says the forest is complete.
+  if (const auto stage = usd_stage_trees(trees); !stage.empty()) {
+    const long long start = trees[0].at("frame_start").get<long long>();
+    write_forest_usda(out_dir / "forest.usda", stage,
+                      {scene.time.fps, start, start + std::max(1LL, trees[0].at("frame_count").get<long long>()) - 1});
+  }
   const Json manifest = {{"format", "treeanim-forest"},
                          {"format_version", 1},
                          {"generator", generator},

@@ -26,7 +26,7 @@ ForestEstimate estimate_forest(const Scene& scene) {
     variant_cost[v] = uint64_t(tree.model.vertex_count()) * uint64_t(steps);
     for (const OutputOptions& output : one.outputs)
       variant_bytes[v] += estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
-                                                 scene.time.frames);
+                                                 tree.model.cluster_count(), scene.time.frames);
   }
   ForestEstimate estimate;
   for (const ForestTree& tree : forest.trees) {

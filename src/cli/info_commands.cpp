@@ -4,6 +4,8 @@
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
+#include "io/output_estimate.h"
+#include "io/output_formats.h"
 
 namespace treeanim {
 
@@ -59,6 +61,12 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
       std::printf("forest of %zu trees, %zu variants; tree %s:\n", scene.forest->trees.size(),
                   scene.forest->variants.size(), scene.forest->trees[0].id.c_str());
   }
+  Json& outputs = summary["estimate"]["outputs"] = Json::array();
+  for (const OutputOptions& output : one.outputs)
+    outputs.push_back({{"format", output.format->name},
+                       {"path", output.path.string()},
+                       {"bytes", estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
+                                                        tree.model.cluster_count(), one.time.frames)}});
   if (format == InfoFormat::kJson) {
     std::cout << summary.dump(2) << "\n";
     return 0;
@@ -74,6 +82,9 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
               scene.time.frames, scene.time.substeps,
               summary["estimate"]["bytes_per_frame"].get<double>() / 1024.0,
               summary["estimate"]["bytes_positions_total"].get<double>() / (1024.0 * 1024.0));
+  for (const Json& output : outputs)  // io/output_estimate.h: the frames' data, uncompressed
+    std::printf("output %s (%s): about %.1f MiB of frames\n", output["path"].get<std::string>().c_str(),
+                output["format"].get<std::string>().c_str(), output["bytes"].get<double>() / (1024.0 * 1024.0));
   return 0;
 }
 

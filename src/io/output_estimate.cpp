@@ -4,9 +4,10 @@
 
 namespace treeanim {
 
-double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, long long frames) {
+double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, size_t clusters,
+                              long long frames) {
   const double written = double((frames + output.frame_step - 1) / output.frame_step);
-  return written * output.format->frame_bytes(output, vertices, triangles);
+  return written * output.format->frame_bytes(output, vertices, triangles, clusters);
 }
 
 }  // namespace treeanim

@@ -9,7 +9,8 @@
 
 namespace treeanim {
 
-// output options, mesh size, frames of the bake => estimated bytes of the output.
-double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, long long frames);
+// output options, mesh size (vertices, triangles, clusters), frames of the bake => estimated bytes of the output.
+double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, size_t clusters,
+                              long long frames);
 
 }  // namespace treeanim

@@ -3,13 +3,15 @@
 // compares with the table).
 #include "io/output_formats.h"
 
+#include <algorithm>
+
 #include "io/frame_sink.h"
 
 namespace treeanim {
 
 // Each format's sink, defined in its own file (src/io/<format>_sink.cpp).
 SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
-    make_skinned_glb_sink;
+    make_skinned_glb_sink, make_usd_sink;
 
 namespace {
 
@@ -26,9 +28,27 @@ const OutputKey kNormalsKey{.name = "normals",
                             .store = [](OutputOptions& o, double v) { o.normals = v != 0; }};
 
 // Positions and, when asked, normals of every vertex: the GLB's morph targets, PC2 and MDD.
-double vector_frame_bytes(const OutputOptions& o, size_t vertices, size_t) {
+double vector_frame_bytes(const OutputOptions& o, size_t vertices, size_t, size_t) {
   return vector_bytes(vertices) + normal_bytes(o, vertices);
 }
+
+// Joints of a skinned output: one per cluster, or max_joints when fewer.
+double joint_count(const OutputOptions& o, size_t clusters) {
+  return double(o.max_joints > 0 ? std::min(o.max_joints, clusters) : clusters);
+}
+
+// A skinned GLB's keys: a float translation and rotation per joint.
+double skinned_frame_bytes(const OutputOptions& o, size_t, size_t, size_t clusters) {
+  return 28.0 * joint_count(o, clusters);
+}
+
+// The joints a skinned output takes at most.
+const OutputKey kMaxJointsKey{.name = "max_joints",
+                              .type = Type::kInteger,
+                              .optional = true,
+                              .lo = 1,
+                              .hi = 65535,
+                              .store = [](OutputOptions& o, double v) { o.max_joints = size_t(v); }};
 
 const std::vector<OutputFormatRow> kFormats = {
     {.name = "hdf5",
@@ -51,7 +71,7 @@ const std::vector<OutputFormatRow> kFormats = {
      .leaf_flags = true,
      .make = make_hdf5_sink,
      // quantized: int16 displacements
-     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t) {
+     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        const double vectors = vector_bytes(vertices);
        return (o.quantize > 0 ? 0.5 : 1.0) * vectors + (o.velocities ? vectors : 0) + normal_bytes(o, vertices);
      }},
@@ -59,14 +79,14 @@ const std::vector<OutputFormatRow> kFormats = {
      .keys = {kNormalsKey},
      .make = make_obj_sink,
      // text: "v x y z" lines of ~32 characters, faces of ~24
-     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles) {
+     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
        return 32.0 * double(vertices) + (o.normals ? 36.0 * double(vertices) : 0) + 24.0 * double(triangles);
      }},
     {.name = "gltf",
      .keys = {kNormalsKey},
      .make = make_gltf_sink,
      // a file per frame: positions, triangles
-     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles) {
+     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
        return vector_bytes(vertices) + normal_bytes(o, vertices) + 12.0 * double(triangles);
      }},
     {.name = "glb", .keys = {kNormalsKey}, .make = make_glb_sink, .frame_bytes = vector_frame_bytes},
@@ -85,19 +105,24 @@ const std::vector<OutputFormatRow> kFormats = {
      .always_normals = true,  // the normals texture
      .make = make_vat_sink,
      // offsets and normals, RGBA texels
-     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t) {
+     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        return (o.vat_half ? 8.0 : 16.0) * 2.0 * double(vertices);
      }},
     {.name = "skinned_glb",
-     .keys = {{.name = "max_joints",
-               .type = Type::kInteger,
-               .optional = true,
-               .lo = 1,
-               .hi = 65535,
-               .store = [](OutputOptions& o, double v) { o.max_joints = size_t(v); }}},
+     .keys = {kMaxJointsKey},
      .make = make_skinned_glb_sink,
-     // keys per joint, small beside the mesh
-     .frame_bytes = [](const OutputOptions&, size_t, size_t) { return 0.0; }},
+     .frame_bytes = skinned_frame_bytes},
+    {.name = "usd",
+     .keys = {kNormalsKey,
+              {.name = "skinned",
+               .type = Type::kBoolean,
+               .store = [](OutputOptions& o, double v) { o.skinned = v != 0; }},
+              kMaxJointsKey},
+     .make = make_usd_sink,
+     // text: ~36 characters a point, ~38 a normal; skinned: ~96 a joint's translation and rotation
+     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t clusters) {
+       return o.skinned ? 96.0 * joint_count(o, clusters) : (36.0 + (o.normals ? 38.0 : 0.0)) * double(vertices);
+     }},
 };
 
 }  // namespace

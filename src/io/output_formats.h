@@ -43,7 +43,7 @@ struct OutputFormatRow {
   bool leaf_flags = false;      // writes FrameData::leaf_attached
   SinkFactory* make = nullptr;  // the format's sink
   // options, mesh size => bytes of one written frame's data, uncompressed (io/output_estimate.h)
-  double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles) = nullptr;
+  double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
 };
 
 // Every format, in the order messages and docs/outputs.md list them.

@@ -18,8 +18,9 @@ struct OutputOptions {
   bool normals = false;            // hdf5, obj, gltf, glb: per-frame vertex normals
   double quantize = 0;             // hdf5: m, > 0 stores displacements as integers of this step
   size_t texture_width = 0;        // vat: texels per row; 0 = as many as vertices, at most 8192
-  size_t max_joints = 0;           // skinned_glb: joints at most; 0 = one per cluster
+  size_t max_joints = 0;           // skinned_glb, skinned usd: joints at most; 0 = one per cluster
   bool vat_half = false;           // vat: half-float textures (else float)
+  bool skinned = false;            // usd: UsdSkel joints and keys instead of points per frame
   std::string pointer;             // "/outputs/N", for messages about this element
 };
 

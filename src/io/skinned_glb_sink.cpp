@@ -1,14 +1,12 @@
 // Skinned glTF ("skinned_glb", docs/outputs.md "Skinned glTF"): the rest mesh bound to one joint
 // per cluster (or per limb, option max_joints), and per joint a translation and a rotation key
-// per written frame, fitted so that the skinned mesh follows the bake (io/skin_fit.h). The RMS
+// per written frame, fitted so that the skinned mesh follows the bake (io/skin_track.h). The RMS
 // and largest error of the skinned mesh against the bake, relative to the bake's RMS
 // displacement, go into the asset's extras ("skinning") and the run's summary. Written with tinygltf at the
 // end: the keys of every frame are kept until then (28 bytes per joint and frame).
 #include <tiny_gltf.h>
 
-#include <Eigen/Geometry>
-#include <cmath>
-#include <cstdio>
+#include <algorithm>
 #include <limits>
 
 #include "common/errors.h"
@@ -16,6 +14,7 @@
 #include "io/glb_size.h"
 #include "io/obj_format.h"
 #include "io/skin_fit.h"
+#include "io/skin_track.h"
 #include "io/staged_files.h"
 #include "io/vertex_normals.h"
 
@@ -98,69 +97,27 @@ class SkinnedGlbSink final : public FrameSink {
   void begin() override {
     temporary_ = staged_.stage(path_);
     rest_ = rest_positions_f32(model_);
-    previous_rotation_.assign(skin_.joint_count(), Eigen::Quaterniond::Identity());
   }
 
   void write(const FrameData& frame) override {
-    fit_joints(skin_, model_, frame.positions.data(), motions_);
-    for (size_t j = 0; j < skin_.joint_count(); ++j) {
-      const auto [rotation, translation] = local_transform(j);
-      Eigen::Quaterniond q(rotation);
-      q.normalize();
-      if (q.dot(previous_rotation_[j]) < 0) q.coeffs() = -q.coeffs();  // keys interpolate the short way
-      previous_rotation_[j] = q;
-      for (int a = 0; a < 3; ++a) translations_.push_back(float(translation[a]));
-      for (double c : {q.x(), q.y(), q.z(), q.w()}) rotations_.push_back(float(c));
-    }
-    double frame_squared_error = 0;
-    for (size_t v = 0; v < model_.vertex_count(); ++v) {
-      const Eigen::Vector3d baked(frame.positions[3 * v], frame.positions[3 * v + 1], frame.positions[3 * v + 2]);
-      const double error = (skinned_position(skin_, model_, motions_, v) - baked).norm();
-      frame_squared_error += error * error;
-      largest_error_ = std::max(largest_error_, error);
-      squared_displacement_ += (baked - model_.rest_positions.col(long(v))).squaredNorm();
-    }
-    squared_error_ += frame_squared_error;
-    frame_rms_error_.push_back(model_.vertex_count() ? std::sqrt(frame_squared_error / double(model_.vertex_count())) : 0.0);
-    times_.push_back(float(frame.time));
+    add_skin_frame(skin_, model_, frame.positions.data(), frame.time, track_);
   }
 
   void finish() override {
-    const double samples = double(times_.size()) * double(model_.vertex_count());
-    const double rms_displacement = samples > 0 ? std::sqrt(squared_displacement_ / samples) : 0.0;
-    const double rms_error = samples > 0 ? std::sqrt(squared_error_ / samples) : 0.0;
-    relative_rms_ = rms_displacement > 0 ? rms_error / rms_displacement : 0.0;
-    relative_max_ = rms_displacement > 0 ? largest_error_ / rms_displacement : 0.0;
-    tinygltf::Model gltf = assemble(rms_displacement, rms_error);
+    error_ = skin_error(track_, model_.vertex_count());
+    tinygltf::Model gltf = assemble();
     tinygltf::TinyGLTF writer;
     if (!writer.WriteGltfSceneToFile(&gltf, temporary_.string(), false, true, false, true))
       throw OutputError(io_failure(path_, "tinygltf could not write the skinned GLB"));
   }
 
-  std::string report() const override {
-    char text[200];
-    std::snprintf(text, sizeof text, "skinning error RMS %.2f %%, max %.2f %% of the RMS displacement, %zu joints",
-                  100 * relative_rms_, 100 * relative_max_, skin_.joint_count());
-    return text;
-  }
+  std::string report() const override { return skin_error_report(error_, skin_.joint_count()); }
 
  private:
-  // Joint j's transform relative to its parent's: world_j = M_j T(pivot_j), local = world_parent^-1 world_j.
-  std::pair<Eigen::Matrix3d, Eigen::Vector3d> local_transform(size_t j) const {
-    const RigidMotion& m = motions_[j];
-    const Eigen::Vector3d& pivot = skin_.joint_pivot[j];
-    const int32_t parent = skin_.joint_parent[j];
-    if (parent < 0) return {m.rotation, m.rotation * pivot + m.translation};
-    const RigidMotion& p = motions_[size_t(parent)];
-    const Eigen::Matrix3d rotation = p.rotation.transpose() * m.rotation;
-    return {rotation, rotation * pivot + p.rotation.transpose() * (m.translation - p.translation) -
-                          skin_.joint_pivot[size_t(parent)]};
-  }
-
-  tinygltf::Model assemble(double rms_displacement, double rms_error) const {
+  tinygltf::Model assemble() const {
     tinygltf::Model gltf;
     GltfBuilder add(gltf);
-    const size_t n = model_.vertex_count(), joints = skin_.joint_count(), frames = times_.size();
+    const size_t n = model_.vertex_count(), joints = skin_.joint_count(), frames = track_.times.size();
     tinygltf::Primitive primitive;
     primitive.mode = TINYGLTF_MODE_TRIANGLES;
     primitive.indices = add.accessor(model_.triangles.data(), 4 * model_.triangles.size(),
@@ -199,7 +156,7 @@ class SkinnedGlbSink final : public FrameSink {
     skin.name = "clusters";
     std::vector<float> inverse_binds(16 * joints, 0.0f);
     tinygltf::Value::Array frame_errors;
-    for (double error : frame_rms_error_) frame_errors.emplace_back(error);
+    for (double error : track_.frame_rms_error) frame_errors.emplace_back(error);
     tinygltf::Scene scene;
     scene.nodes.push_back(0);
     for (size_t j = 0; j < joints; ++j) {
@@ -220,12 +177,12 @@ class SkinnedGlbSink final : public FrameSink {
     skin.inverseBindMatrices = add.floats(inverse_binds, TINYGLTF_TYPE_MAT4, 16);
     // In the asset's extras: tinygltf writes no skin extras.
     gltf.asset.extras = tinygltf::Value(tinygltf::Value::Object{{"skinning", tinygltf::Value(tinygltf::Value::Object{
-        {"skinning_error_rms", tinygltf::Value(relative_rms_)},
-        {"skinning_error_max", tinygltf::Value(relative_max_)},
+        {"skinning_error_rms", tinygltf::Value(error_.relative_rms)},
+        {"skinning_error_max", tinygltf::Value(error_.relative_max)},
         {"skinning_error_relative_to", tinygltf::Value(std::string("the bake's RMS displacement from rest"))},
-        {"rms_displacement_m", tinygltf::Value(rms_displacement)},
-        {"rms_error_m", tinygltf::Value(rms_error)},
-        {"largest_error_m", tinygltf::Value(largest_error_)},
+        {"rms_displacement_m", tinygltf::Value(error_.rms_displacement)},
+        {"rms_error_m", tinygltf::Value(error_.rms_error)},
+        {"largest_error_m", tinygltf::Value(track_.largest_error)},
         {"frame_rms_error_m", tinygltf::Value(frame_errors)},
         {"clusters", tinygltf::Value(int(model_.cluster_count()))},
         {"joints", tinygltf::Value(int(joints))}})}});
@@ -235,14 +192,14 @@ class SkinnedGlbSink final : public FrameSink {
       tinygltf::Animation animation;
       animation.name = "wind";
       // A loop closes with the first frame's keys again at the loop's end.
-      std::vector<float> times = times_;
+      std::vector<float> times = track_.times;
       if (info_.loop) times.push_back(float(info_.loop_end_time));
       const int input = add.floats(times, TINYGLTF_TYPE_SCALAR, 1);
       add.bound(input, times, 1);
       std::vector<float> keys;
       for (size_t j = 0; j < joints; ++j) {
         for (const auto& [path, width] : {std::pair{"translation", 3}, std::pair{"rotation", 4}}) {
-          const std::vector<float>& all = width == 3 ? translations_ : rotations_;
+          const std::vector<float>& all = width == 3 ? track_.translations : track_.rotations;
           keys.clear();
           for (size_t k = 0; k < times.size(); ++k) {
             const size_t f = k % frames;
@@ -284,14 +241,8 @@ class SkinnedGlbSink final : public FrameSink {
   FrameSelection selection_;
   Skin skin_;
   std::vector<float> rest_;                          // (N*3) m, the bind pose
-  std::vector<RigidMotion> motions_;                 // (J) scratch: this frame's fitted motions
-  std::vector<Eigen::Quaterniond> previous_rotation_;  // (J) last key, for sign continuity
-  std::vector<float> translations_;                  // (F*J*3) m, local to the parent joint
-  std::vector<float> rotations_;                     // (F*J*4) unit quaternions (x, y, z, w)
-  std::vector<float> times_;                         // (F) s
-  std::vector<double> frame_rms_error_;              // (F) m, RMS over the vertices of skinned - baked
-  double squared_error_ = 0, largest_error_ = 0, squared_displacement_ = 0;  // m^2, m, m^2
-  double relative_rms_ = 0, relative_max_ = 0;       // of the RMS displacement, after finish()
+  SkinTrack track_;                                  // every written frame's keys and errors
+  SkinError error_;                                  // after finish()
 };
 
 }  // namespace

@@ -100,6 +100,25 @@ TEST_F(Cli, InfoJsonGivesExactSkeletonCounts) {
   for (const char* key : {"clusters", "memberships", "mass_kg"}) EXPECT_TRUE(info["model"].contains(key));
 }
 
+// Each output's estimate: 12 bytes a vertex and frame for the HDF5 positions, the USD text's
+// ~36 characters a point, ~96 a joint skinned (io/output_estimate.cpp).
+TEST_F(Cli, InfoEstimatesEachOutput) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("info --json " + scene.string() +
+                       R"( --set 'outputs=[{"format": "hdf5", "path": "b.h5"}, {"format": "usd", "path": "t.usda"},)"
+                       R"( {"format": "usd", "path": "s.usda", "skinned": true}]')");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto info = nlohmann::json::parse(r.out);
+  const auto& outputs = info["estimate"]["outputs"];
+  ASSERT_EQ(outputs.size(), 3u);
+  const double vertices = info["mesh"]["vertices"].get<double>(), joints = info["model"]["clusters"].get<double>();
+  EXPECT_EQ(outputs[0]["format"], "hdf5");
+  EXPECT_EQ(outputs[0]["bytes"].get<double>(), 5 * 12 * vertices);
+  EXPECT_EQ(outputs[1]["path"], "t.usda");
+  EXPECT_EQ(outputs[1]["bytes"].get<double>(), 5 * 36 * vertices);
+  EXPECT_EQ(outputs[2]["bytes"].get<double>(), 5 * 96 * joints);
+}
+
 // A cpfg object (tests/data/cpfg): plant.v names leaf.s for ~l, a 3 x 2-quad patch of 12 points
 // and 12 triangles; four leaves on a stem of two segments (25 vertices, 40 triangles).
 TEST_F(Cli, ViewFileSurfaceIsTheLeafShapeAndBakes) {

@@ -61,13 +61,13 @@ TEST(OutputFormats, RowsAreComplete) {
 }
 
 TEST(OutputFormats, SizeEstimatesPerFormat) {
-  // 100 vertices, 50 triangles, 10 frames written every 3rd: 4 frames of 1200 bytes of vectors.
+  // 100 vertices, 50 triangles, 7 clusters, 10 frames written every 3rd: 4 frames of 1200 bytes of vectors.
   auto bytes = [](const char* format, auto&& set) {
     OutputOptions o;
     o.format = find_output_format(format);
     o.frame_step = 3;
     set(o);
-    return estimated_output_bytes(o, 100, 50, 10);
+    return estimated_output_bytes(o, 100, 50, 7, 10);
   };
   auto plain = [](OutputOptions&) {};
   auto with_normals = [](OutputOptions& o) { o.normals = true; };
@@ -79,7 +79,11 @@ TEST(OutputFormats, SizeEstimatesPerFormat) {
   for (const char* format : {"glb", "pc2", "mdd"}) EXPECT_EQ(bytes(format, with_normals), 9600) << format;
   EXPECT_EQ(bytes("vat", plain), 12800);
   EXPECT_EQ(bytes("vat", [](OutputOptions& o) { o.vat_half = true; }), 6400);
-  EXPECT_EQ(bytes("skinned_glb", plain), 0);
+  EXPECT_EQ(bytes("skinned_glb", plain), 4 * 28 * 7);  // a joint per cluster
+  EXPECT_EQ(bytes("skinned_glb", [](OutputOptions& o) { o.max_joints = 5; }), 4 * 28 * 5);
+  EXPECT_EQ(bytes("usd", plain), 4 * 36 * 100);
+  EXPECT_EQ(bytes("usd", with_normals), 4 * (36 + 38) * 100);
+  EXPECT_EQ(bytes("usd", [](OutputOptions& o) { o.skinned = true; }), 4 * 96 * 7);
 }
 
 }  // namespace
