@@ -26,7 +26,7 @@ OutputOptions read_output_options(SceneObject element) {
     options.quantize = element.optional_number("quantize", Range{1e-9, 1.0, false, false}).value_or(0.0);
   }
   if (options.format == "hdf5" || options.format == "obj" || options.format == "gltf" || options.format == "glb")
-    options.normals = element.boolean("normals", false);
+    options.normals = element.boolean("normals", options.format == "gltf" || options.format == "glb");  // smooth shading
   if (options.format == "vat") {
     options.normals = true;  // the normals texture
     options.texture_width = static_cast<size_t>(element.integer("texture_width", 0, 0, 8192));
