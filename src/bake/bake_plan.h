@@ -30,7 +30,7 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config);
 // The simulation time of `frame` (s).
 double frame_time(const BakePlan& plan, long long frame);
 
-// scene, plan => what the outputs record of the bake.
-BakeInfo bake_info(const Scene& scene, const BakePlan& plan);
+// scene, plan, the tree's model => what the outputs record of the bake (its materials and leaf colours too).
+BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& model);
 
 }  // namespace treeanim

@@ -64,7 +64,7 @@ Eigen::AlignedBox3d world_bounds(const Eigen::AlignedBox3d& own, const TreePlace
 }  // namespace
 
 BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model)
-    : info(bake_info(scene, plan)),
+    : info(bake_info(scene, plan, model)),
       output_count(scene.outputs.size()),
       outputs(scene.outputs, config.out_dir, model, info) {}
 

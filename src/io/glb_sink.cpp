@@ -5,9 +5,13 @@
 // nlohmann_json, streamed: the JSON chunk's room is reserved up front (its numbers at their
 // longest) and filled in by finish(), the frames go straight to the BIN chunk.
 //
-// BIN layout (every part a multiple of 4 bytes): indices u32 [T*3], rest positions f32 [N*3],
-// (with normals: rest normals f32 [N*3]), UVs f32 [N*2], targets f32 [F][N*3] (with normals
-// [F][2][N*3]: a frame's position then normal displacements), times f32 [F], weights f32 [F*F].
+// The mesh is io/gltf_mesh.h's: one vertex set, a primitive per material, each primitive with
+// the same targets.
+//
+// BIN layout (every part a multiple of 4 bytes): indices u32 [T*3] grouped by material, rest
+// positions f32 [N*3], (with normals: rest normals f32 [N*3]), UVs f32 [N*2], (with vertex colours:
+// f32 [N*3]), targets f32 [F][N*3] (with normals [F][2][N*3]: a frame's position then normal
+// displacements), times f32 [F], weights f32 [F*F].
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -18,6 +22,7 @@
 #include "common/errors.h"
 #include "io/frame_sink.h"
 #include "io/glb_size.h"
+#include "io/gltf_mesh.h"
 #include "io/obj_format.h"
 #include "io/output_file.h"
 #include "io/staged_files.h"
@@ -55,6 +60,10 @@ struct Bounds {
 struct GlbLayout {
   bool normals = false;  // NORMAL on the mesh and on every target
   bool loop = false;     // a closing key brings the first frame back at the loop's end
+  bool colors = false;   // COLOR_0, the per-leaf colour factors
+  std::array<uint64_t, kMaterialCount> corners{};  // index count of each material's primitive
+  std::array<SurfaceMaterial, kMaterialCount> materials;
+  uint64_t primitives() const { return uint64_t(std::count_if(corners.begin(), corners.end(), [](uint64_t c) { return c > 0; })); }
   // Animation keys for f frames: one per frame, and the closing one of a loop.
   uint64_t keys(uint64_t f) const { return f + (loop && f > 0 ? 1 : 0); }
 };
@@ -80,9 +89,21 @@ nlohmann::json bounds_json(const std::array<float, 3>& values, bool placeholder)
 // Bytes of one vertex attribute per vertex set that a frame's target holds: 1, or 2 with normals.
 uint64_t target_sets(bool normals) { return normals ? 2 : 1; }
 
+// Bytes of the static vertex attributes: rest positions (and normals), UVs, (colours).
+uint64_t static_vertex_bytes(uint64_t n, const GlbLayout& layout) {
+  return 12 * n * target_sets(layout.normals) + 8 * n + (layout.colors ? 12 * n : 0);
+}
+
 uint64_t bin_bytes(size_t vertices, size_t triangles, size_t frames, const GlbLayout& layout) {
   const uint64_t n = vertices, f = frames, sets = target_sets(layout.normals), keys = layout.keys(f);
-  return 12 * uint64_t(triangles) + 12 * n * sets + 8 * n + 12 * n * sets * f + 4 * keys + 4 * f * keys;
+  return 12 * uint64_t(triangles) + static_vertex_bytes(n, layout) + 12 * n * sets * f + 4 * keys + 4 * f * keys;
+}
+
+// model, bake, options => what the GLB carries.
+GlbLayout glb_layout(const TreeModel& model, const BakeInfo& info, bool normals) {
+  GlbLayout layout{normals, info.loop, !info.vertex_colors.empty(), {}, info.materials};
+  for (uint8_t m : model.triangle_material) layout.corners[m] += 3;
+  return layout;
 }
 
 std::string render_json(const GlbContent& c) {
@@ -91,10 +112,10 @@ std::string render_json(const GlbContent& c) {
   const uint64_t keys = c.layout.keys(f);
   const uint64_t indices_bytes = 12 * t, rest_bytes = 12 * n * sets, uv_bytes = 8 * n;
   const uint64_t frame_bytes = 12 * n * sets, targets_bytes = frame_bytes * f;
-  const uint64_t targets_offset = indices_bytes + rest_bytes + uv_bytes;
+  const uint64_t targets_offset = indices_bytes + static_vertex_bytes(n, c.layout);
   const uint64_t times_offset = targets_offset + targets_bytes;
 
-  // Views 0-2: indices, rest positions (and normals, one view: stride 12), UVs.
+  // Views 0-2: indices, rest positions (and normals, one view: stride 12), UVs; 3: colours.
   json views = json::array({
       {{"buffer", 0}, {"byteOffset", 0}, {"byteLength", indices_bytes}, {"target", kElementArrayBuffer}},
       {{"buffer", 0}, {"byteOffset", indices_bytes}, {"byteLength", rest_bytes}, {"byteStride", 12},
@@ -103,17 +124,33 @@ std::string render_json(const GlbContent& c) {
        {"target", kArrayBuffer}},
   });
   json accessors = json::array({
-      {{"bufferView", 0}, {"componentType", kUnsignedInt}, {"count", 3 * t}, {"type", "SCALAR"}},
       {{"bufferView", 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"},
        {"min", bounds_json(c.rest ? c.rest->min : std::array<float, 3>{}, c.placeholder)},
        {"max", bounds_json(c.rest ? c.rest->max : std::array<float, 3>{}, c.placeholder)}},
       {{"bufferView", 2}, {"componentType", kFloat}, {"count", n}, {"type", "VEC2"}},
   });
-  json primitive = {{"attributes", {{"POSITION", 1}, {"TEXCOORD_0", 2}}}, {"indices", 0}, {"mode", 4}};
+  json attributes = {{"POSITION", 0}, {"TEXCOORD_0", 1}};
   if (c.layout.normals) {
-    primitive["attributes"]["NORMAL"] = accessors.size();
+    attributes["NORMAL"] = accessors.size();
     accessors.push_back({{"bufferView", 1}, {"byteOffset", 12 * n}, {"componentType", kFloat}, {"count", n},
                          {"type", "VEC3"}});
+  }
+  if (c.layout.colors) {
+    attributes["COLOR_0"] = accessors.size();
+    views.push_back({{"buffer", 0}, {"byteOffset", indices_bytes + rest_bytes + uv_bytes}, {"byteLength", 12 * n},
+                     {"target", kArrayBuffer}});
+    accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
+  }
+  // A primitive per material that has triangles, over its part of the index view.
+  json primitives = json::array();
+  uint64_t first_corner = 0;
+  for (size_t m = 0; m < kMaterialCount; ++m) {
+    const uint64_t count = c.layout.corners[m];
+    if (count == 0) continue;
+    primitives.push_back({{"attributes", attributes}, {"indices", accessors.size()}, {"material", m}, {"mode", 4}});
+    accessors.push_back({{"bufferView", 0}, {"byteOffset", 4 * first_corner}, {"componentType", kUnsignedInt},
+                         {"count", count}, {"type", "SCALAR"}});
+    first_corner += count;
   }
   json mesh = {{"name", "tree"}};
   json document = {
@@ -125,6 +162,7 @@ std::string render_json(const GlbContent& c) {
   };
   if (f > 0) {
     // Several target accessors share one view: glTF then requires its byteStride.
+    const size_t targets_view = views.size();
     views.push_back({{"buffer", 0}, {"byteOffset", targets_offset}, {"byteLength", targets_bytes},
                      {"byteStride", 12}, {"target", kArrayBuffer}});
     views.push_back({{"buffer", 0}, {"byteOffset", times_offset}, {"byteLength", 4 * keys}});
@@ -133,22 +171,23 @@ std::string render_json(const GlbContent& c) {
     for (uint64_t k = 0; k < f; ++k) {
       const Bounds bounds = c.placeholder ? Bounds{} : c.targets[k];
       targets.push_back({{"POSITION", accessors.size()}});
-      accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k}, {"componentType", kFloat},
+      accessors.push_back({{"bufferView", targets_view}, {"byteOffset", frame_bytes * k}, {"componentType", kFloat},
                            {"count", n}, {"type", "VEC3"}, {"min", bounds_json(bounds.min, c.placeholder)},
                            {"max", bounds_json(bounds.max, c.placeholder)}});
       if (c.layout.normals) {  // glTF asks bounds of POSITION only
         targets.back()["NORMAL"] = accessors.size();
-        accessors.push_back({{"bufferView", 3}, {"byteOffset", frame_bytes * k + 12 * n}, {"componentType", kFloat},
-                             {"count", n}, {"type", "VEC3"}});
+        accessors.push_back({{"bufferView", targets_view}, {"byteOffset", frame_bytes * k + 12 * n},
+                             {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
       }
     }
     const size_t times_accessor = accessors.size();
     const double longest = -1.7976931348623157e308;
-    accessors.push_back({{"bufferView", 4}, {"componentType", kFloat}, {"count", keys}, {"type", "SCALAR"},
+    accessors.push_back({{"bufferView", targets_view + 1}, {"componentType", kFloat}, {"count", keys}, {"type", "SCALAR"},
                          {"min", json::array({c.placeholder ? longest : double(c.time_min)})},
                          {"max", json::array({c.placeholder ? longest : double(c.time_max)})}});
-    accessors.push_back({{"bufferView", 5}, {"componentType", kFloat}, {"count", f * keys}, {"type", "SCALAR"}});
-    primitive["targets"] = targets;
+    accessors.push_back({{"bufferView", targets_view + 2}, {"componentType", kFloat}, {"count", f * keys},
+                         {"type", "SCALAR"}});
+    for (json& primitive : primitives) primitive["targets"] = targets;
     mesh["weights"] = json(std::vector<double>(f, 0.0));
     mesh["extras"] = {{"targetNames", c.target_names}};
     document["animations"] = json::array({{
@@ -158,8 +197,9 @@ std::string render_json(const GlbContent& c) {
         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}})},
     }});
   }
-  mesh["primitives"] = json::array({primitive});
+  mesh["primitives"] = primitives;
   document["meshes"] = json::array({mesh});
+  document["materials"] = gltf_materials_json(c.layout.materials);
   document["buffers"] = json::array({{{"byteLength", bin_bytes(n, t, f, c.layout)}}});
   document["bufferViews"] = views;
   document["accessors"] = accessors;
@@ -208,8 +248,9 @@ class GlbSizeBound {
     json target = {{"POSITION", kMax}};
     if (layout.normals) target["NORMAL"] = kMax;
     const json name = "frame_-9223372036854775808";
-    per_frame_json_ = target_sets(layout.normals) * (accessor.dump().size() + 1) + target.dump().size() +
-                      name.dump().size() + json(0.0).dump().size() + 3;
+    per_frame_json_ = target_sets(layout.normals) * (accessor.dump().size() + 1) +
+                      layout.primitives() * (target.dump().size() + 1) + name.dump().size() +
+                      json(0.0).dump().size() + 3;
     no_frame_json_ = render_json(placeholder_content(model, generator, layout, 0, {})).size();
     one_frame_json_ = render_json(placeholder_content(model, generator, layout, 1, {name.get<std::string>()})).size();
   }
@@ -245,8 +286,8 @@ class GlbSink final : public FrameSink {
   GlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : path_(std::move(path)), model_(model),
         selection_{info.frame_start, info.frame_count, options.frame_step},
-        loop_end_time_(info.loop_end_time),
-        content_(placeholder_content(model, info.generator, GlbLayout{options.normals, info.loop},
+        loop_end_time_(info.loop_end_time), vertex_colors_(info.vertex_colors),
+        content_(placeholder_content(model, info.generator, glb_layout(model, info, options.normals),
                                      size_t(selection_.written()),
                                      target_names(selection_))) {}
 
@@ -258,18 +299,15 @@ class GlbSink final : public FrameSink {
     rest_ = rest_positions_f32(model_);
     file_.emplace(staged_.stage(path_), path_);
     file_->write(std::string(12 + 8 + reserved_json_ + 8, '\0'));  // header and JSON, filled by finish()
-    for (uint32_t index : model_.triangles) file_->write_u32_le(index);
+    for (uint32_t index : material_indices(model_).corners) file_->write_u32_le(index);
     file_->write_f32_le(rest_.data(), rest_.size());
     if (content_.layout.normals) {
       rest_normals_ = rest_normals(model_);
       file_->write_f32_le(rest_normals_.data(), rest_normals_.size());
     }
-    std::vector<float> uvs(2 * model_.vertex_count());
-    for (size_t v = 0; v < model_.vertex_count(); ++v) {
-      uvs[2 * v] = model_.uvs(0, long(v));
-      uvs[2 * v + 1] = 1.0f - model_.uvs(1, long(v));  // glTF's v runs down the image, OBJ's up
-    }
+    const std::vector<float> uvs = gltf_uvs(model_);
     file_->write_f32_le(uvs.data(), uvs.size());
+    file_->write_f32_le(vertex_colors_.data(), vertex_colors_.size());
     Bounds rest;
     for (size_t i = 0; i < rest_.size(); i += 3) rest.add(&rest_[i]);
     content_.rest = rest;
@@ -336,6 +374,7 @@ class GlbSink final : public FrameSink {
   const TreeModel& model_;
   FrameSelection selection_;
   double loop_end_time_;  // s, the closing key's time when the bake is a loop
+  std::vector<float> vertex_colors_;   // (N*3) COLOR_0, or empty
   GlbContent content_;
   size_t reserved_json_ = 0;           // bytes of the JSON chunk
   std::vector<float> rest_;            // (N*3) m, float rest pose the displacements are taken from
@@ -349,13 +388,13 @@ class GlbSink final : public FrameSink {
 
 uint64_t animated_glb_bytes(const TreeModel& model, const BakeInfo& info, int frame_step, bool normals) {
   const FrameSelection selection{info.frame_start, info.frame_count, frame_step};
-  return GlbSizeBound(model, info.generator, GlbLayout{normals, info.loop}).bytes(uint64_t(selection.written()));
+  return GlbSizeBound(model, info.generator, glb_layout(model, info, normals)).bytes(uint64_t(selection.written()));
 }
 
 std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
   const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
-  const GlbSizeBound bound(model, info.generator, GlbLayout{options.normals, info.loop});
+  const GlbSizeBound bound(model, info.generator, glb_layout(model, info, options.normals));
   const uint64_t bytes = bound.bytes(uint64_t(selection.written()));
   if (bytes > kGlbMaxBytes) {
     const uint64_t fits = bound.frames_within(kGlbMaxBytes);  // written frames

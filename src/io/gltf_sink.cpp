@@ -1,12 +1,13 @@
-// glTF sequence through assimp's "glb2" exporter: one self-contained .glb per written frame
-// ("<name>.%04d.glb"), mesh with positions, UVs (and normals when asked) and the shared triangle list.
-#include <assimp/Exporter.hpp>
-#include <assimp/material.h>
-#include <assimp/scene.h>
+// glTF sequence: one self-contained .glb per written frame ("<name>.%04d.glb"), the tree's mesh
+// (io/gltf_mesh.h: positions, UVs, normals unless turned off, materials) at that frame.
+#include <cstring>
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/gltf_mesh.h"
+#include "io/obj_format.h"
 #include "io/staged_files.h"
+#include "io/vertex_normals.h"
 
 namespace treeanim {
 
@@ -14,53 +15,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The rest mesh as an aiScene (one node, one mesh, one default material: assimp's glTF 2
-// exporter dereferences the mesh's material, so a scene without one cannot be exported).
-std::unique_ptr<aiScene> make_scene(const TreeModel& model, bool with_normals) {
-  auto scene = std::make_unique<aiScene>();
-  scene->mRootNode = new aiNode("tree");
-  scene->mRootNode->mNumMeshes = 1;
-  scene->mRootNode->mMeshes = new unsigned[1]{0};
-  auto* material = new aiMaterial();
-  const aiString material_name("bark");
-  material->AddProperty(&material_name, AI_MATKEY_NAME);
-  scene->mNumMaterials = 1;
-  scene->mMaterials = new aiMaterial*[1]{material};
-
-  auto* mesh = new aiMesh();
-  mesh->mName = aiString("tree");
-  mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
-  mesh->mMaterialIndex = 0;
-  const unsigned n = unsigned(model.vertex_count());
-  mesh->mNumVertices = n;
-  mesh->mVertices = new aiVector3D[n];
-  mesh->mTextureCoords[0] = new aiVector3D[n];
-  mesh->mNumUVComponents[0] = 2;
-  if (with_normals) mesh->mNormals = new aiVector3D[n];
-  for (unsigned v = 0; v < n; ++v) {
-    mesh->mVertices[v] = aiVector3D(float(model.rest_positions(0, v)), float(model.rest_positions(1, v)),
-                                    float(model.rest_positions(2, v)));
-    // assimp keeps OBJ's convention (v up) and flips v itself when writing glTF.
-    mesh->mTextureCoords[0][v] = aiVector3D(model.uvs(0, v), model.uvs(1, v), 0.0f);
-  }
-  mesh->mNumFaces = unsigned(model.triangle_count());
-  mesh->mFaces = new aiFace[mesh->mNumFaces];
-  for (unsigned t = 0; t < mesh->mNumFaces; ++t) {
-    aiFace& face = mesh->mFaces[t];
-    face.mNumIndices = 3;
-    face.mIndices = new unsigned[3];
-    for (int corner = 0; corner < 3; ++corner) face.mIndices[corner] = model.triangles[3 * t + corner];
-  }
-  scene->mNumMeshes = 1;
-  scene->mMeshes = new aiMesh*[1]{mesh};
-  return scene;
-}
-
 class GltfSink final : public FrameSink {
  public:
   GltfSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
-      : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model), normals_(options.normals),
-        selection_{info.frame_start, info.frame_count, options.frame_step} {}
+      : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model), info_(info),
+        normals_(options.normals), selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
     for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
@@ -71,30 +30,45 @@ class GltfSink final : public FrameSink {
     return {pattern_.frame(selection_.start)};
   }
 
-  void begin() override { scene_ = make_scene(model_, normals_); }
-
-  void write(const FrameData& frame) override {
-    aiMesh* mesh = scene_->mMeshes[0];
-    for (unsigned v = 0; v < mesh->mNumVertices; ++v)
-      mesh->mVertices[v] = aiVector3D(frame.positions[3 * v], frame.positions[3 * v + 1], frame.positions[3 * v + 2]);
+  // The rest mesh; write() replaces its positions and normals in the buffer frame by frame.
+  void begin() override {
+    GltfBuilder add(gltf_);
+    std::map<std::string, int> attributes;
+    const std::vector<float> rest = rest_positions_f32(model_);
+    attributes["POSITION"] = position_ = add.floats(rest, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    set_bounds(gltf_, position_, rest, 3);
     if (normals_)
-      for (unsigned v = 0; v < mesh->mNumVertices; ++v)
-        mesh->mNormals[v] = aiVector3D(frame.normals[3 * v], frame.normals[3 * v + 1], frame.normals[3 * v + 2]);
-    const fs::path target = pattern_.frame(frame.frame);
-    const fs::path temporary = staged_.stage(target);
-    if (exporter_.Export(scene_.get(), "glb2", temporary.string()) != aiReturn_SUCCESS)
-      throw OutputError(target.string() + ": assimp could not write the glTF frame: " +
-                        exporter_.GetErrorString());
+      attributes["NORMAL"] = normal_ = add.floats(rest_normals(model_), TINYGLTF_TYPE_VEC3, 3,
+                                                  TINYGLTF_TARGET_ARRAY_BUFFER);
+    attributes["TEXCOORD_0"] = add.floats(gltf_uvs(model_), TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+    add_tree_scene(add, model_, info_, attributes);
   }
 
+  void write(const FrameData& frame) override {
+    replace(position_, frame.positions);
+    set_bounds(gltf_, position_, frame.positions, 3);
+    if (normals_) replace(normal_, frame.normals);
+    const fs::path target = pattern_.frame(frame.frame);
+    const fs::path temporary = staged_.stage(target);
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToFile(&gltf_, temporary.string(), false, true, false, true))
+      throw OutputError(io_failure(target, "tinygltf could not write the glTF frame"));
+  }
 
  private:
+  // Overwrites the data of float accessor `accessor` (its own view) with `values`.
+  void replace(int accessor, const std::vector<float>& values) {
+    const tinygltf::BufferView& view = gltf_.bufferViews[size_t(gltf_.accessors[size_t(accessor)].bufferView)];
+    std::memcpy(gltf_.buffers[0].data.data() + view.byteOffset, values.data(), view.byteLength);
+  }
+
   SequencePattern pattern_;
   const TreeModel& model_;
+  BakeInfo info_;
   bool normals_;  // NORMAL in every frame
   FrameSelection selection_;
-  std::unique_ptr<aiScene> scene_;  // rest mesh, positions replaced per frame
-  Assimp::Exporter exporter_;
+  tinygltf::Model gltf_;  // the mesh; positions and normals replaced per frame
+  int position_ = -1, normal_ = -1;  // accessors
 };
 
 }  // namespace

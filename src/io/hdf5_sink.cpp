@@ -166,6 +166,8 @@ class Hdf5Sink final : public FrameSink {
     write_array(group.get(), "rest_positions", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {n, 3}, rest_.data());
     write_array(group.get(), "triangles", H5T_STD_U32LE, H5T_NATIVE_UINT32, {model_.triangle_count(), 3},
                 model_.triangles.data());
+    write_array(group.get(), "triangle_material", H5T_STD_U8LE, H5T_NATIVE_UINT8, {model_.triangle_count()},
+                model_.triangle_material.data());
   }
 
   void write_model() const {

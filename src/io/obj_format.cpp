@@ -28,9 +28,10 @@ std::vector<float> rest_positions_f32(const TreeModel& model) {
   return std::vector<float>(rest, rest + 3 * model.vertex_count());
 }
 
-std::string obj_shared_lines(const TreeModel& model, bool with_normals) {
+std::string obj_shared_lines(const TreeModel& model, const std::string& mtl_name, bool with_normals) {
   std::string out;
   out.reserve(24 * model.vertex_count() + 40 * model.triangle_count());
+  out += "mtllib " + mtl_name + "\n";
   for (size_t v = 0; v < model.vertex_count(); ++v) {
     out += "vt ";
     append_number(out, model.uvs(0, long(v)));
@@ -39,6 +40,11 @@ std::string obj_shared_lines(const TreeModel& model, bool with_normals) {
     out += '\n';
   }
   for (size_t t = 0; t < model.triangle_count(); ++t) {
+    if (t == 0 || model.triangle_material[t] != model.triangle_material[t - 1]) {
+      out += "usemtl ";
+      out += kMaterialNames[model.triangle_material[t]];
+      out += '\n';
+    }
     out += 'f';
     for (int corner = 0; corner < 3; ++corner) {
       const uint32_t index = model.triangles[3 * t + corner] + 1;  // OBJ counts from 1
@@ -54,6 +60,30 @@ std::string obj_shared_lines(const TreeModel& model, bool with_normals) {
     out += '\n';
   }
   return out;
+}
+
+void write_mtl_file(const std::filesystem::path& temporary, const std::filesystem::path& target,
+                    std::string_view comment, const std::array<SurfaceMaterial, kMaterialCount>& materials) {
+  std::string text = "# ";
+  text += comment;
+  text += '\n';
+  for (const SurfaceMaterial& m : materials) {
+    // Ns from the roughness as Blender's importer inverts it (roughness = 1 - sqrt(Ns / 1000)).
+    const float shininess = float(1000.0 * (1.0 - m.roughness) * (1.0 - m.roughness));
+    text += std::string("\nnewmtl ") + m.name + "\nKd";
+    for (float c : m.base_color) {
+      text += ' ';
+      append_number(text, c);
+    }
+    text += "\nNs ";
+    append_number(text, shininess);
+    text += "\nPr ";
+    append_number(text, float(m.roughness));
+    text += "\nPm 0\nd 1\nillum 2\n";
+  }
+  OutputFile file(temporary, target);
+  file.write(text);
+  file.close();
 }
 
 void write_obj_file(const std::filesystem::path& temporary, const std::filesystem::path& target,

@@ -1,6 +1,7 @@
 // OBJ sequence: "<name>.%04d.obj" per written frame plus "<name>.rest.obj", all with the
-// TreeModel's vertex order, the same "vt" and "f" lines, so a sequence loader (Houdini's $F4,
-// Blender's Mesh Sequence Cache) sees one topology.
+// TreeModel's vertex order, the same "vt", "usemtl" and "f" lines, so a sequence loader
+// (Houdini's $F4, Blender's Mesh Sequence Cache) sees one topology; "<name>.rest.mtl" holds the
+// materials every file names.
 #include "common/errors.h"
 #include "io/frame_sink.h"
 #include "io/obj_format.h"
@@ -19,10 +20,12 @@ class ObjSink final : public FrameSink {
  public:
   ObjSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
       : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
-        selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals) {}
+        selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals),
+        mtl_(fs::path(pattern_.rest()).replace_extension(".mtl")) {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
     visit(pattern_.rest());
+    visit(mtl_);
     for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
   }
 
@@ -32,7 +35,8 @@ class ObjSink final : public FrameSink {
   }
 
   void begin() override {
-    shared_ = obj_shared_lines(model_, normals_);
+    shared_ = obj_shared_lines(model_, mtl_.filename().string(), normals_);
+    write_mtl_file(staged_.stage(mtl_), mtl_, info_.generator + ", materials", info_.materials);
     const fs::path rest = pattern_.rest();
     write_obj_file(staged_.stage(rest), rest, info_.generator + ", rest pose, metres, Y up",
                    rest_positions_f32(model_), shared_, normals_ ? rest_normals(model_) : kNoNormals);
@@ -52,7 +56,8 @@ class ObjSink final : public FrameSink {
   BakeInfo info_;
   FrameSelection selection_;
   bool normals_;        // "vn" lines in every file
-  std::string shared_;  // "vt" and "f" lines, identical in every file
+  fs::path mtl_;        // the materials file beside the rest OBJ
+  std::string shared_;  // "mtllib", "vt", "usemtl" and "f" lines, identical in every file
 };
 
 }  // namespace

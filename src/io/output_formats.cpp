@@ -27,6 +27,12 @@ const OutputKey kNormalsKey{.name = "normals",
                             .type = Type::kBoolean,
                             .store = [](OutputOptions& o, double v) { o.normals = v != 0; }};
 
+// The same key on by default: glTF viewers shade a mesh without normals flat.
+const OutputKey kSmoothNormalsKey{.name = "normals",
+                                  .type = Type::kBoolean,
+                                  .fallback = 1,
+                                  .store = [](OutputOptions& o, double v) { o.normals = v != 0; }};
+
 // Positions and, when asked, normals of every vertex: the GLB's morph targets, PC2 and MDD.
 double vector_frame_bytes(const OutputOptions& o, size_t vertices, size_t, size_t) {
   return vector_bytes(vertices) + normal_bytes(o, vertices);
@@ -83,13 +89,13 @@ const std::vector<OutputFormatRow> kFormats = {
        return 32.0 * double(vertices) + (o.normals ? 36.0 * double(vertices) : 0) + 24.0 * double(triangles);
      }},
     {.name = "gltf",
-     .keys = {kNormalsKey},
+     .keys = {kSmoothNormalsKey},
      .make = make_gltf_sink,
      // a file per frame: positions, triangles
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
        return vector_bytes(vertices) + normal_bytes(o, vertices) + 12.0 * double(triangles);
      }},
-    {.name = "glb", .keys = {kNormalsKey}, .make = make_glb_sink, .frame_bytes = vector_frame_bytes},
+    {.name = "glb", .keys = {kSmoothNormalsKey}, .make = make_glb_sink, .frame_bytes = vector_frame_bytes},
     {.name = "pc2", .make = make_pc2_sink, .frame_bytes = vector_frame_bytes},
     {.name = "mdd", .make = make_mdd_sink, .frame_bytes = vector_frame_bytes},
     {.name = "vat",

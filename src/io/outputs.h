@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "io/output_options.h"
+#include "tree/surface_materials.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -27,6 +28,10 @@ struct BakeInfo {
   // loop_end_time (s), so animations add a closing key there.
   bool loop = false;
   double loop_end_time = 0;
+  // The mesh's look: materials by TriangleMaterial, and (V*3) linear colour factors per vertex
+  // (tree/surface_materials.h; empty: no vertex colours).
+  std::array<SurfaceMaterial, kMaterialCount> materials = surface_materials(TreeOptions{});
+  std::vector<float> vertex_colors;
 };
 
 // One simulated frame, converted to float for output.

@@ -24,18 +24,21 @@ class PointCacheSink final : public FrameSink {
   PointCacheSink(CacheFormat format, const OutputOptions& options, const fs::path& path, const TreeModel& model,
                  const BakeInfo& info)
       : format_(format), path_(with_extension(path, format == CacheFormat::kPc2 ? ".pc2" : ".mdd")),
-        rest_(fs::path(path_).replace_extension(".rest.obj")), model_(model), info_(info),
+        rest_(fs::path(path_).replace_extension(".rest.obj")), mtl_(fs::path(path_).replace_extension(".rest.mtl")),
+        model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
   void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
     visit(path_);
     visit(rest_);
+    visit(mtl_);
   }
   std::vector<fs::path> summary_paths() const override { return {path_, rest_}; }
 
   void begin() override {
+    write_mtl_file(staged_.stage(mtl_), mtl_, info_.generator + ", materials", info_.materials);
     write_obj_file(staged_.stage(rest_), rest_, info_.generator + ", rest pose for " + path_.filename().string(),
-                   rest_positions_f32(model_), obj_shared_lines(model_));
+                   rest_positions_f32(model_), obj_shared_lines(model_, mtl_.filename().string()));
     file_.emplace(staged_.stage(path_), path_);
     const auto samples = uint32_t(selection_.written());
     const auto points = uint32_t(model_.vertex_count());
@@ -92,6 +95,7 @@ class PointCacheSink final : public FrameSink {
   CacheFormat format_;
   fs::path path_;  // "<name>.pc2" or "<name>.mdd"
   fs::path rest_;  // "<name>.rest.obj"
+  fs::path mtl_;   // "<name>.rest.mtl", the materials the rest OBJ names
   const TreeModel& model_;
   BakeInfo info_;
   FrameSelection selection_;

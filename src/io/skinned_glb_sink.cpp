@@ -12,6 +12,7 @@
 #include "common/errors.h"
 #include "io/frame_sink.h"
 #include "io/glb_size.h"
+#include "io/gltf_mesh.h"
 #include "io/obj_format.h"
 #include "io/skin_fit.h"
 #include "io/skin_track.h"
@@ -24,57 +25,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Appends views and accessors to a tinygltf model over one growing buffer.
-class GltfBuilder {
- public:
-  explicit GltfBuilder(tinygltf::Model& gltf) : gltf_(gltf) { gltf_.buffers.emplace_back(); }
-
-  int accessor(const void* data, size_t bytes, int component, size_t count, int type, int target = 0) {
-    auto& buffer = gltf_.buffers[0].data;
-    buffer.resize((buffer.size() + 3) / 4 * 4, 0);  // every view 4-byte aligned
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = buffer.size();
-    view.byteLength = bytes;
-    view.target = target;
-    const auto* begin = static_cast<const unsigned char*>(data);
-    buffer.insert(buffer.end(), begin, begin + bytes);
-    gltf_.bufferViews.push_back(view);
-    tinygltf::Accessor a;
-    a.bufferView = int(gltf_.bufferViews.size() - 1);
-    a.componentType = component;
-    a.count = count;
-    a.type = type;
-    gltf_.accessors.push_back(a);
-    return int(gltf_.accessors.size() - 1);
-  }
-
-  int floats(const std::vector<float>& values, int type, int components, int target = 0) {
-    return accessor(values.data(), 4 * values.size(), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                    values.size() / size_t(components), type, target);
-  }
-
-  // Per-component bounds of a float accessor (glTF asks them of POSITION and animation inputs).
-  void bound(int index, const std::vector<float>& values, int components) {
-    std::vector<double> low(size_t(components), std::numeric_limits<double>::max());
-    std::vector<double> high(size_t(components), -std::numeric_limits<double>::max());
-    for (size_t i = 0; i < values.size(); ++i) {
-      low[i % size_t(components)] = std::min(low[i % size_t(components)], double(values[i]));
-      high[i % size_t(components)] = std::max(high[i % size_t(components)], double(values[i]));
-    }
-    gltf_.accessors[size_t(index)].minValues = low;
-    gltf_.accessors[size_t(index)].maxValues = high;
-  }
-
- private:
-  tinygltf::Model& gltf_;
-};
-
 // Bytes of the file, bounded from above before simulating (a GLB states its length in 32 bits).
 uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frames) {
   const uint64_t n = model.vertex_count(), t = model.triangle_count(), j = joints;
   constexpr uint64_t kJsonPerJoint = 1024, kJsonFixed = 4096;  // generous: nodes, samplers, channels, accessors
-  return kJsonFixed + kJsonPerJoint * j + 12 * t + n * (12 + 12 + 8 + 8 + 16) + 64 * j + 4 * frames +
+  return kJsonFixed + kJsonPerJoint * j + 12 * t + n * (12 + 12 + 8 + 8 + 16 + 12) + 64 * j + 4 * frames +
          28 * frames * j + 8 * (2 * j + 16);
 }
 
@@ -118,33 +73,23 @@ class SkinnedGlbSink final : public FrameSink {
     tinygltf::Model gltf;
     GltfBuilder add(gltf);
     const size_t n = model_.vertex_count(), joints = skin_.joint_count(), frames = track_.times.size();
-    tinygltf::Primitive primitive;
-    primitive.mode = TINYGLTF_MODE_TRIANGLES;
-    primitive.indices = add.accessor(model_.triangles.data(), 4 * model_.triangles.size(),
-                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, model_.triangles.size(), TINYGLTF_TYPE_SCALAR,
-                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-    primitive.attributes["POSITION"] = add.floats(rest_, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
-    add.bound(primitive.attributes["POSITION"], rest_, 3);
-    primitive.attributes["NORMAL"] = add.floats(rest_normals(model_), TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
-    std::vector<float> uvs(2 * n), weights(4 * n);
+    std::map<std::string, int> attributes;
+    attributes["POSITION"] = add.floats(rest_, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    set_bounds(gltf, attributes["POSITION"], rest_, 3);
+    attributes["NORMAL"] = add.floats(rest_normals(model_), TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    std::vector<float> weights(4 * n);
     std::vector<uint16_t> joint_ids(4 * n);
     for (size_t v = 0; v < n; ++v) {
-      uvs[2 * v] = model_.uvs(0, long(v));
-      uvs[2 * v + 1] = 1.0f - model_.uvs(1, long(v));  // glTF's v runs down the image
       for (size_t k = 0; k < 4; ++k) {
         joint_ids[4 * v + k] = skin_.vertex_joints[v][k];
         weights[4 * v + k] = skin_.vertex_weights[v][k];
       }
     }
-    primitive.attributes["TEXCOORD_0"] = add.floats(uvs, TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
-    primitive.attributes["JOINTS_0"] = add.accessor(joint_ids.data(), 2 * joint_ids.size(),
-                                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, n, TINYGLTF_TYPE_VEC4,
-                                                    TINYGLTF_TARGET_ARRAY_BUFFER);
-    primitive.attributes["WEIGHTS_0"] = add.floats(weights, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    tinygltf::Mesh mesh;
-    mesh.name = "tree";
-    mesh.primitives.push_back(primitive);
-    gltf.meshes.push_back(mesh);
+    attributes["TEXCOORD_0"] = add.floats(gltf_uvs(model_), TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+    attributes["JOINTS_0"] = add.accessor(joint_ids.data(), 2 * joint_ids.size(), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                          n, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    attributes["WEIGHTS_0"] = add.floats(weights, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    add_tree_mesh(add, model_, info_, attributes);
 
     // Node 0 holds the skinned mesh; nodes 1 + j are the joints, at their rest pivots.
     tinygltf::Node mesh_node;
@@ -195,7 +140,7 @@ class SkinnedGlbSink final : public FrameSink {
       std::vector<float> times = track_.times;
       if (info_.loop) times.push_back(float(info_.loop_end_time));
       const int input = add.floats(times, TINYGLTF_TYPE_SCALAR, 1);
-      add.bound(input, times, 1);
+      set_bounds(gltf, input, times, 1);
       std::vector<float> keys;
       for (size_t j = 0; j < joints; ++j) {
         for (const auto& [path, width] : {std::pair{"translation", 3}, std::pair{"rotation", 4}}) {

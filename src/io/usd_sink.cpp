@@ -18,6 +18,7 @@
 #include "io/skin_track.h"
 #include "io/staged_files.h"
 #include "io/usd_text.h"
+#include "tree/surface_materials.h"
 #include "io/vertex_normals.h"
 
 namespace treeanim {
@@ -29,19 +30,6 @@ namespace {
 // Where a sample's line starts: inside the Mesh, inside the SkelAnimation.
 constexpr const char* kSampleIndent = "            ";
 constexpr const char* kKeyIndent = "                ";
-
-// Surface colours in sRGB, until the tree options carry them.
-constexpr std::array<double, 3> kBarkColor = {0.35, 0.25, 0.17};
-constexpr std::array<double, 3> kLeafColor = {0.23, 0.42, 0.12};
-
-// Triangle => 1 when it belongs to a leaf (its vertices are a leaf's), 0 for bark.
-std::vector<uint8_t> leaf_triangles(const TreeModel& model) {
-  std::vector<uint8_t> leaf(model.triangle_count(), 0);
-  for (size_t t = 0; t < model.triangle_count(); ++t)
-    for (int corner = 0; corner < 3; ++corner)
-      if (model.vertex_leaf[model.triangles[3 * t + size_t(corner)]] >= 0) leaf[t] = 1;
-  return leaf;
-}
 
 // The stage's metadata: the frames written are the time codes, one per frame at the bake's rate.
 std::string layer_header(const BakeInfo& info, const FrameSelection& selection, const std::string& custom) {
@@ -67,11 +55,11 @@ void append_sample(std::string& out, const char* indent, long long code, const f
   out += ",\n";
 }
 
-void append_color(std::string& out, const std::array<double, 3>& srgb) {
+void append_color(std::string& out, const std::array<float, 3>& linear) {
   out += '(';
   for (size_t c = 0; c < 3; ++c) {
     if (c > 0) out += ", ";
-    append_usd_number(out, float(srgb_to_linear(srgb[c])));
+    append_usd_number(out, linear[c]);
   }
   out += ')';
 }
@@ -104,37 +92,42 @@ std::string mesh_rest_attributes(const TreeModel& model, bool with_normals) {
   return out;
 }
 
+// The USD prim names of the materials and their subsets, by TriangleMaterial.
+constexpr const char* kMaterialPrims[kMaterialCount] = {"Bark", "Leaf"};
+constexpr const char* kSubsetPrims[kMaterialCount] = {"bark", "leaves"};
+
 // The bark and leaf subsets of the mesh, each bound to its material.
-std::string material_subsets(const std::vector<uint8_t>& leaf, const std::string& indent) {
+std::string material_subsets(const TreeModel& model, const std::string& indent) {
   std::string out;
-  for (const auto& [name, kind] : {std::pair{"bark", uint8_t(0)}, std::pair{"leaves", uint8_t(1)}}) {
-    std::vector<uint32_t> faces;
-    for (size_t t = 0; t < leaf.size(); ++t)
-      if (leaf[t] == kind) faces.push_back(uint32_t(t));
+  const auto triangles = material_triangles(model);
+  for (size_t kind = 0; kind < kMaterialCount; ++kind) {
+    const std::vector<uint32_t>& faces = triangles[kind];
     if (faces.empty()) continue;  // a leafless tree
-    out += '\n' + indent + "def GeomSubset \"" + name + "\" (\n" + indent +
+    out += '\n' + indent + "def GeomSubset \"" + kSubsetPrims[kind] + "\" (\n" + indent +
            "    prepend apiSchemas = [\"MaterialBindingAPI\"]\n" + indent + ")\n" + indent + "{\n";
     out += indent + "    uniform token elementType = \"face\"\n" + indent +
            "    uniform token familyName = \"materialBind\"\n" + indent + "    int[] indices = ";
     append_usd_ints(out, faces.data(), faces.size());
-    out += '\n' + indent + "    rel material:binding = </Tree/Materials/" + (kind ? "Leaf" : "Bark") + ">\n" + indent +
+    out += '\n' + indent + "    rel material:binding = </Tree/Materials/" + kMaterialPrims[kind] + ">\n" + indent +
            "}\n";
   }
   return out;
 }
 
 // The two UsdPreviewSurface materials under /Tree/Materials.
-std::string materials() {
+std::string materials(const std::array<SurfaceMaterial, kMaterialCount>& surfaces) {
   std::string out = "\n    def Scope \"Materials\"\n    {\n";
-  for (const auto& [name, color] : {std::pair{"Bark", kBarkColor}, std::pair{"Leaf", kLeafColor}}) {
-    const std::string path = std::string("/Tree/Materials/") + name;
-    out += "        def Material \"" + std::string(name) + "\"\n        {\n";
+  for (size_t kind = 0; kind < kMaterialCount; ++kind) {
+    const std::string name = kMaterialPrims[kind], path = "/Tree/Materials/" + name;
+    out += "        def Material \"" + name + "\"\n        {\n";
     out += "            token outputs:surface.connect = <" + path + "/Surface.outputs:surface>\n\n";
     out += "            def Shader \"Surface\"\n            {\n";
     out += "                uniform token info:id = \"UsdPreviewSurface\"\n";
     out += "                color3f inputs:diffuseColor = ";
-    append_color(out, color);
-    out += "\n                float inputs:roughness = 0.8\n                token outputs:surface\n            }\n";
+    append_color(out, surfaces[kind].base_color);
+    out += "\n                float inputs:metallic = 0\n                float inputs:roughness = ";
+    append_usd_number(out, float(surfaces[kind].roughness));
+    out += "\n                token outputs:surface\n            }\n";
     out += "        }\n";
   }
   return out + "    }\n";
@@ -203,7 +196,7 @@ class UsdSink final : public FrameSink {
         scratch_->close();
         copy_scratch();
       }
-      file_->write(material_subsets(leaf_triangles(model_), "        ") + "    }\n" + materials() + "}\n");
+      file_->write(material_subsets(model_, "        ") + "    }\n" + materials(info_.materials) + "}\n");
     }
     file_->close();
   }
@@ -324,7 +317,7 @@ class UsdSink final : public FrameSink {
     out += element + "        matrix4d primvars:skel:geomBindTransform = ";
     append_usd_matrix(out, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
     out += "\n        rel skel:skeleton = </Tree/Skeleton>\n";
-    return out + material_subsets(leaf_triangles(model_), "        ") + "    }\n" + materials() + "}\n";
+    return out + material_subsets(model_, "        ") + "    }\n" + materials(info_.materials) + "}\n";
   }
 
   fs::path path_;

@@ -1,7 +1,6 @@
 #include "io/usd_text.h"
 
 #include <charconv>
-#include <cmath>
 
 namespace treeanim {
 
@@ -74,10 +73,6 @@ std::string usd_prim_name(std::string_view name) {
   }
   if (out.empty() || (out[0] >= '0' && out[0] <= '9')) out.insert(out.begin(), '_');
   return out;
-}
-
-double srgb_to_linear(double component) {
-  return component <= 0.04045 ? component / 12.92 : std::pow((component + 0.055) / 1.055, 2.4);
 }
 
 }  // namespace treeanim

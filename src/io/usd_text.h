@@ -29,7 +29,4 @@ std::string usd_quoted(std::string_view text);
 // Any name => a valid prim name: letters, digits and '_', not starting with a digit.
 std::string usd_prim_name(std::string_view name);
 
-// sRGB colour component (0..1) => linear, as UsdPreviewSurface's colour inputs take it.
-double srgb_to_linear(double component);
-
 }  // namespace treeanim

@@ -19,6 +19,7 @@
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/gltf_mesh.h"
 #include "io/obj_format.h"
 #include "io/output_file.h"
 #include "io/staged_files.h"
@@ -94,81 +95,26 @@ class ExrTexture {
 };
 
 // The rest mesh as a GLB: POSITION, NORMAL, TEXCOORD_0 (the model's UVs), TEXCOORD_1 (the texel
-// of each vertex in frame 0, at its centre), indices.
+// of each vertex in frame 0, at its centre), the materials.
 void write_rest_glb(const fs::path& temporary, const fs::path& target, const TreeModel& model,
-                    const VatLayout& layout, const std::string& generator) {
+                    const VatLayout& layout, const BakeInfo& info) {
   const size_t n = model.vertex_count();
-  const std::vector<float> rest = rest_positions_f32(model), normals = rest_normals(model);
-  std::vector<float> uv0(2 * n), uv1(2 * n);
+  const std::vector<float> rest = rest_positions_f32(model);
+  std::vector<float> uv1(2 * n);
   for (size_t v = 0; v < n; ++v) {
-    uv0[2 * v] = model.uvs(0, long(v));
-    uv0[2 * v + 1] = 1.0f - model.uvs(1, long(v));  // glTF's v runs down the image
     const auto [column, row] = layout.texel(v, 0);
     uv1[2 * v] = float((double(column) + 0.5) / double(layout.width));
     uv1[2 * v + 1] = float((double(row) + 0.5) / double(layout.height));
   }
   tinygltf::Model gltf;
-  tinygltf::Buffer buffer;
-  auto append = [&](const void* data, size_t bytes, int target_kind) {
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = buffer.data.size();
-    view.byteLength = bytes;
-    view.target = target_kind;
-    const auto* begin = static_cast<const unsigned char*>(data);
-    buffer.data.insert(buffer.data.end(), begin, begin + bytes);
-    gltf.bufferViews.push_back(view);
-    return int(gltf.bufferViews.size() - 1);
-  };
-  auto accessor = [&](int view, int component, size_t count, int type) {
-    tinygltf::Accessor a;
-    a.bufferView = view;
-    a.componentType = component;
-    a.count = count;
-    a.type = type;
-    gltf.accessors.push_back(a);
-    return int(gltf.accessors.size() - 1);
-  };
-  tinygltf::Primitive primitive;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  primitive.indices = accessor(append(model.triangles.data(), 4 * model.triangles.size(),
-                                      TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, model.triangles.size(), TINYGLTF_TYPE_SCALAR);
-  const int position = accessor(append(rest.data(), 4 * rest.size(), TINYGLTF_TARGET_ARRAY_BUFFER),
-                                TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC3);
-  std::array<double, 3> low{}, high{};
-  for (int a = 0; a < 3; ++a) {
-    low[a] = std::numeric_limits<double>::max();
-    high[a] = -std::numeric_limits<double>::max();
-    for (size_t v = 0; v < n; ++v) {
-      low[a] = std::min(low[a], double(rest[3 * v + a]));
-      high[a] = std::max(high[a], double(rest[3 * v + a]));
-    }
-  }
-  gltf.accessors[size_t(position)].minValues.assign(low.begin(), low.end());
-  gltf.accessors[size_t(position)].maxValues.assign(high.begin(), high.end());
-  primitive.attributes["POSITION"] = position;
-  primitive.attributes["NORMAL"] = accessor(append(normals.data(), 4 * normals.size(), TINYGLTF_TARGET_ARRAY_BUFFER),
-                                            TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC3);
-  primitive.attributes["TEXCOORD_0"] = accessor(append(uv0.data(), 4 * uv0.size(), TINYGLTF_TARGET_ARRAY_BUFFER),
-                                                TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC2);
-  primitive.attributes["TEXCOORD_1"] = accessor(append(uv1.data(), 4 * uv1.size(), TINYGLTF_TARGET_ARRAY_BUFFER),
-                                                TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC2);
-  gltf.buffers.push_back(buffer);
-  tinygltf::Mesh mesh;
-  mesh.name = "tree";
-  mesh.primitives.push_back(primitive);
-  gltf.meshes.push_back(mesh);
-  tinygltf::Node node;
-  node.mesh = 0;
-  node.name = "tree";
-  gltf.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes.push_back(0);
-  gltf.scenes.push_back(scene);
-  gltf.defaultScene = 0;
-  gltf.asset.version = "2.0";
-  gltf.asset.generator = generator;
+  GltfBuilder add(gltf);
+  std::map<std::string, int> attributes;
+  attributes["POSITION"] = add.floats(rest, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+  set_bounds(gltf, attributes["POSITION"], rest, 3);
+  attributes["NORMAL"] = add.floats(rest_normals(model), TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+  attributes["TEXCOORD_0"] = add.floats(gltf_uvs(model), TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+  attributes["TEXCOORD_1"] = add.floats(uv1, TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+  add_tree_scene(add, model, info, attributes);
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToFile(&gltf, temporary.string(), false, true, false, true))
     throw OutputError(io_failure(target, "tinygltf could not write the rest mesh"));
@@ -203,7 +149,7 @@ class VatSink final : public FrameSink {
     positions_.emplace(staged_.stage(positions), positions, layout_, half_);
     normals_.emplace(staged_.stage(normals), normals, layout_, half_);
     const fs::path glb = stem_ + ".glb";
-    write_rest_glb(staged_.stage(glb), glb, model_, layout_, info_.generator);
+    write_rest_glb(staged_.stage(glb), glb, model_, layout_, info_);
     rows_.assign(3 * layout_.width * layout_.rows_per_frame, 0.0f);
   }
 

@@ -13,6 +13,14 @@ static LeafOptions read_leaf_options(SceneObject section) {
   return o;
 }
 
+// An sRGB colour: three numbers in [0, 1] (validated here: vector3 takes any finite numbers).
+static Eigen::Vector3d read_color(SceneObject& section, const std::string& key, const Eigen::Vector3d& fallback) {
+  const Eigen::Vector3d color = section.vector3(key, fallback);
+  if (color.minCoeff() < 0 || color.maxCoeff() > 1)
+    section.fail_expected(key, "an sRGB colour: an array of 3 numbers in [0, 1]");
+  return color;
+}
+
 // /tree/cluster object => cluster options.
 static ClusterOptions read_cluster_options(SceneObject section) {
   ClusterOptions o;
@@ -32,6 +40,9 @@ TreeOptions read_tree_options(SceneObject section) {
   o.wood_density = section.number("wood_density", o.wood_density, Range::positive());
   o.pipe_exponent = section.number("pipe_exponent", o.pipe_exponent, Range::between(1.0, 4.0));
   o.tip_taper = section.number("tip_taper", o.tip_taper, Range::between(0.0, 1.0));
+  o.bark_color = read_color(section, "bark_color", o.bark_color);
+  o.leaf_color = read_color(section, "leaf_color", o.leaf_color);
+  o.leaf_color_variation = section.number("leaf_color_variation", o.leaf_color_variation, Range::between(0.0, 1.0));
   o.leaf = read_leaf_options(section.object("leaf"));
   o.cluster = read_cluster_options(section.object("cluster"));
   return o;

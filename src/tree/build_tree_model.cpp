@@ -121,6 +121,8 @@ TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options)
 
   const BranchRings rings = build_branch_mesh(skeleton, topology, options, model);
   const LeafMeshes leaves = build_leaf_meshes(skeleton, options, shape, counts, model);
+  model.triangle_material.assign(counts.branch_triangles, kMaterialBark);  // the branch mesh comes first
+  model.triangle_material.resize(counts.branch_triangles + counts.leaf_triangles, kMaterialLeaf);
 
   model.segment_start.resize(skeleton.segment_count());
   model.segment_end.resize(skeleton.segment_count());

@@ -9,6 +9,10 @@
 namespace treeanim {
 
 enum ClusterKind : uint8_t { kClusterBranch = 0, kClusterLeaf = 1 };
+// The surface a triangle belongs to; mesh outputs give each its own material (tree/surface_materials.h).
+enum TriangleMaterial : uint8_t { kMaterialBark = 0, kMaterialLeaf = 1 };
+inline constexpr size_t kMaterialCount = 2;
+inline constexpr const char* kMaterialNames[kMaterialCount] = {"bark", "leaf"};  // by TriangleMaterial
 
 struct TreeModel {
   // --- mesh (V vertices, T triangles) ---
@@ -17,6 +21,7 @@ struct TreeModel {
   std::vector<uint32_t> triangles;                // (T*3) vertex ids, counter-clockwise seen from outside
   std::vector<int32_t> vertex_segment;            // (V) segment the vertex was built for; -1 for leaf vertices
   std::vector<int32_t> vertex_leaf;               // (V) leaf the vertex belongs to; -1 for branch vertices
+  std::vector<uint8_t> triangle_material;         // (T) TriangleMaterial
 
   // --- masses and forces ---
   std::vector<double> vertex_mass;                // (V) kg (shared vertices sum their shares)

@@ -1,5 +1,6 @@
 #pragma once
 // Scene section /tree (docs/scene.md), read by scene/ (src/scene/tree_section.h).
+#include <Eigen/Core>
 #include <filesystem>
 #include <optional>
 
@@ -29,6 +30,11 @@ struct TreeOptions {
   double wood_density = 700;   // kg/m^3
   double pipe_exponent = 2.0;  // k of the pipe model r_parent^k = sum r_child^k
   double tip_taper = 0.5;      // top / base radius of a segment that ends an axis
+  // Base colours of the two surface materials, sRGB in [0, 1] as a colour picker gives them
+  // (tree/surface_materials.h converts them for glTF, whose factors are linear).
+  Eigen::Vector3d bark_color = Eigen::Vector3d(0.36, 0.27, 0.19);  // grey-brown bark
+  Eigen::Vector3d leaf_color = Eigen::Vector3d(0.30, 0.47, 0.16);  // mid green foliage
+  double leaf_color_variation = 0.3;  // 0 = every leaf leaf_color; 1 = the widest per-leaf spread
   LeafOptions leaf;
   ClusterOptions cluster;
 };

@@ -39,6 +39,8 @@ void check_mesh(const TreeModel& m) {
   expect_size("uvs", size_t(m.uvs.cols()), V);
   if (m.triangles.size() % 3) fail("triangles size is not a multiple of 3");
   expect_range("triangles", m.triangles, 0, (long long)V);
+  expect_size("triangle_material", m.triangle_material.size(), m.triangle_count());
+  expect_range("triangle_material", m.triangle_material, 0, (long long)kMaterialCount);
   expect_size("vertex_segment", m.vertex_segment.size(), V);
   expect_size("vertex_leaf", m.vertex_leaf.size(), V);
   expect_range("vertex_segment", m.vertex_segment, -1, (long long)m.segment_count());

@@ -79,7 +79,7 @@ TEST_F(BakeStages, PlanOfAFrameRange) {
   EXPECT_EQ(plan.key.scene_hash, bake_key(line, treeanim_generator()));
   EXPECT_EQ(plan.key.generator.rfind("treeanim ", 0), 0u);
   EXPECT_EQ(frame_time(plan, 12), 12.0 * (1.0 / 24));
-  const BakeInfo info = bake_info(line, plan);
+  const BakeInfo info = bake_info(line, plan, TreeModel());
   EXPECT_EQ(info.frame_start, 12);
   EXPECT_EQ(info.frame_count, 2);
   EXPECT_FALSE(info.loop);

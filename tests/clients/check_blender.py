@@ -4,7 +4,9 @@
    error) and checks every shape key against the HDF5 frame it stands for, to 1e-5 m;
 2. imports each point cache's rest OBJ (PC2, and MDD when given), adds a Mesh Cache modifier
    reading the cache, and checks the evaluated vertices at several frames against the HDF5
-   frames, to 1e-5 m.
+   frames, to 1e-5 m;
+3. both: the mesh has the materials bark and leaf, its faces as many of each as
+   /mesh/triangle_material says (the OBJ's face by face).
 
 Usage: blender -b --factory-startup --python check_blender.py -- BAKE.h5 ANIM.glb CACHE.pc2 REST.obj
        [CACHE.mdd REST.obj]
@@ -47,6 +49,20 @@ def y_up(blender_co):
     return np.stack([blender_co[:, 0], blender_co[:, 2], -blender_co[:, 1]], axis=1)
 
 
+def check_materials(path, obj, bake, face_by_face):
+    # Blender suffixes a material name it already has (".001") when a later file brings it again.
+    names = [m.name.split(".")[0] for m in obj.data.materials]
+    check(names == ["bark", "leaf"], f"{path}: materials {names}, expected ['bark', 'leaf']")
+    index = np.empty(len(obj.data.polygons), np.int64)
+    obj.data.polygons.foreach_get("material_index", index)
+    expected = bake["mesh/triangle_material"][()].astype(np.int64)
+    counts, expected_counts = np.bincount(index, minlength=2), np.bincount(expected, minlength=2)
+    check(np.array_equal(counts, expected_counts),
+          f"{path}: {counts.tolist()} bark and leaf faces in Blender, {expected_counts.tolist()} in the bake")
+    if face_by_face:
+        check(np.array_equal(index, expected), f"{path}: face materials differ from /mesh/triangle_material")
+
+
 def check_animated_glb(path, bake):
     clear_scene()
     fps = bake.attrs["fps"]
@@ -54,7 +70,9 @@ def check_animated_glb(path, bake):
     bpy.context.scene.render.fps_base = round(fps) / fps
     bpy.ops.import_scene.gltf(filepath=path, import_shading='SMOOTH')
     obj = only_mesh_object()
-    # The importer keeps the vertices some triangle uses, in ascending id order.
+    check_materials(path, obj, bake, face_by_face=False)
+    # The importer keeps the vertices some triangle uses, in ascending id order (a primitive per
+    # material: the bark's vertices, then the leaves', which come after them in the model).
     used = np.unique(bake["mesh/triangles"][()])
     check(len(obj.data.vertices) == len(used),
           f"{path}: {len(obj.data.vertices)} vertices in Blender, {len(used)} used in the bake")
@@ -84,6 +102,7 @@ def check_mesh_cache(cache, rest_obj, bake):
     # Axes as in the file (no Y-up => Z-up turn), so the cache's coordinates apply unchanged.
     bpy.ops.wm.obj_import(filepath=rest_obj, forward_axis='Y', up_axis='Z')
     obj = only_mesh_object()
+    check_materials(rest_obj, obj, bake, face_by_face=True)
     rest = bake["mesh/rest_positions"][()]
     check(len(obj.data.vertices) == len(rest), f"{rest_obj}: {len(obj.data.vertices)} vertices in Blender, "
           f"{len(rest)} in the bake (Blender drops vertices no face uses)")

@@ -34,19 +34,25 @@ def expect_dataset(f, name, dtype, shape):
     return d[()]
 
 
-def read_obj(path):
+def read_obj(path, materials=None):
+    """positions, UVs, faces; and the usemtl name of each face appended to `materials` when given."""
     positions, uvs, faces = [], [], []
+    material = None
     with open(path) as lines:
         for line in lines:
             fields = line.split()
             if not fields:
                 continue
-            if fields[0] == "v":
+            if fields[0] == "usemtl":
+                material = fields[1]
+            elif fields[0] == "v":
                 positions.append([np.float32(x) for x in fields[1:4]])
             elif fields[0] == "vt":
                 uvs.append([float(x) for x in fields[1:3]])
             elif fields[0] == "f":
                 faces.append([int(c.split("/")[0]) - 1 for c in fields[1:4]])
+                if materials is not None:
+                    materials.append(material)
     return np.array(positions, np.float32), np.array(uvs), np.array(faces, np.uint32)
 
 
@@ -88,6 +94,7 @@ def main():
     t = f["mesh/triangles"].shape[0]
     triangles = expect_dataset(f, "mesh/triangles", np.uint32, (t, 3))
     check(t == 0 or triangles.max() < n, "/mesh/triangles: vertex id out of range")
+    material = expect_dataset(f, "mesh/triangle_material", np.uint8, (t,))
     mass = expect_dataset(f, "model/mass", np.float64, (n,))
     check(np.all(mass > 0), "/model/mass: a vertex without mass")
     anchored = expect_dataset(f, "model/anchored", np.uint8, (n,))
@@ -99,6 +106,17 @@ def main():
     check(offsets[0] == 0 and np.all(np.diff(offsets.astype(np.int64)) > 0), "/model/cluster_offsets: not increasing")
     check(members.size == 0 or members.max() < n, "/model/cluster_members: vertex id out of range")
     check(set(np.unique(kind)) <= {0, 1}, "/model/cluster_kind: values other than 0/1")
+    # A leaf's triangles are the ones whose three vertices all belong to leaf clusters (bark
+    # vertices never do), and they are leaf material: the model's count of each.
+    on_leaf = np.zeros(n, bool)
+    for k in np.flatnonzero(kind == 1):
+        on_leaf[members[offsets[k]:offsets[k + 1]]] = True
+    leaf_triangles = on_leaf[triangles].all(axis=1)
+    check(np.array_equal(material, leaf_triangles.astype(np.uint8)),
+          f"/mesh/triangle_material: {np.count_nonzero(material == 0)} bark and {np.count_nonzero(material == 1)} leaf "
+          f"triangles, the model has {np.count_nonzero(~leaf_triangles)} and {np.count_nonzero(leaf_triangles)}")
+    check(np.count_nonzero(material == 0) > 0 and np.count_nonzero(material == 1) > 0,
+          "/mesh/triangle_material: the tree lacks bark or leaf triangles")
     s = f["skeleton/segment_parent"].shape[0]
     expect_dataset(f, "skeleton/segment_start", np.float32, (s, 3))
     expect_dataset(f, "skeleton/segment_end", np.float32, (s, 3))
@@ -122,7 +140,7 @@ def main():
         check((positions.compression, positions.compression_opts) == expected,
               f"/frames/positions: compression {positions.compression} {positions.compression_opts}")
         check(positions.shuffle == (args.compression > 0), "/frames/positions: shuffle filter")
-    expected_groups = {"frames": {"time", "positions"}, "mesh": {"rest_positions", "triangles"},
+    expected_groups = {"frames": {"time", "positions"}, "mesh": {"rest_positions", "triangles", "triangle_material"},
                        "model": {"mass", "anchored", "cluster_offsets", "cluster_members", "cluster_kind"},
                        "skeleton": {"segment_start", "segment_end", "segment_radius", "segment_parent", "segment_cluster"}}
     if args.velocities == "yes" or (args.velocities is None and "velocities" in f["frames"]):
@@ -141,9 +159,11 @@ def main():
     frame_index = np.rint(time * f.attrs["fps"]).astype(np.int64)
     compared = 0
     if args.obj:
-        obj_rest, obj_uv, obj_faces = read_obj(f"{args.obj}.rest.obj")
+        obj_materials = []
+        obj_rest, obj_uv, obj_faces = read_obj(f"{args.obj}.rest.obj", obj_materials)
         check(np.array_equal(obj_rest, rest), "rest OBJ != /mesh/rest_positions")
         check(np.array_equal(obj_faces, triangles), "rest OBJ faces != /mesh/triangles")
+        check(obj_materials == [("bark", "leaf")[m] for m in material], "rest OBJ usemtl != /mesh/triangle_material")
         for k, index in enumerate(frame_index):
             try:
                 obj_positions, _, obj_faces = read_obj(f"{args.obj}.{index:04d}.obj")

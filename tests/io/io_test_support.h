@@ -31,6 +31,7 @@ inline TreeModel small_model() {
   m.uvs << 0.0f, 1.0f, 1.0f, 0.0f, 0.5f, 1.0f,  //
       0.0f, 0.0f, 1.0f, 1.0f, 0.25f, 0.75f;
   m.triangles = {1, 2, 0, 0, 2, 3, 4, 5, 3};  // first use not in index order: exporters must keep it
+  m.triangle_material = {kMaterialBark, kMaterialBark, kMaterialLeaf};
   m.vertex_segment = {0, 0, 0, 0, -1, -1};
   m.vertex_leaf = {-1, -1, -1, 0, 0, 0};
   m.vertex_mass = {0.5, 0.5, 0.25, 0.3, 0.01, 0.01};
@@ -134,17 +135,23 @@ struct ObjMesh {
   std::vector<float> uvs;         // (V*2)
   std::vector<uint32_t> faces;    // (T*3) 0-based
   std::vector<uint32_t> face_uvs; // (T*3) 0-based
+  std::vector<std::string> face_materials;  // (T) the "usemtl" name in force
+  std::string mtllib;                       // the "mtllib" file
 };
 
 inline ObjMesh parse_obj(const std::filesystem::path& path) {
   ObjMesh mesh;
   std::istringstream in(read_file(path));
-  std::string line;
+  std::string line, material;
   while (std::getline(in, line)) {
     std::istringstream fields(line);
     std::string tag;
     fields >> tag;
-    if (tag == "v") {
+    if (tag == "mtllib") {
+      fields >> mesh.mtllib;
+    } else if (tag == "usemtl") {
+      fields >> material;
+    } else if (tag == "v") {
       for (int a = 0; a < 3; ++a) {
         std::string x;
         fields >> x;
@@ -157,6 +164,7 @@ inline ObjMesh parse_obj(const std::filesystem::path& path) {
         mesh.uvs.push_back(std::stof(x));
       }
     } else if (tag == "f") {
+      mesh.face_materials.push_back(material);
       for (int c = 0; c < 3; ++c) {
         std::string corner;
         fields >> corner;

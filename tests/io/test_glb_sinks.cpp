@@ -1,11 +1,11 @@
-// Animated GLB parsed back byte by byte (header, chunks, accessors, targets, one-hot weights)
-// and the assimp glTF sequence read back through assimp's importer.
-#include <assimp/Importer.hpp>
-#include <assimp/scene.h>
+// Animated GLB and glTF sequence parsed back byte by byte (header, chunks, accessors, targets,
+// one-hot weights, a primitive per material over one vertex set, the materials).
+#include <algorithm>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "io/glb_size.h"
+#include "io/vertex_normals.h"
 #include "io_test_support.h"
 
 namespace treeanim {
@@ -54,11 +54,58 @@ std::vector<float> accessor_floats(const Glb& glb, size_t index) {
   return values;
 }
 
+// Index accessor `index`, as vertex ids.
+std::vector<uint32_t> accessor_indices(const Glb& glb, size_t index) {
+  const auto& accessor = glb.json["accessors"][index];
+  EXPECT_EQ(accessor["componentType"], 5125);  // UNSIGNED_INT
+  const auto& view = glb.json["bufferViews"][accessor["bufferView"].get<size_t>()];
+  std::vector<uint32_t> values(accessor["count"].get<size_t>());
+  const size_t offset = view.value("byteOffset", size_t(0)) + accessor.value("byteOffset", size_t(0));
+  std::memcpy(values.data(), glb.bin.data() + offset, 4 * values.size());
+  return values;
+}
+
+// The small model's bark and leaf primitives: the same attributes, its triangles split by
+// material, the bake's materials (linear base colours, leaves double-sided).
+void expect_materials(const Glb& glb, const BakeInfo& info) {
+  const auto& primitives = glb.json["meshes"][0]["primitives"];
+  ASSERT_EQ(primitives.size(), 2u);
+  EXPECT_EQ(primitives[0]["attributes"], primitives[1]["attributes"]);
+  EXPECT_EQ(primitives[0]["material"], 0);
+  EXPECT_EQ(primitives[1]["material"], 1);
+  EXPECT_EQ(accessor_indices(glb, primitives[0]["indices"]), (std::vector<uint32_t>{1, 2, 0, 0, 2, 3}));
+  EXPECT_EQ(accessor_indices(glb, primitives[1]["indices"]), (std::vector<uint32_t>{4, 5, 3}));
+  const auto& materials = glb.json["materials"];
+  ASSERT_EQ(materials.size(), 2u);
+  for (size_t m = 0; m < 2; ++m) {
+    EXPECT_EQ(materials[m]["name"], info.materials[m].name);
+    const auto& pbr = materials[m]["pbrMetallicRoughness"];
+    for (size_t c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(pbr["baseColorFactor"][c].get<float>(), info.materials[m].base_color[c]);
+    EXPECT_EQ(pbr["baseColorFactor"][3], 1.0);
+    EXPECT_EQ(pbr["metallicFactor"], 0.0);
+    EXPECT_FLOAT_EQ(pbr["roughnessFactor"].get<float>(), m == 0 ? 0.8f : 0.6f);
+  }
+  EXPECT_FALSE(materials[0].value("doubleSided", false));
+  EXPECT_TRUE(materials[1].value("doubleSided", false));
+  if (info.vertex_colors.empty()) {
+    EXPECT_FALSE(primitives[0]["attributes"].contains("COLOR_0"));
+  } else {
+    EXPECT_EQ(accessor_floats(glb, primitives[0]["attributes"]["COLOR_0"]), info.vertex_colors);
+  }
+}
+
+// small_info with per-leaf colours: bark white, the leaf's vertices one factor.
+BakeInfo coloured_info(long long frames, long long start) {
+  BakeInfo info = small_info(frames, start);
+  info.vertex_colors = {1, 1, 1, 1, 1, 1, 1, 1, 1, 0.8f, 0.9f, 0.7f, 0.8f, 0.9f, 0.7f, 0.8f, 0.9f, 0.7f};
+  return info;
+}
+
 class GlbSinks : public test::TempFolder {};
 
 TEST_F(GlbSinks, AnimatedGlbHasOneMorphTargetPerFrame) {
   const TreeModel m = small_model();
-  const BakeInfo info = small_info(5, 1);
+  const BakeInfo info = coloured_info(5, 1);
   test::bake({test::output("glb", "anim.glb", 2)}, dir_, m, info);
   EXPECT_EQ(entries(), (std::vector<std::string>{"anim.glb"}));
   // The size check's bound holds, and is not loose by more than the JSON's longest numbers.
@@ -74,9 +121,8 @@ TEST_F(GlbSinks, AnimatedGlbHasOneMorphTargetPerFrame) {
     EXPECT_EQ(uv[size_t(2 * v)], m.uvs(0, v));
     EXPECT_EQ(uv[size_t(2 * v + 1)], 1.0f - m.uvs(1, v));
   }
-  std::vector<uint32_t> indices(9);
-  std::memcpy(indices.data(), glb.bin.data(), 36);
-  EXPECT_EQ(indices, m.triangles);
+  expect_materials(glb, info);
+  EXPECT_EQ(glb.json["meshes"][0]["primitives"][1]["targets"], primitive["targets"]);
 
   const std::vector<long long> frames{1, 3, 5};
   ASSERT_EQ(primitive["targets"].size(), frames.size());
@@ -103,29 +149,29 @@ TEST_F(GlbSinks, AnimatedGlbHasOneMorphTargetPerFrame) {
     for (size_t target = 0; target < 3; ++target) EXPECT_EQ(weights[3 * key + target], key == target ? 1.0f : 0.0f);
 }
 
-TEST_F(GlbSinks, AssimpSequenceKeepsVerticesAndFaces) {
+TEST_F(GlbSinks, SequenceKeepsVerticesAndSplitsFacesByMaterial) {
   const TreeModel m = small_model();
-  test::bake({test::output("gltf", "gltf/tree.%03d.glb")}, dir_, m, small_info(2, 0));
+  OutputOptions options = test::output("gltf", "gltf/tree.%03d.glb");
+  options.normals = true;
+  const BakeInfo info = small_info(2, 0);
+  test::bake({options}, dir_, m, info);
   EXPECT_EQ(entries(), (std::vector<std::string>{"gltf", "gltf/tree.000.glb", "gltf/tree.001.glb"}));
   for (long long f : {0, 1}) {
-    Assimp::Importer importer;
-    const std::string path = (dir_ / ("gltf/tree.00" + std::to_string(f) + ".glb")).string();
-    const aiScene* scene = importer.ReadFile(path, 0);
-    ASSERT_NE(scene, nullptr) << importer.GetErrorString();
-    ASSERT_EQ(scene->mNumMeshes, 1u);
-    const aiMesh* mesh = scene->mMeshes[0];
-    ASSERT_EQ(mesh->mNumVertices, 6u);
+    const Glb glb = parse_glb(dir_ / ("gltf/tree.00" + std::to_string(f) + ".glb"));
+    expect_materials(glb, info);
+    const auto& attributes = glb.json["meshes"][0]["primitives"][0]["attributes"];
     const FrameData frame = small_frame(m, f);
-    for (unsigned v = 0; v < 6; ++v) {
-      EXPECT_EQ(mesh->mVertices[v].x, frame.positions[3 * v]);
-      EXPECT_EQ(mesh->mVertices[v].y, frame.positions[3 * v + 1]);
-      EXPECT_EQ(mesh->mVertices[v].z, frame.positions[3 * v + 2]);
-      EXPECT_EQ(mesh->mTextureCoords[0][v].x, m.uvs(0, v));
-      EXPECT_EQ(mesh->mTextureCoords[0][v].y, m.uvs(1, v));  // assimp flips v back on import
+    EXPECT_EQ(accessor_floats(glb, attributes["POSITION"]), frame.positions);
+    const std::vector<float> uv = accessor_floats(glb, attributes["TEXCOORD_0"]);
+    for (long v = 0; v < 6; ++v) {
+      EXPECT_EQ(uv[size_t(2 * v)], m.uvs(0, v));
+      EXPECT_EQ(uv[size_t(2 * v + 1)], 1.0f - m.uvs(1, v));
     }
-    ASSERT_EQ(mesh->mNumFaces, 3u);
-    for (unsigned t = 0; t < 3; ++t)
-      for (unsigned c = 0; c < 3; ++c) EXPECT_EQ(mesh->mFaces[t].mIndices[c], m.triangles[3 * t + c]);
+    std::vector<float> normals;
+    vertex_normals(m, frame.positions.data(), rest_normals(m), normals);
+    EXPECT_EQ(accessor_floats(glb, attributes["NORMAL"]), normals);
+    const auto& position = glb.json["accessors"][attributes["POSITION"].get<size_t>()];
+    EXPECT_EQ(position["max"][1].get<float>(), *std::max_element(frame.positions.begin(), frame.positions.end()));
   }
 }
 

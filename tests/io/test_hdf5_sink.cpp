@@ -135,6 +135,7 @@ TEST_F(Hdf5Sink, WritesTheContractLayout) {
   const std::vector<Expected> layout = {
       {"/mesh/rest_positions", {6, 3}, H5T_FLOAT, 4, H5T_SGN_ERROR},
       {"/mesh/triangles", {3, 3}, H5T_INTEGER, 4, H5T_SGN_NONE},
+      {"/mesh/triangle_material", {3}, H5T_INTEGER, 1, H5T_SGN_NONE},
       {"/model/mass", {6}, H5T_FLOAT, 8, H5T_SGN_ERROR},
       {"/model/anchored", {6}, H5T_INTEGER, 1, H5T_SGN_NONE},
       {"/model/cluster_offsets", {3}, H5T_INTEGER, 4, H5T_SGN_NONE},
@@ -162,6 +163,7 @@ TEST_F(Hdf5Sink, WritesTheContractLayout) {
 
   EXPECT_EQ(read_all<float>(file, "/mesh/rest_positions", H5T_NATIVE_FLOAT), test::rest_f32(m));
   EXPECT_EQ(read_all<uint32_t>(file, "/mesh/triangles", H5T_NATIVE_UINT32), m.triangles);
+  EXPECT_EQ(read_all<uint8_t>(file, "/mesh/triangle_material", H5T_NATIVE_UINT8), (std::vector<uint8_t>{0, 0, 1}));
   EXPECT_EQ(read_all<double>(file, "/model/mass", H5T_NATIVE_DOUBLE), m.vertex_mass);
   EXPECT_EQ(read_all<uint8_t>(file, "/model/anchored", H5T_NATIVE_UINT8), m.vertex_anchored);
   EXPECT_EQ(read_all<uint32_t>(file, "/model/cluster_offsets", H5T_NATIVE_UINT32), m.cluster_offsets);

@@ -16,7 +16,9 @@ using test::small_model;
 
 class ObjPc2 : public test::TempFolder {};
 
-void expect_topology(const test::ObjMesh& mesh, const TreeModel& m) {
+void expect_topology(const test::ObjMesh& mesh, const TreeModel& m, const std::string& mtllib) {
+  EXPECT_EQ(mesh.mtllib, mtllib);
+  EXPECT_EQ(mesh.face_materials, (std::vector<std::string>{"bark", "bark", "leaf"}));
   EXPECT_EQ(mesh.faces, m.triangles);
   EXPECT_EQ(mesh.face_uvs, m.triangles);
   EXPECT_EQ(mesh.uvs, std::vector<float>(m.uvs.data(), m.uvs.data() + m.uvs.size()));
@@ -26,16 +28,23 @@ TEST_F(ObjPc2, ObjSequenceKeepsVertexOrderAndTopology) {
   const TreeModel m = small_model();
   test::bake({test::output("obj", "obj/tree", 2)}, dir_, m, small_info(5, 1));
   EXPECT_EQ(entries(), (std::vector<std::string>{"obj", "obj/tree.0001.obj", "obj/tree.0003.obj",
-                                                 "obj/tree.0005.obj", "obj/tree.rest.obj"}));
+                                                 "obj/tree.0005.obj", "obj/tree.rest.mtl", "obj/tree.rest.obj"}));
   const test::ObjMesh rest = test::parse_obj(dir_ / "obj/tree.rest.obj");
   EXPECT_EQ(rest.positions, test::rest_f32(m));
-  expect_topology(rest, m);
+  expect_topology(rest, m, "tree.rest.mtl");
+  // Kd is the linear base colour, as glTF's baseColorFactor; Pr the roughness.
+  const std::string mtl = test::read_file(dir_ / "obj/tree.rest.mtl");
+  EXPECT_EQ(mtl.substr(0, mtl.find('\n')), "# treeanim test, materials");
+  EXPECT_NE(mtl.find("\nnewmtl bark\nKd 0.10653923"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("\nnewmtl leaf\nKd 0.07"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("\nPr 0.8\n"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("\nPr 0.6\n"), std::string::npos) << mtl;
   for (long long f : {1, 3, 5}) {
     char name[32];
     std::snprintf(name, sizeof name, "obj/tree.%04lld.obj", f);
     const test::ObjMesh mesh = test::parse_obj(dir_ / name);
     EXPECT_EQ(mesh.positions, small_frame(m, f).positions) << name;
-    expect_topology(mesh, m);
+    expect_topology(mesh, m, "tree.rest.mtl");
   }
 }
 
@@ -63,10 +72,10 @@ TEST(SequencePattern, NamesFramesAndRest) {
 TEST_F(ObjPc2, Pc2CacheAndRestObj) {
   const TreeModel m = small_model();
   test::bake({test::output("pc2", "cache/tree.pc2", 2)}, dir_, m, small_info(6, 4));
-  EXPECT_EQ(entries(), (std::vector<std::string>{"cache", "cache/tree.pc2", "cache/tree.rest.obj"}));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"cache", "cache/tree.pc2", "cache/tree.rest.mtl", "cache/tree.rest.obj"}));
   const test::ObjMesh rest = test::parse_obj(dir_ / "cache/tree.rest.obj");
   EXPECT_EQ(rest.positions, test::rest_f32(m));
-  expect_topology(rest, m);
+  expect_topology(rest, m, "tree.rest.mtl");
 
   const std::string bytes = test::read_file(dir_ / "cache/tree.pc2");
   ASSERT_EQ(bytes.size(), 32u + 3 * 6 * 3 * 4);  // frames 4, 6, 8
@@ -91,10 +100,10 @@ TEST_F(ObjPc2, Pc2CacheAndRestObj) {
 TEST_F(ObjPc2, MddCacheAndRestObj) {
   const TreeModel m = small_model();
   test::bake({test::output("mdd", "cache/tree", 2)}, dir_, m, small_info(6, 4));
-  EXPECT_EQ(entries(), (std::vector<std::string>{"cache", "cache/tree.mdd", "cache/tree.rest.obj"}));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"cache", "cache/tree.mdd", "cache/tree.rest.mtl", "cache/tree.rest.obj"}));
   const test::ObjMesh rest = test::parse_obj(dir_ / "cache/tree.rest.obj");
   EXPECT_EQ(rest.positions, test::rest_f32(m));
-  expect_topology(rest, m);
+  expect_topology(rest, m, "tree.rest.mtl");
 
   const std::string bytes = test::read_file(dir_ / "cache/tree.mdd");
   ASSERT_EQ(bytes.size(), 8u + 3 * 4 + 3 * 6 * 3 * 4);  // frames 4, 6, 8
@@ -137,7 +146,7 @@ TEST_F(ObjPc2, ObjSequenceWithNormals) {
 TEST_F(ObjPc2, Pc2PathGetsItsExtension) {
   const TreeModel m = small_model();
   test::bake({test::output("pc2", "tree")}, dir_, m, small_info(1, 0));
-  EXPECT_EQ(entries(), (std::vector<std::string>{"tree.pc2", "tree.rest.obj"}));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"tree.pc2", "tree.rest.mtl", "tree.rest.obj"}));
 }
 
 }  // namespace

@@ -61,8 +61,8 @@ TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {
   set.push(small_frame(m, 0));
   set.finish();
   EXPECT_EQ(entries(), (std::vector<std::string>{"anim.glb", "bake.h5", "gltf", "gltf/tree.0000.glb", "obj",
-                                                 "obj/tree.0000.obj", "obj/tree.rest.obj", "tree.pc2",
-                                                 "tree.rest.obj"}));
+                                                 "obj/tree.0000.obj", "obj/tree.rest.mtl", "obj/tree.rest.obj",
+                                                 "tree.pc2", "tree.rest.mtl", "tree.rest.obj"}));
   const auto paths = set.final_paths();
   ASSERT_EQ(paths.size(), 7u);
   EXPECT_EQ(paths[0], dir_ / "bake.h5");

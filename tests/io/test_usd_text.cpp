@@ -41,11 +41,6 @@ TEST(UsdText, PrimNamesFromIds) {
   EXPECT_EQ(usd_quoted("a \"b\" \\"), "\"a \\\"b\\\" \\\\\"");
 }
 
-TEST(UsdText, SrgbToLinear) {
-  EXPECT_NEAR(srgb_to_linear(0.5), 0.21404, 1e-5);
-  EXPECT_DOUBLE_EQ(srgb_to_linear(0.04), 0.04 / 12.92);
-}
-
 TEST(UsdForest, APrimPerTreeReferencingItsLayer) {
   const std::string text = forest_usda(
       {{"a-b", "trees/a-b.usda", {1, 0, -2}, 30}, {"a.b", "/abs/a.b.usda", {0, 0, 0}, -90}}, {24, 2, 11});

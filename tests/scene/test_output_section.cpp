@@ -49,6 +49,16 @@ TEST(OutputOptions, Hdf5OptionsAreRead) {
   EXPECT_EQ(o.frame_step, 2);
 }
 
+TEST(OutputOptions, GltfAndGlbCarryNormalsUnlessTurnedOff) {
+  Json resolved;
+  EXPECT_TRUE(read_first(R"({"outputs": [{"format": "glb", "path": "t.glb"}]})", &resolved).normals);
+  EXPECT_EQ(resolved["outputs"][0]["normals"], true);
+  EXPECT_TRUE(read_first(R"({"outputs": [{"format": "gltf", "path": "t"}]})").normals);
+  EXPECT_FALSE(read_first(R"({"outputs": [{"format": "glb", "path": "t.glb", "normals": false}]})").normals);
+  EXPECT_FALSE(read_first(R"({"outputs": [{"format": "obj", "path": "t"}]})").normals);
+  EXPECT_FALSE(read_first(R"({"outputs": [{"format": "hdf5", "path": "t.h5"}]})").normals);
+}
+
 TEST(OutputOptions, ErrorsNameTheKey) {
   EXPECT_EQ(error_of(R"({"outputs": [{"path": "b.h5"}]})"),
             "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb, usd)");

@@ -58,5 +58,21 @@ TEST(TreeOptions, BadValuesNameThePointer) {
             "/tree/cluster/segments_per_cluster?)");
 }
 
+TEST(TreeOptions, ColoursAreSrgbTriplesInTheUnitRange) {
+  Json document = Json::parse(R"({"tree": {"bark_color": [0.5, 0.4, 0.3], "leaf_color_variation": 0}})");
+  SceneReader reader(document, "/scenes");
+  const TreeOptions o = read_tree_options(reader.root().object("tree"));
+  EXPECT_EQ(o.bark_color, Eigen::Vector3d(0.5, 0.4, 0.3));
+  EXPECT_EQ(o.leaf_color, TreeOptions{}.leaf_color);
+  EXPECT_EQ(o.leaf_color_variation, 0);
+  EXPECT_EQ(document["tree"]["leaf_color"], Json::parse("[0.3, 0.47, 0.16]"));
+  EXPECT_EQ(error_of(R"({"tree": {"leaf_color": [0.2, 1.5, 0.1]}})"),
+            "s.json: /tree/leaf_color: expected an sRGB colour: an array of 3 numbers in [0, 1], got [0.2,1.5,0.1]");
+  EXPECT_EQ(error_of(R"({"tree": {"bark_color": [0.2, 0.1]}})"),
+            "s.json: /tree/bark_color: expected an array of 3 finite numbers, got [0.2,0.1]");
+  EXPECT_EQ(error_of(R"({"tree": {"leaf_color_variation": -0.1}})"),
+            "s.json: /tree/leaf_color_variation: expected a number in [0, 1], got -0.1");
+}
+
 }  // namespace
 }  // namespace treeanim

@@ -37,6 +37,10 @@ TEST(ValidateTreeModel, CatchesCorruptedIndices) {
             "tree model: vertex_memberships of vertex 8 not in ascending cluster order");
   EXPECT_EQ(error_after([](TreeModel& m) { m.vertex_cluster_offsets.pop_back(); }),
             "tree model: vertex_cluster_offsets has 70 entries, expected 71");
+  EXPECT_EQ(error_after([](TreeModel& m) { m.triangle_material[3] = 2; }),
+            "tree model: triangle_material[3] = 2 out of range [0, 2)");
+  EXPECT_EQ(error_after([](TreeModel& m) { m.triangle_material.pop_back(); }),
+            "tree model: triangle_material has 101 entries, expected 102");
 }
 
 TEST(ValidateTreeModel, AnEmptySkeletonIsAnInputError) {

@@ -7,7 +7,7 @@
 //                                 place OUT/forest.json gives it
 import fs from 'node:fs';
 import path from 'node:path';
-import { AnimationMixer, LoopOnce, Matrix4, Vector3 } from 'three';
+import { AnimationMixer, LoopOnce, Matrix4, SRGBColorSpace, Vector3 } from 'three';
 import { USDAParser } from 'three/examples/jsm/loaders/usd/USDAParser.js';
 import { USDLoader } from 'three/examples/jsm/loaders/USDLoader.js';
 import { zipSync, strToU8 } from 'three/examples/jsm/libs/fflate.module.js';
@@ -34,14 +34,20 @@ function checkStage(text, bake, file) {
   expect(root.defaultPrim === '"Tree"', `${file}: defaultPrim ${root.defaultPrim}`);
 }
 
-// Two materials bound by GeomSubsets: bark and leaves, in the colours the docs give.
-function checkMaterials(mesh, file) {
+// Two materials bound by GeomSubsets: bark and leaves, in the scene's sRGB colours (within one
+// 8-bit step: three reads the linear values back), the leaves over the bake's leaf triangles.
+function checkMaterials(mesh, bake, file) {
   const materials = Array.isArray(mesh.material) ? mesh.material : [mesh.material];
   expect(materials.length === 2 && mesh.geometry.groups.length === 2,
     `${file}: ${materials.length} materials, ${mesh.geometry.groups.length} groups (expected bark and leaves)`);
-  const colors = materials.map((m) => m.color.getHexString());
-  console.log(`${file}: bark and leaf materials, sRGB ${colors.join(', ')}`);
-  expect(colors.includes('59402b') && colors.includes('3b6b1f'), `${file}: colours ${colors}`);
+  const srgb = (m) => { const c = {}; m.color.getRGB(c, SRGBColorSpace); return [c.r, c.g, c.b]; };
+  const near = (a, b) => a.every((x, i) => Math.abs(x - b[i]) <= 1 / 255);
+  const colors = materials.map(srgb);
+  console.log(`${file}: bark and leaf materials, sRGB ${colors.map((c) => c.map((x) => x.toFixed(3)).join(' ')).join(', ')}`);
+  expect(colors.some((c) => near(c, bake.bark_color)) && colors.some((c) => near(c, bake.leaf_color)),
+    `${file}: colours ${JSON.stringify(colors)}, scene bark ${bake.bark_color} leaf ${bake.leaf_color}`);
+  const leaf = mesh.geometry.groups[materials.findIndex((c) => near(srgb(c), bake.leaf_color))];
+  expect(leaf && leaf.count === 3 * bake.leaf_triangles, `${file}: leaf subset of ${leaf && leaf.count / 3} triangles, bake ${bake.leaf_triangles}`);
 }
 
 const bakeBase = option('--bake');
@@ -69,7 +75,7 @@ if (pointsFile) {
   const geometry = meshes[0].geometry;
   const triangles = (geometry.index ? geometry.index.count : geometry.attributes.position.count) / 3;
   expect(triangles === bake.triangles, `${pointsFile}: ${triangles} triangles, bake ${bake.triangles}`);
-  checkMaterials(meshes[0], pointsFile);
+  checkMaterials(meshes[0], bake, pointsFile);
 }
 
 const skinnedFile = option('--skinned');
@@ -88,7 +94,7 @@ if (skinnedFile) {
   const joints = specs['/Tree/Skeleton.joints'].fields.default.length;
   expect(mesh.skeleton.bones.length === joints, `${skinnedFile}: ${mesh.skeleton.bones.length} bones, ${joints} joints`);
   expect(group.animations.length === 1, `${skinnedFile}: ${group.animations.length} animations`);
-  checkMaterials(mesh, skinnedFile);
+  checkMaterials(mesh, bake, skinnedFile);
   // three draws a subset mesh unindexed, triangles sorted by subset (bark, then leaves, each in
   // the subset's face order): corner c of its geometry is vertex vertexOf[c] of the layer.
   const triangles = specs['/Tree/Mesh.faceVertexIndices'].fields.default;
