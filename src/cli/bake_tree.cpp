@@ -83,6 +83,8 @@ TreeBakeResult bake_tree(const Scene& scene, const RunRequest& request, const Tr
   // Only a bake of the whole loop closes it; --frames writes a part of it.
   info.loop = scene.time.loop && write_first == first && write_last == last;
   info.loop_end_time = double(last + 1) / scene.time.fps;
+  info.wind = scene.wind;
+  if (placement) info.placement = *placement;
   OutputSet outputs(scene.outputs, request.out_dir, tree.model, info);
   TreeBakeResult result;
   result.frame_start = write_first;

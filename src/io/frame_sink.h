@@ -80,6 +80,8 @@ std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, c
                                                  const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
+std::unique_ptr<FrameSink> make_html_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                          const TreeModel& model, const BakeInfo& info);
 std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const std::filesystem::path& path,
                                          const TreeModel& model, const BakeInfo& info);
 

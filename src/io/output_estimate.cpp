@@ -1,5 +1,7 @@
 #include "io/output_estimate.h"
 
+#include <algorithm>
+
 namespace treeanim {
 
 double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, long long frames) {
@@ -15,6 +17,8 @@ double estimated_output_bytes(const OutputOptions& output, size_t vertices, size
   if (output.format == "glb" || output.format == "pc2" || output.format == "mdd") return written * (vectors + normals);
   if (output.format == "vat")  // offsets and normals, RGBA texels
     return written * (output.vat_half ? 8.0 : 16.0) * 2.0 * double(vertices);
+  if (output.format == "html")  // float32 positions in base64, reduced to fit the page's limit
+    return std::min(written * vectors * 4.0 / 3.0, double(output.max_page_bytes));
   return 0;  // skinned_glb: keys per joint, small beside the mesh
 }
 

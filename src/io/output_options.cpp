@@ -34,6 +34,7 @@ OutputOptions read_output_options(SceneObject element) {
   }
   if (options.format == "skinned_glb")
     options.max_joints = static_cast<size_t>(element.optional_integer("max_joints", 1, 65535).value_or(0));
+  if (options.format == "html") options.max_page_bytes = size_t(element.integer("max_mib", 64, 2, 64)) << 20;
   return options;
 }
 

@@ -18,11 +18,12 @@ struct OutputOptions {
   size_t texture_width = 0;        // vat: texels per row; 0 = as many as vertices, at most 8192
   size_t max_joints = 0;           // skinned_glb: joints at most; 0 = one per cluster
   bool vat_half = false;           // vat: half-float textures (else float)
+  size_t max_page_bytes = 64 << 20;  // html: the page's size limit (key max_mib)
   std::string pointer;             // "/outputs/N", for messages about this element
 };
 
 // The formats /outputs/N/format accepts.
-inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd", "vat", "skinned_glb"};
+inline const char* const kOutputFormats[] = {"hdf5", "obj", "gltf", "glb", "pc2", "mdd", "vat", "skinned_glb", "html"};
 
 // One element of /outputs => options. Keys that do not apply to the format are left
 // undeclared, so the scene reader reports them as unknown.

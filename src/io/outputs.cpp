@@ -44,6 +44,7 @@ std::unique_ptr<FrameSink> make_sink(const OutputOptions& options, const fs::pat
   if (options.format == "mdd") return make_mdd_sink(options, path, model, info);
   if (options.format == "vat") return make_vat_sink(options, path, model, info);
   if (options.format == "skinned_glb") return make_skinned_glb_sink(options, path, model, info);
+  if (options.format == "html") return make_html_sink(options, path, model, info);
   throw InputError(options.pointer + "/format: unknown output format \"" + options.format + "\"");
 }
 

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "io/output_options.h"
+#include "sim/sim_options.h"
+#include "tree/tree_placement.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -27,6 +29,8 @@ struct BakeInfo {
   // loop_end_time (s), so animations add a closing key there.
   bool loop = false;
   double loop_end_time = 0;
+  WindOptions wind;            // the scene's wind (the html page plots it at the tree)
+  TreePlacement placement;     // where the tree stands in that wind; identity for a lone tree
 };
 
 // One simulated frame, converted to float for output.

@@ -50,9 +50,9 @@ TEST(OutputOptions, Hdf5OptionsAreRead) {
 
 TEST(OutputOptions, ErrorsNameTheKey) {
   EXPECT_EQ(error_of(R"({"outputs": [{"path": "b.h5"}]})"),
-            "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb)");
+            "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb, html)");
   EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf"}]})"),
-            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", \"skinned_glb\", got \"hdf\" "
+            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", \"skinned_glb\", \"html\", got \"hdf\" "
             "(did you mean \"hdf5\"?)");
   EXPECT_EQ(error_of(R"({"outputs": [{"format": "obj"}]})"),
             "/outputs/0/path: expected a non-empty path string, got nothing");
