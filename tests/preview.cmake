@@ -11,7 +11,9 @@ set(preview_small_leaves "--set tree.leaf.size=0.3 --set hsm.leaf_detach_force=0
 add_test(NAME preview.bake
   COMMAND sh -c "rm -rf '${preview_out}' && t='$<TARGET_FILE:treeanim>' && \
 \"$t\" run tests/golden/small_tree.json -o '${preview_out}/small' --quiet ${preview_small_leaves} --set '${preview_page_only}' && \
-\"$t\" run tests/golden/small_tree.json -o '${preview_out}/reduced' --quiet ${preview_small_leaves} --set time.frames=1200 --set '${preview_small_reduced}'"
+\"$t\" run tests/golden/small_tree.json -o '${preview_out}/reduced' --quiet ${preview_small_leaves} --set time.frames=1200 --set '${preview_small_reduced}' && \
+\"$t\" run configs/demo.json -o '${preview_out}/demo' --quiet --set time.frames=96 --set '${preview_page_only}' && \
+exec \"$t\" run configs/conifer.json -o '${preview_out}/conifer' --quiet --set time.frames=72 --set '${preview_page_only}'"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP preview_pages TIMEOUT 300)
 
@@ -31,3 +33,5 @@ function(preview_page_test name page)
 endfunction()
 preview_page_test(small small/page.html)
 preview_page_test(reduced reduced/page.html --reduced yes)
+preview_page_test(demo demo/page.html --min-leaf-share 0.3)
+preview_page_test(conifer conifer/page.html --min-leaf-share 0.3)
