@@ -21,7 +21,7 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
 
 double frame_time(const BakePlan& plan, long long frame) { return static_cast<double>(frame) * plan.frame_dt; }
 
-BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& model) {
+BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& model, const TreePlacement* placement) {
   BakeInfo info;
   info.scene_json = scene.resolved.dump(2);
   info.generator = plan.key.generator;
@@ -34,6 +34,8 @@ BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& mo
   info.loop_end_time = double(plan.last + 1) / scene.time.fps;
   info.materials = surface_materials(scene.tree);
   info.vertex_colors = leaf_color_factors(model, scene.tree.leaf_color_variation, scene.lsystem.seed);
+  info.wind = scene.wind;
+  if (placement) info.placement = *placement;
   return info;
 }
 

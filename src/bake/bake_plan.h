@@ -30,7 +30,8 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config);
 // The simulation time of `frame` (s).
 double frame_time(const BakePlan& plan, long long frame);
 
-// scene, plan, the tree's model => what the outputs record of the bake (its materials and leaf colours too).
-BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& model);
+// scene, plan, the tree's model and where it stands (null: at the origin) => what the outputs
+// record of the bake (its materials and leaf colours, the wind at the tree, too).
+BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& model, const TreePlacement* placement);
 
 }  // namespace treeanim

@@ -63,8 +63,9 @@ Eigen::AlignedBox3d world_bounds(const Eigen::AlignedBox3d& own, const TreePlace
 
 }  // namespace
 
-BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model)
-    : info(bake_info(scene, plan, model)),
+BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model,
+                       const TreePlacement* placement)
+    : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
       outputs(scene.outputs, config.out_dir, model, info) {}
 
@@ -137,7 +138,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const BakePlan plan = plan_bake(scene, config);
   const PreparedTree tree = prepare_tree(scene);
   log.prepared(tree);
-  BakeFrames frames(scene, config, plan, tree.model);
+  BakeFrames frames(scene, config, plan, tree.model, placement);
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
   const std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;

@@ -23,7 +23,9 @@ namespace treeanim {
 // Where the frames of a bake go: its outputs, and what the summary and the manifest measure.
 struct BakeFrames {
   // Checks every output target (InputError, OutputError) before anything is simulated.
-  BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model);
+  // placement: where the tree stands (null: a lone tree at the origin).
+  BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model,
+             const TreePlacement* placement);
   // A frame measured (bounds, a whole loop's seam), then queued to the outputs.
   void push(FrameData data);
 

@@ -11,7 +11,7 @@ namespace treeanim {
 
 // Each format's sink, defined in its own file (src/io/<format>_sink.cpp).
 SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
-    make_skinned_glb_sink, make_usd_sink;
+    make_skinned_glb_sink, make_usd_sink, make_html_sink;
 
 namespace {
 
@@ -129,6 +129,17 @@ const std::vector<OutputFormatRow> kFormats = {
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t clusters) {
        return o.skinned ? 96.0 * joint_count(o, clusters) : (36.0 + (o.normals ? 38.0 : 0.0)) * double(vertices);
      }},
+    {.name = "html",
+     .keys = {{.name = "max_mib",
+               .type = Type::kInteger,
+               .fallback = 64,
+               .lo = 2,
+               .hi = 64,
+               .store = [](OutputOptions& o, double v) { o.max_page_bytes = size_t(v) << 20; }}},
+     .make = make_html_sink,
+     // float32 positions in base64, reduced to fit the page's limit
+     .frame_bytes = [](const OutputOptions&, size_t vertices, size_t, size_t) { return vector_bytes(vertices) * 4.0 / 3.0; },
+     .limit_bytes = [](const OutputOptions& o) { return double(o.max_page_bytes); }},
 };
 
 }  // namespace

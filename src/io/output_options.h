@@ -21,6 +21,7 @@ struct OutputOptions {
   size_t max_joints = 0;           // skinned_glb, skinned usd: joints at most; 0 = one per cluster
   bool vat_half = false;           // vat: half-float textures (else float)
   bool skinned = false;            // usd: UsdSkel joints and keys instead of points per frame
+  size_t max_page_bytes = 64 << 20;  // html: the page's size limit (key max_mib)
   std::string pointer;             // "/outputs/N", for messages about this element
 };
 

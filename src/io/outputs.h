@@ -11,6 +11,8 @@
 
 #include "io/output_options.h"
 #include "tree/surface_materials.h"
+#include "sim/sim_options.h"
+#include "tree/tree_placement.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -32,6 +34,8 @@ struct BakeInfo {
   // (tree/surface_materials.h; empty: no vertex colours).
   std::array<SurfaceMaterial, kMaterialCount> materials = surface_materials(TreeOptions{});
   std::vector<float> vertex_colors;
+  WindOptions wind;            // the scene's wind (the html page plots it at the tree)
+  TreePlacement placement;     // where the tree stands in that wind; identity for a lone tree
 };
 
 // One simulated frame, converted to float for output.

@@ -79,7 +79,7 @@ TEST_F(BakeStages, PlanOfAFrameRange) {
   EXPECT_EQ(plan.key.scene_hash, bake_key(line, treeanim_generator()));
   EXPECT_EQ(plan.key.generator.rfind("treeanim ", 0), 0u);
   EXPECT_EQ(frame_time(plan, 12), 12.0 * (1.0 / 24));
-  const BakeInfo info = bake_info(line, plan, TreeModel());
+  const BakeInfo info = bake_info(line, plan, TreeModel(), nullptr);
   EXPECT_EQ(info.frame_start, 12);
   EXPECT_EQ(info.frame_count, 2);
   EXPECT_FALSE(info.loop);
@@ -135,7 +135,7 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   const BakeConfig whole = config();
   const BakePlan plan = plan_bake(line, whole);
   const PreparedTree tree = prepare_tree(line);
-  BakeFrames frames(line, whole, plan, tree.model);
+  BakeFrames frames(line, whole, plan, tree.model, nullptr);
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
   BakeStart start = start_bake(plan, layout, simulator, nullptr);

@@ -61,9 +61,9 @@ TEST(OutputOptions, GltfAndGlbCarryNormalsUnlessTurnedOff) {
 
 TEST(OutputOptions, ErrorsNameTheKey) {
   EXPECT_EQ(error_of(R"({"outputs": [{"path": "b.h5"}]})"),
-            "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb, usd)");
+            "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb, usd, html)");
   EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf"}]})"),
-            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", \"skinned_glb\", \"usd\", got \"hdf\" "
+            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", \"skinned_glb\", \"usd\", \"html\", got \"hdf\" "
             "(did you mean \"hdf5\"?)");
   EXPECT_EQ(error_of(R"({"outputs": [{"format": "obj"}]})"),
             "/outputs/0/path: expected a non-empty path string, got nothing");

@@ -1,0 +1,178 @@
+#!/usr/bin/env node
+// The html output's page in Debian's chromium (headless, software GL), driven by playwright-core:
+//   preview_page.js shot PAGE.html OUT.png SECONDS [SECONDS...]
+//       the page's 3D view at each time (page.html#t=SECONDS, once the title says "ready"),
+//       side by side in one PNG (scripts/render-preview makes docs/demo.png so)
+//   preview_page.js check PAGE.html --bark R,G,B --leaf R,G,B [--min-leaf-share F] [--trees N]
+//       fails unless the view at the first and last third of the bake is not blank, the two
+//       differ (the tree moves), bark and leaf pixels have the given sRGB colours (0..1) within
+//       shading, leaves are at least F of the tree's pixels, and (--trees) N trees were drawn.
+// CHROMIUM names the browser (default /usr/bin/chromium).
+'use strict';
+const path = require('path');
+const { chromium } = require('playwright-core');
+
+// Browser windows: the checks' (the view 960 x 558), and the pictures' (a tall view, 600 x 620).
+const kCheckSize = { width: 960, height: 900 };
+const kShotSize = { width: 600, height: 1000 };
+
+async function openBrowser() {
+  return chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+}
+
+// The page at time t => PNG bytes of its 3D view, and what the page says about itself.
+async function viewAt(browser, page, t, viewport = kCheckSize) {
+  const tab = await browser.newPage({ viewport });
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(String(e)));
+  await tab.goto(`file://${path.resolve(page)}#t=${t}`);
+  try {
+    await tab.waitForFunction(() => document.title === 'ready', null, { timeout: 120000 });
+  } catch (e) {
+    throw new Error(`${page}#t=${t}: the title never became "ready" (${errors.join('; ') || e.message})`);
+  }
+  const png = await tab.locator('#view canvas').screenshot();
+  const info = await tab.evaluate(() => ({ clock: document.getElementById('clock').textContent,
+                                           note: document.getElementById('note').textContent,
+                                           data: JSON.parse(document.getElementById('treeanim-bake').textContent) }));
+  await tab.close();
+  return { png, info };
+}
+
+// PNG images => their RGBA pixels, decoded by the browser itself.
+async function pixels(browser, pngs) {
+  const tab = await browser.newPage();
+  const out = await tab.evaluate(async (sources) => Promise.all(sources.map(async (b64) => {
+    const image = new Image();
+    image.src = `data:image/png;base64,${b64}`;
+    await image.decode();
+    const canvas = new OffscreenCanvas(image.width, image.height);
+    const g = canvas.getContext('2d');
+    g.drawImage(image, 0, 0);
+    return { width: image.width, height: image.height,
+             data: Array.from(g.getImageData(0, 0, image.width, image.height).data) };
+  })), pngs.map((p) => p.toString('base64')));
+  await tab.close();
+  return out;
+}
+
+// PNG images => one PNG of them side by side.
+async function sideBySide(browser, pngs) {
+  const tab = await browser.newPage();
+  const b64 = await tab.evaluate(async (sources) => {
+    const images = await Promise.all(sources.map(async (s) => {
+      const image = new Image();
+      image.src = `data:image/png;base64,${s}`;
+      await image.decode();
+      return image;
+    }));
+    const canvas = document.createElement('canvas');
+    canvas.width = images.reduce((w, i) => w + i.width, 0);
+    canvas.height = Math.max(...images.map((i) => i.height));
+    const g = canvas.getContext('2d');
+    let x = 0;
+    for (const i of images) { g.drawImage(i, x, 0); x += i.width; }
+    return canvas.toDataURL('image/png').split(',')[1];
+  }, pngs.map((p) => p.toString('base64')));
+  await tab.close();
+  return Buffer.from(b64, 'base64');
+}
+
+// sRGB 0..255 => hue (degrees) and saturation (0..1) of HSV.
+function hueSat(r, g, b) {
+  const max = Math.max(r, g, b), min = Math.min(r, g, b), c = max - min;
+  if (max === 0 || c === 0) return { hue: 0, sat: 0 };
+  let hue;
+  if (max === r) hue = ((g - b) / c) % 6;
+  else if (max === g) hue = (b - r) / c + 2;
+  else hue = (r - g) / c + 4;
+  return { hue: (hue * 60 + 360) % 360, sat: c / max };
+}
+
+// Pixels whose hue is within 12 degrees of the colour's (shading scales brightness, not hue).
+function countLike(image, rgb) {
+  const want = hueSat(rgb[0] * 255, rgb[1] * 255, rgb[2] * 255);
+  let n = 0;
+  for (let i = 0; i < image.data.length; i += 4) {
+    const got = hueSat(image.data[i], image.data[i + 1], image.data[i + 2]);
+    const dh = Math.min(Math.abs(got.hue - want.hue), 360 - Math.abs(got.hue - want.hue));
+    if (dh <= 12 && got.sat >= 0.5 * want.sat && image.data[i] + image.data[i + 1] + image.data[i + 2] > 15) ++n;
+  }
+  return n;
+}
+
+function parseColor(text, name) {
+  const rgb = (text || '').split(',').map(Number);
+  if (rgb.length !== 3 || rgb.some((v) => !(v >= 0 && v <= 1))) throw new Error(`--${name}: expected R,G,B in 0..1`);
+  return rgb;
+}
+
+async function check(browser, page, options) {
+  const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
+  const text = require('fs').readFileSync(page, 'utf8');
+  const json = /<script id="treeanim-bake" type="application\/json">(.*?)<\/script>/s.exec(text);
+  if (!json) throw new Error(`${page}: no <script id="treeanim-bake"> element`);
+  const times = JSON.parse(json[1]).plot.time;
+  const t0 = times[Math.floor(times.length / 3)], t1 = times[Math.floor((2 * times.length) / 3)];
+  const a = await viewAt(browser, page, t0), b = await viewAt(browser, page, t1);
+  const [ia, ib] = await pixels(browser, [a.png, b.png]);
+  const failures = [];
+  const total = ia.width * ia.height;
+  const background = ia.data.slice(0, 3);  // the top-left corner: sky
+  let drawn = 0, changed = 0;
+  for (let i = 0; i < ia.data.length; i += 4) {
+    const d = Math.abs(ia.data[i] - background[0]) + Math.abs(ia.data[i + 1] - background[1]) +
+              Math.abs(ia.data[i + 2] - background[2]);
+    if (d > 24) ++drawn;
+    if (Math.abs(ia.data[i] - ib.data[i]) + Math.abs(ia.data[i + 1] - ib.data[i + 1]) +
+        Math.abs(ia.data[i + 2] - ib.data[i + 2]) > 24) ++changed;
+  }
+  const barkPixels = countLike(ia, bark), leafPixels = countLike(ia, leaf);
+  const leafShare = leafPixels / Math.max(1, leafPixels + barkPixels);
+  console.log(`${page}: t=${t0} "${a.info.clock}", t=${t1} "${b.info.clock}"; ${ia.width}x${ia.height} view, ` +
+              `${drawn} pixels drawn, ${changed} changed between the two times, ${barkPixels} bark-coloured, ` +
+              `${leafPixels} leaf-coloured (leaves ${(100 * leafShare).toFixed(1)} % of the tree)` +
+              (a.info.note ? `; note: ${a.info.note}` : ''));
+  if (drawn < 0.01 * total) failures.push(`blank view: ${drawn} of ${total} pixels differ from the sky`);
+  if (changed < 0.001 * total) failures.push(`the tree does not move: ${changed} pixels changed between t=${t0} and t=${t1}`);
+  if (barkPixels < 0.0005 * total) failures.push(`no bark of colour ${bark}: ${barkPixels} pixels`);
+  if (leafPixels < 0.002 * total) failures.push(`no leaves of colour ${leaf}: ${leafPixels} pixels`);
+  if (options['min-leaf-share'] && leafShare < Number(options['min-leaf-share']))
+    failures.push(`leaves are ${(100 * leafShare).toFixed(1)} % of the tree's pixels, below ${100 * options['min-leaf-share']} %`);
+  if (options['reduced'] && !a.info.note.startsWith('Reduced to fit'))
+    failures.push(`the page says nothing about a reduction (note "${a.info.note}")`);
+  if (options.trees && a.info.data.trees.length !== Number(options.trees))
+    failures.push(`${a.info.data.trees.length} trees in the page, expected ${options.trees}`);
+  return failures;
+}
+
+async function main() {
+  const [command, page, ...rest] = process.argv.slice(2);
+  const browser = await openBrowser();
+  try {
+    if (command === 'shot') {
+      const [out, ...times] = rest;
+      const views = [];
+      for (const t of times) views.push((await viewAt(browser, page, t, kShotSize)).png);
+      require('fs').writeFileSync(out, await sideBySide(browser, views));
+      console.log(out);
+      return 0;
+    }
+    if (command === 'check') {
+      const options = {};
+      for (let i = 0; i < rest.length; i += 2) options[rest[i].replace(/^--/, '')] = rest[i + 1];
+      const failures = await check(browser, page, options);
+      for (const f of failures) console.log(`FAIL: ${f}`);
+      return failures.length ? 1 : 0;
+    }
+    console.error('usage: preview_page.js shot PAGE OUT.png SECONDS... | check PAGE --bark R,G,B --leaf R,G,B');
+    return 2;
+  } finally {
+    await browser.close();
+  }
+}
+
+main().then((code) => process.exit(code), (e) => { console.error(String(e.stack || e)); process.exit(1); });

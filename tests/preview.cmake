@@ -1,0 +1,38 @@
+# The html output's page in a real browser (docs/outputs.md "Preview page"), label `preview`:
+# pages baked by the CLI, each opened in Debian's chromium (headless, SwiftShader GL) by
+# tests/clients/node/preview_page.js (playwright-core) at two times, which checks the view is
+# drawn, moves, and shows bark and leaves in the page's colours. Included by CMakeLists.txt
+# inside TREEANIM_TESTS; chromium and playwright-core come from `scripts/setup test`.
+set(preview_out ${CMAKE_BINARY_DIR}/preview_pages)
+set(preview_page_only "outputs=[{\"format\":\"html\",\"path\":\"page.html\"}]")
+set(preview_small_reduced "outputs=[{\"format\":\"html\",\"path\":\"page.html\",\"max_mib\":2}]")
+# The golden tree's leaves, larger and kept on: enough leaf pixels to check their colour.
+set(preview_small_leaves "--set tree.leaf.size=0.3 --set hsm.leaf_detach_force=0")
+# Every page in the scene colours (tree.bark_color, tree.leaf_color) the check looks for.
+set(preview_colors --bark 0.36,0.26,0.18 --leaf 0.30,0.52,0.16)
+set(preview_scene_colors "--set tree.bark_color=[0.36,0.26,0.18] --set tree.leaf_color=[0.30,0.52,0.16]")
+add_test(NAME preview.bake
+  COMMAND sh -c "rm -rf '${preview_out}' && t='$<TARGET_FILE:treeanim>' && \
+\"$t\" run tests/golden/small_tree.json -o '${preview_out}/small' --quiet ${preview_scene_colors} ${preview_small_leaves} --set '${preview_page_only}' && \
+\"$t\" run tests/golden/small_tree.json -o '${preview_out}/reduced' --quiet ${preview_scene_colors} ${preview_small_leaves} --set time.frames=1200 --set '${preview_small_reduced}' && \
+\"$t\" run configs/demo.json -o '${preview_out}/demo' --quiet ${preview_scene_colors} --set time.frames=96 --set '${preview_page_only}' && \
+exec \"$t\" run configs/conifer.json -o '${preview_out}/conifer' --quiet ${preview_scene_colors} --set time.frames=72 --set '${preview_page_only}'"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP preview_pages TIMEOUT 300)
+
+find_program(TREEANIM_NODE node)
+set(preview_client ${CMAKE_SOURCE_DIR}/tests/clients/node/preview_page.js)
+function(preview_page_test name page)
+  if(TREEANIM_NODE AND EXISTS ${CMAKE_SOURCE_DIR}/tests/clients/node/node_modules/playwright-core AND EXISTS /usr/bin/chromium)
+    add_test(NAME preview.${name} COMMAND ${TREEANIM_NODE} ${preview_client} check ${preview_out}/${page} ${preview_colors} ${ARGN})
+  else()
+    add_test(NAME preview.${name}
+             COMMAND sh -c "echo 'preview.${name}: node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
+  endif()
+  set_tests_properties(preview.${name} PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 300
+                       WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+endfunction()
+preview_page_test(small small/page.html)
+preview_page_test(reduced reduced/page.html --reduced yes)
+preview_page_test(demo demo/page.html --min-leaf-share 0.3)
+preview_page_test(conifer conifer/page.html --min-leaf-share 0.3)
