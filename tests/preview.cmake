@@ -1,7 +1,10 @@
 # The html output's page in a real browser (docs/outputs.md "Preview page"), label `preview`:
 # pages baked by the CLI, each opened in Debian's chromium (headless, SwiftShader GL) by
 # tests/clients/node/preview_page.js (playwright-core) at two times, which checks the view is
-# drawn, moves, and shows bark and leaves in the page's colours. Included by CMakeLists.txt
+# drawn, moves, and shows bark and leaves in the page's colours; a forest's forest.html
+# (tests/clients/scenes/forest_preview.json) shows every tree, each drawn alone where the
+# forest places it, and is the same page when gathered after a sharded bake, or thinned to fit.
+# Included by CMakeLists.txt
 # inside TREEANIM_TESTS; chromium and playwright-core come from `scripts/setup test`.
 set(preview_out ${CMAKE_BINARY_DIR}/preview_pages)
 set(preview_page_only "outputs=[{\"format\":\"html\",\"path\":\"page.html\"}]")
@@ -15,6 +18,7 @@ add_test(NAME preview.bake
   COMMAND sh -c "rm -rf '${preview_out}' && t='$<TARGET_FILE:treeanim>' && \
 \"$t\" run tests/golden/small_tree.json -o '${preview_out}/small' --quiet ${preview_scene_colors} ${preview_small_leaves} --set '${preview_page_only}' && \
 \"$t\" run tests/golden/small_tree.json -o '${preview_out}/reduced' --quiet ${preview_scene_colors} ${preview_small_leaves} --set time.frames=1200 --set '${preview_small_reduced}' && \
+\"$t\" run tests/clients/scenes/forest_preview.json -o '${preview_out}/forest' --quiet && \
 \"$t\" run configs/demo.json -o '${preview_out}/demo' --quiet ${preview_scene_colors} --set time.frames=96 --set '${preview_page_only}' && \
 exec \"$t\" run configs/conifer.json -o '${preview_out}/conifer' --quiet ${preview_scene_colors} --set time.frames=72 --set '${preview_page_only}'"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
@@ -36,3 +40,22 @@ preview_page_test(small small/page.html)
 preview_page_test(reduced reduced/page.html --reduced yes)
 preview_page_test(demo demo/page.html --min-leaf-share 0.3)
 preview_page_test(conifer conifer/page.html --min-leaf-share 0.3)
+preview_page_test(forest forest/forest.html --trees 3)
+
+# The farm's gather writes the same forest.html as `run`: the forest baked as three shards, then gathered.
+set(preview_forest_scene ${CMAKE_SOURCE_DIR}/tests/clients/scenes/forest_preview.json)
+add_test(NAME preview.forest_gather
+  COMMAND sh -c "d='${preview_out}/forest-farm' && t='$<TARGET_FILE:treeanim>' && rm -rf \"$d\" && \
+for shard in 0/3 1/3 2/3; do \"$t\" run '${preview_forest_scene}' -o \"$d\" --quiet --shard $shard || exit 1; done; \
+test ! -e \"$d/forest.html\" && \"$t\" farm gather '${preview_forest_scene}' -o \"$d\" && cmp \"$d/forest.html\" '${preview_out}/forest/forest.html'")
+set_tests_properties(preview.forest_gather PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 120)
+
+# A forest whose pages together pass max_mib: forest.html thins every tree's frames alike and says so.
+add_test(NAME preview.forest_thinned
+  COMMAND sh -c "d='${preview_out}/forest-thinned' && rm -rf \"$d\" && \
+'$<TARGET_FILE:treeanim>' run '${preview_forest_scene}' -o \"$d\" --quiet --set time.frames=600 \
+  --set 'outputs=[{\"format\":\"html\",\"path\":\"trees/{tree}.html\",\"max_mib\":2}]' && \
+test $(wc -c < \"$d/forest.html\") -le 2097152 && \
+grep -o 'Reduced to fit 2 MiB: 1 frame in [0-9]* of the trees. pages kept, the others interpolated. 3 of 3 tree pages were reduced' \"$d/forest.html\""
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(preview.forest_thinned PROPERTIES LABELS preview TIMEOUT 300)

@@ -4,6 +4,7 @@
 
 #include "common/json_text.h"
 #include "common/read_text_file.h"
+#include "io/html_forest.h"
 #include "io/output_formats.h"
 #include "io/text_output.h"
 #include "io/usd_forest.h"
@@ -35,20 +36,44 @@ Json placement_matrix(const TreePlacement& placement) {
   return matrix;
 }
 
+// The parts' trees => each one's first file of `format`, or none unless every tree has one.
+std::vector<std::string> first_files(const Json& trees, const std::string& format) {
+  std::vector<std::string> files;
+  for (const Json& tree : trees) {
+    const Json& outputs = tree.at("outputs");
+    const auto found =
+        std::find_if(outputs.begin(), outputs.end(), [&](const Json& o) { return o.at("format") == format; });
+    if (found == outputs.end()) return {};
+    files.push_back(found->at("files").at(0).get<std::string>());
+  }
+  return files;
+}
+
+Eigen::Vector3d position_of(const Json& tree) {
+  const Json& position = tree.at("position");
+  return {position[0].get<double>(), position[1].get<double>(), position[2].get<double>()};
+}
+
 // The parts' trees with their first USD layer each, or none unless every tree has one.
 std::vector<ForestStageTree> usd_stage_trees(const Json& trees) {
   std::vector<ForestStageTree> stage;
-  for (const Json& tree : trees) {
-    const Json& outputs = tree.at("outputs");
-    const auto usd =
-        std::find_if(outputs.begin(), outputs.end(), [](const Json& o) { return o.at("format") == "usd"; });
-    if (usd == outputs.end()) return {};
-    const Json& position = tree.at("position");
-    stage.push_back({tree.at("id").get<std::string>(), usd->at("files").at(0).get<std::string>(),
-                     Eigen::Vector3d(position[0].get<double>(), position[1].get<double>(), position[2].get<double>()),
-                     tree.at("rotation").get<double>()});
-  }
+  const std::vector<std::string> layers = first_files(trees, "usd");
+  for (size_t t = 0; t < layers.size(); ++t)
+    stage.push_back({trees[t].at("id").get<std::string>(), layers[t], position_of(trees[t]),
+                     trees[t].at("rotation").get<double>()});
   return stage;
+}
+
+// The parts' trees with their first preview page each, or none unless every tree has one.
+std::vector<ForestPageTree> page_trees(const Json& trees, const fs::path& out_dir) {
+  std::vector<ForestPageTree> pages;
+  const std::vector<std::string> files = first_files(trees, "html");
+  for (size_t t = 0; t < files.size(); ++t) {
+    const fs::path page(files[t]);
+    pages.push_back({trees[t].at("id").get<std::string>(), page.is_absolute() ? page : out_dir / page,
+                     position_of(trees[t]), trees[t].at("rotation").get<double>()});
+  }
+  return pages;
 }
 
 }  // namespace
@@ -137,6 +162,11 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
     const long long start = trees[0].at("frame_start").get<long long>();
     write_forest_usda(out_dir / "forest.usda", stage,
                       {scene.time.fps, start, start + std::max(1LL, trees[0].at("frame_count").get<long long>()) - 1});
+  }
+  if (const auto pages = page_trees(trees, out_dir); !pages.empty()) {
+    const auto html = std::find_if(scene.outputs.begin(), scene.outputs.end(),
+                                   [](const OutputOptions& o) { return o.format->name == std::string("html"); });
+    write_forest_page(out_dir / "forest.html", pages, html->max_page_bytes);
   }
   const Json manifest = {{"format", "treeanim-forest"},
                          {"format_version", 1},

@@ -14,6 +14,7 @@
 #include "io/base64.h"
 #include "io/frame_sink.h"
 #include "io/output_file.h"
+#include "io/preview_page.h"
 #include "tree/surface_materials.h"
 #include "preview_viewer_js.h"
 #include "sim/wind.h"
@@ -126,13 +127,7 @@ class HtmlSink final : public FrameSink {
     page["wind_probe"] = {probe_.x(), probe_.y(), probe_.z()};
     page["trees"] = nlohmann::json::array({tree_json()});
     page["reduced"] = reduction_note();
-    std::string text = "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
-                       path_.stem().string() + "</title>\n</head>\n<body>\n"
-                       "<script id=\"treeanim-bake\" type=\"application/json\">";
-    text += page.dump();
-    text += "</script>\n<script>";
-    text += kPreviewViewerJs;
-    text += "</script>\n</body>\n</html>\n";
+    const std::string text = preview_page_text(path_.stem().string(), page);
     if (text.size() > max_page_bytes_)
       throw OutputError(path_.string() + ": the page came to " + std::to_string(text.size()) +
                         " bytes, above its limit of " + std::to_string(max_page_bytes_));

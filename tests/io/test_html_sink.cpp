@@ -1,12 +1,17 @@
 // The preview page parsed back: its embedded JSON holds the rest mesh with bark triangles
 // first, every pushed frame (float32, or int16 within half its vertex's step when reduced), the plots'
-// displacements and wind; the viewer bundle follows; a page too small is refused.
+// displacements and wind; the viewer bundle follows; a page too small is refused. The forest
+// page composes tree pages: placed, the first tree's wind turned into the forest, displacements
+// over all trees, frames thinned alike when the pages together pass the limit.
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "common/errors.h"
 #include "io/base64.h"
+#include "io/html_forest.h"
+#include "io/preview_page.h"
+#include "io/text_output.h"
 #include "io/output_options.h"
 #include "io_test_support.h"
 
@@ -139,6 +144,81 @@ TEST_F(HtmlSink, PageTooSmallForTheTreeIsRefused) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               "/outputs/0/max_mib: the page needs 7 MiB at least for this tree (viewer, mesh and two frames)");
+  }
+}
+
+// Two tree pages of the small model, 5 frames: the second's displacements doubled, the first's
+// wind (1, 0, 0) m/s in its own frame.
+std::vector<ForestPageTree> two_tree_pages(const std::filesystem::path& dir) {
+  test::bake({test::output("html", "a")}, dir, small_model(), small_info(5, 1));
+  nlohmann::json a = page_data(dir / "a.html");
+  nlohmann::json b = a;
+  for (size_t i = 0; i < 5; ++i) {
+    a["plot"]["wind"][3 * i] = 1.0;
+    b["plot"]["max_displacement"][i] = 2 * a["plot"]["max_displacement"][i].get<double>();
+    b["plot"]["rms_displacement"][i] = 2 * a["plot"]["rms_displacement"][i].get<double>();
+  }
+  write_text_output(dir / "a.html", preview_page_text("a", a));
+  write_text_output(dir / "b.html", preview_page_text("b", b));
+  return {{"a", dir / "a.html", Eigen::Vector3d(1, 0, 2), 90}, {"b", dir / "b.html", Eigen::Vector3d::Zero(), 0}};
+}
+
+TEST_F(HtmlSink, ForestPagePlacesTreesAndCombinesPlots) {
+  const auto trees = two_tree_pages(dir_);
+  const nlohmann::json a = page_data(dir_ / "a.html"), b = page_data(dir_ / "b.html");
+  write_forest_page(dir_ / "forest.html", trees, 64 << 20);
+  const nlohmann::json data = page_data(dir_ / "forest.html");
+  EXPECT_EQ(data["title"], "forest (treeanim test)");
+  EXPECT_EQ(data["reduced"], "");
+  ASSERT_EQ(data["trees"].size(), 2u);
+  EXPECT_EQ(data["trees"][0]["position"], (std::vector<double>{1, 0, 2}));
+  EXPECT_EQ(data["trees"][0]["rotation"], 90.0);
+  EXPECT_EQ(data["trees"][1]["position"], (std::vector<double>{0, 0, 0}));
+  EXPECT_EQ(data["trees"][0]["frames"], a["trees"][0]["frames"]) << "the frames as the tree's page holds them";
+  EXPECT_EQ(data["trees"][0]["rest"], a["trees"][0]["rest"]) << "in the tree's frame, placed by the viewer";
+  // +x in the first tree's frame is -z in the forest's once it is turned by 90 degrees about +Y.
+  EXPECT_EQ(data["plot"]["wind"][0], 0.0);
+  EXPECT_EQ(data["plot"]["wind"][2], -1.0);
+  const double r = a["plot"]["rms_displacement"][4].get<double>();
+  EXPECT_EQ(data["plot"]["max_displacement"][4], b["plot"]["max_displacement"][4]);
+  EXPECT_NEAR(data["plot"]["rms_displacement"][4].get<double>(), std::sqrt((r * r + 4 * r * r) / 2), 1e-12);
+  EXPECT_EQ(data["plot"]["time"], a["plot"]["time"]);
+}
+
+TEST_F(HtmlSink, ForestPageThinsFramesToFit) {
+  const auto trees = two_tree_pages(dir_);
+  const nlohmann::json a = page_data(dir_ / "a.html");
+  const size_t whole = forest_page(trees, "forest", 64 << 20).size();
+  const std::string text = forest_page(trees, "forest", whole - 1);
+  EXPECT_LE(text.size(), whole - 1);
+  const nlohmann::json data = preview_page_data(text, "forest.html");
+  const std::string frames = a["trees"][0]["frames"]["data"];
+  const size_t one = frames.size() / 5;
+  for (const nlohmann::json& tree : data["trees"]) {
+    EXPECT_EQ(tree["frames"]["sample"], (std::vector<int>{0, 2, 4}));
+    EXPECT_EQ(tree["frames"]["data"],
+              frames.substr(0, one) + frames.substr(2 * one, one) + frames.substr(4 * one, one));
+  }
+  // A limit of 0.6 MiB, rounded as every limit of whole MiB prints.
+  EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: 1 frame in 2 of the trees' pages kept, the others interpolated.");
+  try {
+    forest_page(trees, "forest", 1000);
+    FAIL() << "accepted";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("forest.html: the 2 trees' meshes and two frames each take 1 MiB, above the "
+                                          "page's limit of 0 MiB (max_mib)", 0), 0u) << e.what();
+  }
+}
+
+TEST_F(HtmlSink, ForestPageNamesAPageThatIsNotOne) {
+  auto trees = two_tree_pages(dir_);
+  write_text_output(dir_ / "b.html", "<!doctype html>\n");
+  try {
+    forest_page(trees, "forest", 64 << 20);
+    FAIL() << "accepted";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (dir_ / "b.html").string() + ": not a treeanim preview page (no <script id=\"treeanim-bake\"> element)");
   }
 }
 

@@ -1,7 +1,8 @@
 // The html output's viewer (docs/outputs.md "Preview page"): reads the bake embedded in the
 // page (<script id="treeanim-bake" type="application/json">, written by src/io/html_sink.cpp)
 // and plays it with three.js. Bundled by esbuild at build time; the page needs no network.
-// page.html#t=SECONDS shows that time, stops, and sets document.title to "ready" once drawn.
+// page.html#t=SECONDS shows that time, stops, and sets document.title to "ready" once drawn;
+// &tree=K shows the K-th tree alone (from 0; none past the last), framed as the whole page.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
@@ -200,8 +201,9 @@ function drawPlot(canvas, title, unit, series, cursorTime) {
   g.beginPath(); g.moveTo(x(cursorTime), top); g.lineTo(x(cursorTime), h - bottom); g.stroke();
 }
 const windSpeed = times.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
+const windTitle = trees.length > 1 ? 'wind speed at the first tree' : 'wind speed at the tree';
 function drawPlots(t) {
-  drawPlot(document.getElementById('windplot'), 'wind speed at the tree', 'm/s',
+  drawPlot(document.getElementById('windplot'), windTitle, 'm/s',
            [{ name: 'speed', values: windSpeed, color: '#2060d0' }], t);
   drawPlot(document.getElementById('dispplot'), 'displacement from rest', 'm',
            [{ name: 'largest', values: bake.plot.max_displacement, color: '#c05a00' },
@@ -272,6 +274,8 @@ function tick(now) {
 
 // #t=SECONDS: that time, stopped; the title says "ready" once the frame is on the canvas.
 const requested = /(?:^#|&)t=([0-9.eE+-]+)/.exec(window.location.hash);
+const alone = /(?:^#|&)tree=([0-9]+)/.exec(window.location.hash);
+if (alone) trees.forEach((tree, k) => { tree.mesh.visible = k === Number(alone[1]); });
 resize();
 if (requested) {
   playing = false;

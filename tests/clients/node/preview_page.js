@@ -6,7 +6,8 @@
 //   preview_page.js check PAGE.html --bark R,G,B --leaf R,G,B [--min-leaf-share F] [--trees N]
 //       fails unless the view at the first and last third of the bake is not blank, the two
 //       differ (the tree moves), bark and leaf pixels have the given sRGB colours (0..1) within
-//       shading, leaves are at least F of the tree's pixels, and (--trees) N trees were drawn.
+//       shading, leaves are at least F of the tree's pixels, and (--trees) the page holds N trees,
+//       each drawn on its own (page.html#t=SECONDS&tree=K) and apart from the others on screen.
 // CHROMIUM names the browser (default /usr/bin/chromium).
 'use strict';
 const path = require('path');
@@ -24,11 +25,11 @@ async function openBrowser() {
 }
 
 // The page at time t => PNG bytes of its 3D view, and what the page says about itself.
-async function viewAt(browser, page, t, viewport = kCheckSize) {
+async function viewAt(browser, page, t, viewport = kCheckSize, more = '') {
   const tab = await browser.newPage({ viewport });
   const errors = [];
   tab.on('pageerror', (e) => errors.push(String(e)));
-  await tab.goto(`file://${path.resolve(page)}#t=${t}`);
+  await tab.goto(`file://${path.resolve(page)}#t=${t}${more}`);
   try {
     await tab.waitForFunction(() => document.title === 'ready', null, { timeout: 120000 });
   } catch (e) {
@@ -110,6 +111,40 @@ function parseColor(text, name) {
   return rgb;
 }
 
+// Two images => how many pixels differ, and their centroid.
+function difference(image, base) {
+  let n = 0, x = 0, y = 0;
+  for (let i = 0; i < image.data.length; i += 4) {
+    const d = Math.abs(image.data[i] - base.data[i]) + Math.abs(image.data[i + 1] - base.data[i + 1]) +
+              Math.abs(image.data[i + 2] - base.data[i + 2]);
+    if (d <= 24) continue;
+    ++n;
+    x += (i / 4) % image.width;
+    y += Math.floor(i / 4 / image.width);
+  }
+  return { n, x: n ? x / n : 0, y: n ? y / n : 0 };
+}
+
+// Each of the page's trees alone at time t (&tree=K) against the view of none (&tree=COUNT:
+// the grid and the wind arrow alone): drawn, and away from the others on screen.
+async function checkTrees(browser, page, t, count, failures) {
+  const views = [];
+  for (let k = 0; k <= count; ++k) views.push((await viewAt(browser, page, t, kCheckSize, `&tree=${k}`)).png);
+  const images = await pixels(browser, views);
+  const none = images.pop();
+  const total = none.width * none.height;
+  const drawn = images.map((image) => difference(image, none));
+  console.log(`${page}: each tree alone: ` +
+              drawn.map((d, k) => `tree ${k} ${d.n} pixels around (${d.x.toFixed(0)}, ${d.y.toFixed(0)})`).join(', '));
+  drawn.forEach((d, k) => {
+    if (d.n < 0.001 * total) failures.push(`tree ${k} alone: ${d.n} of ${total} pixels differ from the view of no tree`);
+    for (let j = 0; j < k; ++j) {
+      const apart = Math.hypot(d.x - drawn[j].x, d.y - drawn[j].y);
+      if (apart < 40) failures.push(`trees ${j} and ${k} are drawn at the same place (${apart.toFixed(1)} px apart)`);
+    }
+  });
+}
+
 async function check(browser, page, options) {
   const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
   const text = require('fs').readFileSync(page, 'utf8');
@@ -146,6 +181,7 @@ async function check(browser, page, options) {
     failures.push(`the page says nothing about a reduction (note "${a.info.note}")`);
   if (options.trees && a.info.data.trees.length !== Number(options.trees))
     failures.push(`${a.info.data.trees.length} trees in the page, expected ${options.trees}`);
+  if (options.trees) await checkTrees(browser, page, t0, Number(options.trees), failures);
   return failures;
 }
 
