@@ -103,9 +103,10 @@ std::vector<double> sample_spline(const std::vector<Eigen::Vector2d>& control) {
 }
 
 // "tropism: T: x y z [A: angle] [I: intensity] [E: elasticity] [S: step]" (or "torque:", whose A:
-// is read and not used) of line `line` => the movement as cpfg computes it (CPFG manual 8.1.8).
-// cpfg drops a line it cannot read; here it is refused with its place.
-Movement read_movement(const std::string& name, size_t line, const std::string& key, const std::string& rest) {
+// is read and not used) of line `line` => the movement as cpfg computes it (CPFG manual 8.1.8),
+// or nothing for a line of zero T: or I: without elasticity (E: and S: 0): cpfg drops it, and
+// it bends nothing. cpfg drops any other line it cannot read; here it is refused with its place.
+std::optional<Movement> read_movement(const std::string& name, size_t line, const std::string& key, const std::string& rest) {
   std::string spaced = rest;
   std::replace_if(spaced.begin(), spaced.end(), [](char c) { return c == ',' || c == ':' || c == '\t'; }, ' ');
   std::istringstream in(spaced);
@@ -146,8 +147,11 @@ Movement read_movement(const std::string& name, size_t line, const std::string& 
   }
   if (!t) fail(name, line, head + "expected 'T: x y z' (it is mandatory)");
   const double length = t->norm();
-  if (length == 0.0) fail(name, line, head + "expected a non-zero 'T:' vector");
-  if (intensity && *intensity == 0.0) fail(name, line, head + "expected a non-zero 'I:' (cpfg drops a line of intensity 0)");
+  const bool elastic = m.elasticity != 0.0 || m.step != 0.0;
+  if ((length == 0.0 || (intensity && *intensity == 0.0)) && !elastic) return std::nullopt;
+  if (length == 0.0) fail(name, line, head + "expected a non-zero 'T:' vector (or E: and S: 0, no tropism)");
+  if (intensity && *intensity == 0.0)
+    fail(name, line, head + "expected a non-zero 'I:' (cpfg drops a line of intensity 0; with E: and S: 0 it bends nothing)");
   m.direction = *t * (intensity ? std::clamp(*intensity / length, -1.0, 1.0) : 1.0 / length);
   return m;
 }
@@ -212,6 +216,7 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
   const std::string name = path.string();
   const std::vector<std::string> lines = read_lines(path, "view file");
   ViewSettings view;
+  std::optional<size_t> zero_tropism_line;  // the last "tropism direction:", when it is 0,0,0
   for (size_t i = 0; i < lines.size(); ++i) {
     std::string key, rest;
     if (!split_key(lines[i], &key, &rest)) continue;
@@ -223,12 +228,16 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
     } else if (key == "initial line width") {
       if (rest.find('p') == std::string::npos) view.initial_width = number(name, i, rest, key.c_str());
     } else if (key == "line width increment") view.width_increment = number(name, i, rest, key.c_str());
-    else if (key == "tropism" || key == "torque") view.movements.push_back(read_movement(name, i, key, rest));
-    else if (key == "tropism direction") {
+    else if (key == "tropism" || key == "torque") {
+      if (std::optional<Movement> m = read_movement(name, i, key, rest)) view.movements.push_back(*m);
+    } else if (key == "tropism direction") {
       const std::vector<double> v = numbers(rest);
-      if (v.size() != 3 || !Eigen::Vector3d(v[0], v[1], v[2]).allFinite() || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0)
-        fail(name, i, "expected 'tropism direction: x,y,z' (three numbers, not all 0)");
+      if (v.size() != 3 || !Eigen::Vector3d(v[0], v[1], v[2]).allFinite())
+        fail(name, i, "expected 'tropism direction: x,y,z' (three numbers)");
+      // cpfg divides by the length and bends only at a non-zero elasticity: 0,0,0 is no
+      // tropism while the elasticity stays 0 (checked below), and normalized() keeps it 0.
       view.old_tropism = Eigen::Vector3d(v[0], v[1], v[2]).normalized();
+      zero_tropism_line = view.old_tropism->isZero() ? std::optional<size_t>(i) : std::nullopt;
     } else if (key == "initial elasticity") view.initial_elasticity = number(name, i, rest, key.c_str());
     else if (key == "elasticity increment") view.elasticity_increment = number(name, i, rest, key.c_str());
     else if (key == "initial scale" || key == "scale multiplier") {
@@ -269,6 +278,10 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       for (size_t f = 0; f < items; ++f) view.functions.push_back(parse_function(target.string(), flines, &pos));
     }
   }
+  if (zero_tropism_line && (view.initial_elasticity.value_or(0.0) != 0.0 || view.elasticity_increment.value_or(0.0) != 0.0))
+    fail(name, *zero_tropism_line,
+         "expected a non-zero 'tropism direction:' with a non-zero 'initial elasticity:' or 'elasticity increment:' "
+         "(cpfg divides 0,0,0 by its length; with both 0 it is no tropism)");
   return view;
 }
 

@@ -27,7 +27,7 @@ struct ViewSettings {
   std::optional<double> initial_width;        // "initial line width: w" (not in pixels)
   std::optional<double> width_increment;      // "line width increment: d": '#' adds, '!' subtracts
   std::vector<Movement> movements;            // "tropism:" and "torque:" lines, in order (ids 1, 2, ...)
-  std::optional<Eigen::Vector3d> old_tropism; // "tropism direction: x,y,z", made unit (8.1.10)
+  std::optional<Eigen::Vector3d> old_tropism; // "tropism direction: x,y,z", made unit (8.1.10); 0,0,0: none
   std::optional<double> initial_elasticity;   // "initial elasticity: e" of that tropism
   std::optional<double> elasticity_increment; // "elasticity increment: d": what '_' adds
   std::optional<double> initial_scale;        // "initial scale: s" (0 reads as 1, as in cpfg)

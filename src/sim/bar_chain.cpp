@@ -69,7 +69,7 @@ void cut_for_walks(const TreeModel& tree, BarChain& chain) {
 
 }  // namespace
 
-BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
+BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options, std::span<const double> stiffened) {
   const double youngs_modulus = options.youngs_modulus, yield_strain = options.yield_strain;
   const size_t C = tree.cluster_count();
   BarChain chain;
@@ -113,6 +113,8 @@ BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
         break;
       }
     }
+    const double share = stiffened.empty() ? 1.0 : stiffened[c];
+    chain.cluster_compliance[c] *= share;
     const double r = tree.cluster_radius[c];
     // At most a quarter turn, as a leaf's petiole: rigid clusters stand for a bent branch only
     // while each joint turns moderately; a slender twig's yield turn (eps_y L / r) can be
@@ -124,7 +126,7 @@ BarChain build_bar_chain(const TreeModel& tree, const HsmOptions& options) {
     // largest turn: the soil gives way about where the stem's base would yield.
     if (p < 0 && half[c] > 0) {
       const double height = std::max(0.0, top - chain.cluster_joint(1, c));
-      chain.cluster_compliance[c] += options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];  // 2 half / L = 1 / (E I)
+      chain.cluster_compliance[c] += share * options.root_flexibility * height * half[c] * 2 / tree.cluster_length[c];  // 2 half / L = 1 / (E I)
     }
   }
   cut_for_walks(tree, chain);

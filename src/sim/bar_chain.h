@@ -5,6 +5,7 @@
 // limbs sway at the chain's own first frequency.
 #include <Eigen/Core>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "sim/sim_options.h"
@@ -35,8 +36,10 @@ struct BarChain {
 // length): a joint that continues its parent's axis has half of each, a lateral's base half of
 // its own, and the root half of its own plus the root plate's, root_flexibility H / (E I) for a
 // tree H tall (the soil turns the stem's base, up to the stem's own largest turn). The yield
-// moment of a cluster of radius r is strain E pi r^3 / 4.
-BarChain build_bar_chain(const TreeModel& model, const HsmOptions& options);
+// moment of a cluster of radius r is strain E pi r^3 / 4. `stiffened` (C, or empty: all 1) scales
+// each joint's compliance, root plate included, at the same yield moment
+// (StepRates::cluster_compliance_share: the limb-frequency floor).
+BarChain build_bar_chain(const TreeModel& model, const HsmOptions& options, std::span<const double> stiffened = {});
 
 // Tree model + chain => the tree's reach (m): the longest path from a root cluster's joint to a
 // vertex along the chain of joints. No connected pose moves a vertex farther than twice

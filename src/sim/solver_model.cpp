@@ -208,6 +208,10 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(*this, a, static_cast<uint32_t>(c));
   const StepRates rates = compute_step_rates(tree, options, chain, h);  // before the leaves join the chain
   cluster_alpha = rates.cluster_alpha;
+  // The floor's pull and the chain's statics describe one limb (docs/solver.md, "The floor").
+  if (std::any_of(rates.cluster_compliance_share.begin(), rates.cluster_compliance_share.end(), [](double s) { return s < 1; }))
+    chain = build_bar_chain(t, o, rates.cluster_compliance_share);
+  for (size_t c = 0; c < C; ++c) chain.cluster_compliance[c] *= rates.cluster_compliance_share[c];
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
   vertex_half_damping.resize(V);
   for (size_t v = 0; v < V; ++v) vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));

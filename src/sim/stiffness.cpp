@@ -66,6 +66,7 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, con
   // between it and the ground (a twig on a swaying bough moves with the bough).
   rates.cluster_frequency.assign(C, 0);
   rates.cluster_limb_frequency.assign(C, 0);
+  rates.cluster_compliance_share.assign(C, 1);
   for (uint32_t c : order) {
     const int32_t p = model.cluster_parent[c];
     const double parent = p >= 0 ? rates.cluster_limb_frequency[p] : std::numeric_limits<double>::infinity();
@@ -75,6 +76,10 @@ void physical_frequencies(const TreeModel& model, const HsmOptions& options, con
     }
     rates.cluster_frequency[c] = cantilever_frequency(E, model.cluster_radius[c], model.cluster_length[c], own_mass[c]);
     rates.cluster_limb_frequency[c] = std::min(parent, limb[c]);
+    // The floor stiffens a limb softer than it: its joint takes (w_limb / floor)^2 of its
+    // compliance, so that the limb the goal bends sways at the floor the pull is given.
+    const double floor = options.min_limb_frequency;
+    if (limb[c] < floor) rates.cluster_compliance_share[c] = (limb[c] / floor) * (limb[c] / floor);
   }
 }
 
@@ -140,6 +145,7 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
   } else {
     rates.cluster_frequency.assign(C, 0);
     rates.cluster_limb_frequency.assign(C, 0);
+    rates.cluster_compliance_share.assign(C, 1);
     for (size_t c = 0; c < C; ++c) {
       const bool leaf = model.cluster_kind[c] == kClusterLeaf;
       rates.cluster_alpha[c] = leaf ? options.leaf_alpha : options.alpha;

@@ -13,6 +13,10 @@ struct StepRates {
   std::vector<double> cluster_alpha;          // (C) local shape-matching rate per step, [0, 1]
   std::vector<double> cluster_frequency;      // (C) rad/s, local (segment) frequency; 0 in per-step mode
   std::vector<double> cluster_limb_frequency; // (C) rad/s, frequency of the softest limb holding the cluster
+  // (C) factor on the cluster's joint compliance: (w_limb / min_limb_frequency)^2 for a branch
+  // cluster whose own limb sways below the floor, else 1; the pull K = w^2 the floor raises and
+  // the chain's statics then describe one limb (docs/solver.md, "The floor")
+  std::vector<double> cluster_compliance_share;
   std::vector<double> vertex_global;          // (V) global (Eq. 8) rate per step; 0 when off or anchored
   std::vector<double> vertex_damping;         // (V) velocity factor per step, exp(-2 zeta w h)
   double capped_fraction = 0;                 // share of branch clusters whose w h >= pi/2 (alpha = 1)

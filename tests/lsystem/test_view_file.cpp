@@ -130,7 +130,7 @@ TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(error_of("viewpoint: 0,0,1\nangle increment: wide\n"), "plant.v:2:1: expected a number after 'angle increment:'");
   EXPECT_EQ(error_of("angle factor: 0\n"), "plant.v:1:1: expected a non-zero 'angle factor:'");
   EXPECT_EQ(error_of("line width increment: nan\n"), "plant.v:1:1: expected a number after 'line width increment:'");
-  EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: 'tropism:' expected a non-zero 'T:' vector");
+  EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: 'tropism:' expected a non-zero 'T:' vector (or E: and S: 0, no tropism)");
   EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: 'tropism:' expected a number after 'E:'");
   EXPECT_EQ(error_of("surface: leaf leaf.s 1\n"), "plant.v:1:1: expected a one-letter surface id after 'surface:'");
   EXPECT_EQ(error_of("surface: l\n"), "plant.v:1:1: expected 'surface: id file.s scale' (the file name after the id)");
@@ -190,13 +190,35 @@ TEST_F(ViewFile, MalformedTropismLinesAreRefused) {
   EXPECT_EQ(error_of("tropism: T: 0 1 0 0.5\n"), "plant.v:1:1: 'tropism:' expected a subcommand T: A: I: E: or S:, got '0.5'");
   EXPECT_EQ(error_of("tropism: T: 0 1 0 E: 1 E: 2\n"), "plant.v:1:1: 'tropism:' gives 'E:' twice");
   EXPECT_EQ(error_of("tropism: T: 0 1 0 A: 9x\n"), "plant.v:1:1: 'tropism:' expected a number after 'A:'");
-  EXPECT_EQ(error_of("tropism: T: 0 1 0 I: 0\n"), "plant.v:1:1: 'tropism:' expected a non-zero 'I:' (cpfg drops a line of intensity 0)");
+  EXPECT_EQ(error_of("tropism: T: 0 1 0 I: 0 S: 0.1\n"),
+            "plant.v:1:1: 'tropism:' expected a non-zero 'I:' (cpfg drops a line of intensity 0; with E: and S: 0 it bends nothing)");
   EXPECT_EQ(error_of("tropism: I: 2 T: 0 1 0\n"),
             "plant.v:1:1: 'tropism:' expected 'T:' before 'I:' (cpfg reads an intensity before the direction as 0 and drops the line)");
   EXPECT_EQ(error_of("tropism: T: 0 1 0 E:\n"), "plant.v:1:1: 'tropism:' expected a number after 'E:'");
-  EXPECT_EQ(error_of("tropism direction: 0,0,0\n"), "plant.v:1:1: expected 'tropism direction: x,y,z' (three numbers, not all 0)");
+  EXPECT_EQ(error_of("tropism direction: 0,1\n"), "plant.v:1:1: expected 'tropism direction: x,y,z' (three numbers)");
   EXPECT_EQ(error_of("initial elasticity: soft\n"), "plant.v:1:1: expected a number after 'initial elasticity:'");
   EXPECT_EQ(error_of("initial scale: big\n"), "plant.v:1:1: expected a number after 'initial scale:'");
+}
+
+// cpfg reads a zero tropism direction, or a tropism line of zero T: or I:, as no tropism while
+// nothing makes it elastic: the old-style bend is skipped at elasticity 0 and the line is
+// dropped (so the next line keeps cpfg's movement id). With an elasticity it would divide 0 by 0.
+TEST_F(ViewFile, ZeroTropismWithoutElasticityIsNoTropism) {
+  const ViewSettings v = read_view_file(write("plant.v", "tropism direction: 0.0,0.0,0.0\ninitial elasticity: 0\n"
+                                                         "elasticity increment: 0.0\ntropism: T: 0,0,0 E: 0\n"
+                                                         "tropism: T: 0 1 0 I: 0\ntorque: T: 0 0 0\n"
+                                                         "tropism: T: 0 0 1 E: 0.2\n"));
+  EXPECT_EQ(v.old_tropism, Eigen::Vector3d::Zero());
+  EXPECT_EQ(v.initial_elasticity, 0.0);
+  ASSERT_EQ(v.movements.size(), 1u);
+  EXPECT_EQ(v.movements[0].direction, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(v.movements[0].elasticity, 0.2);
+  EXPECT_EQ(error_of("tropism direction: 0,0,0\ninitial elasticity: 0.1\n"),
+            "plant.v:1:1: expected a non-zero 'tropism direction:' with a non-zero 'initial elasticity:' or "
+            "'elasticity increment:' (cpfg divides 0,0,0 by its length; with both 0 it is no tropism)");
+  EXPECT_EQ(error_of("elasticity increment: 0.05\n\ntropism direction: 0 0 0\n").substr(0, 11), "plant.v:3:1");
+  EXPECT_EQ(error_of("tropism: T: 0 0 0 S: 0.01\n"),
+            "plant.v:1:1: 'tropism:' expected a non-zero 'T:' vector (or E: and S: 0, no tropism)");
 }
 
 // A cuspy curve file in cpfg's layout: a straight line from (0, 0) to (0, 3) (control points on

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <numbers>
 
 #include "sim/simulator.h"
 #include "sim/solver_model.h"
@@ -126,6 +127,41 @@ TEST(Behaviour, LimbFrequencyHasAFloor) {
     below += free[v] < floor_rate;
   }
   EXPECT_GT(below, model.vertex_count() / 2);
+}
+
+TEST(Behaviour, TheFloorStiffensTheLimbsBelowIt) {
+  // The floor raises a soft limb's pull K = w^2; its joints take (w_limb / floor)^2 of their
+  // compliance, so that the limb the goal bends sways no faster than the floor and faster than
+  // before, and the damping K G 2D stays the drag's own. Wood above the floor is left as it is.
+  const TreeModel model = grown_tree(6, 0, 2);
+  HsmOptions soft;
+  soft.youngs_modulus = 1e6;
+  const BarChain chain = build_bar_chain(model, soft);
+  const std::vector<double> before = limb_frequencies(model, chain);
+  const StepRates rates = compute_step_rates(model, soft, chain, 1.0 / 96);
+  const BarChain stiff = build_bar_chain(model, soft, rates.cluster_compliance_share);
+  const std::vector<double> after = limb_frequencies(model, stiff);
+  const double floor = soft.min_limb_frequency;
+  size_t below = 0;
+  for (size_t c = 0; c < model.cluster_count(); ++c) {
+    if (model.cluster_kind[c] != kClusterBranch || !(before[c] < floor)) {
+      EXPECT_EQ(rates.cluster_compliance_share[c], 1.0) << "cluster " << c;
+      continue;
+    }
+    ++below;
+    EXPECT_DOUBLE_EQ(rates.cluster_compliance_share[c], before[c] * before[c] / (floor * floor)) << "cluster " << c;
+    EXPECT_GT(after[c], before[c]) << "cluster " << c;
+    EXPECT_LE(after[c], floor * (1 + 1e-9)) << "cluster " << c;
+    // The joint turns less under the same moment, and reaches its yield turn at the same moment.
+    const double share = rates.cluster_compliance_share[c];
+    EXPECT_NEAR(stiff.cluster_compliance[c], share * chain.cluster_compliance[c], 1e-12 * chain.cluster_compliance[c]);
+    if (chain.cluster_max_turn[c] < std::numbers::pi / 2) {
+      EXPECT_NEAR(stiff.cluster_max_turn[c], share * chain.cluster_max_turn[c], 1e-12) << "cluster " << c;
+    }
+  }
+  EXPECT_GT(below, 10u);  // the trunk and the boughs; the twigs' own limbs sway above the floor
+  const StepRates wood = compute_step_rates(model, HsmOptions{}, 1.0 / 96);
+  for (const double share : wood.cluster_compliance_share) EXPECT_EQ(share, 1.0);
 }
 
 TEST(Behaviour, DetachedLeavesFallAndNeverComeBack) {

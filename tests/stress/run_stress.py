@@ -13,7 +13,8 @@ rest mesh's extent and the tree's reach along its branches, as the solver's guar
 safety net that no scene may trip. A random scene with physical stiffness is baked again at
 64 substeps, and at its own step its branch vertices may move no farther than 1.25 x their
 largest displacement there plus 5 % of the tree's extent (a coarse bake is less accurate,
-never wilder). Prints one line per case; exit 1 on any failure.
+never wilder). A soak case (a long bake written at its last frame) passes when the tree ends
+at rest and its resident memory stays flat. Prints one line per case; exit 1 on any failure.
 """
 import argparse
 import json
@@ -212,10 +213,60 @@ def run_million(binary, case, tmp):
     return bounded, text if bounded else "energy grew: " + text
 
 
+def resident_kib(pid):
+    """Process id => its resident set (KiB), or None once it has ended."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:"))
+    except (OSError, StopIteration):
+        return None
+
+
+def run_soak(binary, case, tmp):
+    """A long bake written only at its last frame: the tree must end within `rest` m of its rest
+    pose, and its resident memory, sampled every `interval` s once `settle` of the run's samples
+    are past (loading, growing and the first steps allocate), may grow by at most `growth` KiB."""
+    s = case["soak"]
+    last = case["set"]["time.frames"] - 1
+    sets = dict(case["set"], outputs=[{"format": "hdf5", "path": "out.h5"}])
+    args = [binary, "run", os.path.join(HERE, case["scene"]), "-o", tmp, "--quiet", "--frames", f"{last}:{last}"]
+    for key, value in sets.items():
+        args += ["--set", f"{key}={json.dumps(value)}"]
+    start = time.perf_counter()
+    samples = []
+    with subprocess.Popen(args, stderr=subprocess.PIPE, text=True) as process:
+        while process.poll() is None:
+            kib = resident_kib(process.pid)
+            if kib:
+                samples.append(kib)
+            time.sleep(s["interval"])
+        err = process.stderr.read().strip()
+    seconds = time.perf_counter() - start
+    if process.returncode != 0:
+        return False, f"exit {process.returncode}: {err.splitlines()[-1] if err else ''}"
+    with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
+        rest = f["/mesh/rest_positions"][()].astype(np.float64)
+        final = np.linalg.norm(f["/frames/positions"][-1].astype(np.float64) - rest, axis=1).max()
+    steady = samples[int(len(samples) * s["settle"]):]
+    if len(steady) < 2:
+        return False, f"{len(samples)} memory samples in {seconds:.1f} s: too few to judge"
+    growth = max(steady) - steady[0]
+    text = (f"{last + 1} frames in {seconds:.0f} s: {final * 1000:.3g} mm from rest at the end; resident memory "
+            f"{steady[0] / 1024:.1f} MiB after the first {s['settle']:.0%} of the run, at most {max(steady) / 1024:.1f} MiB "
+            f"after, {steady[-1] / 1024:.1f} MiB at the end ({len(samples)} samples)")
+    if not final <= s["rest"]:
+        return False, "not at rest: " + text
+    if growth > s["growth"]:
+        return False, "memory grew: " + text
+    return True, text
+
+
 def run_case(binary, case):
     with tempfile.TemporaryDirectory(prefix="stress-") as tmp:
         if "million" in case:
             return run_million(binary, case, tmp)
+        if "soak" in case:
+            return run_soak(binary, case, tmp)
         sets = dict(case.get("set", {}), outputs=[{"format": "hdf5", "path": "out.h5"}])
         scene = os.path.join(HERE, case["scene"])
         code, err, _ = treeanim(binary, scene, tmp, sets, timeout=case.get("timeout", 300))
