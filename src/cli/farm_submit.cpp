@@ -40,8 +40,8 @@ struct FarmJob {
 std::string task_command(const FarmJob& job, const std::string& index) {
   return shell_word(job.treeanim.string()) + " run " + shell_word(job.scene.string()) + " --shard \"" + index + "/" +
          std::to_string(job.tasks) + "\" -o " + shell_word(job.out.string()) + " --checkpoint-every " +
-         std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) + (job.space_check ? "" : " --no-space-check") +
-         job.overrides;
+         std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) +
+         (job.space_check ? "" : " --no-space-check") + job.overrides;
 }
 
 std::string gather_command(const FarmJob& job) {
@@ -209,8 +209,9 @@ int farm_submit_command(const FarmRequest& request) {
       request.checkpoint_every > 0 ? request.checkpoint_every : std::max(1LL, (scene.time.frames + 7) / 8);
   job.cpus = request.cpus_per_task;
   job.overrides = set_arguments(request.overrides);
-  job.space_check = request.space_check;
-  if (job.space_check) check_free_space({{job.out / "forest.json", forest_bytes(scene, estimate, job.checkpoint_every)}});
+  job.space_check = !request.no_space_check;
+  if (job.space_check)
+    check_free_space({{job.out / "forest.json", forest_bytes(scene, estimate, job.checkpoint_every)}});
 
   if (request.engine == "slurm") return submit_to_slurm(job, request);
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");

@@ -48,8 +48,9 @@ void check_free_space(const std::vector<SpaceNeed>& needs, const FreeSpaceProbe&
   }
   for (const Filesystem& filesystem : filesystems)
     if (filesystem.needed > filesystem.space.bytes)
-      throw OutputError(filesystem.first.string() + ": not enough free space: the bake needs " + bytes_text(filesystem.needed) +
-                        " on its filesystem, " + bytes_text(filesystem.space.bytes) + " free; make room, write elsewhere (-o), or skip this estimate with --no-space-check");
+      throw OutputError(filesystem.first.string() + ": not enough free space: the bake needs " +
+                        bytes_text(filesystem.needed) + " on its filesystem, " + bytes_text(filesystem.space.bytes) +
+                        " free; make room, write elsewhere (-o), or skip this estimate with --no-space-check");
 }
 
 std::string bytes_text(double bytes) {

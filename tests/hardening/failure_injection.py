@@ -454,7 +454,8 @@ def no_room_for_the_outputs(bake):
 
 
 def no_room_for_the_forest(bake):
-    """farm submit estimates the whole forest against its output folder's free space."""
+    """farm submit estimates the whole forest against its output folder's free space; with
+    --no-space-check it writes the script, whose tasks skip their own estimate too."""
     out = small_filesystem(bake)
     if out is None:
         print("skipped: mounting a tmpfs is not permitted here")
@@ -463,6 +464,13 @@ def no_room_for_the_forest(bake):
     done = subprocess.run([bake.binary, "farm", "submit", scene, "--tasks", "2", "--engine", "script", "-o", out],
                           capture_output=True, text=True)
     expect(done, 4, "%s/forest.json: not enough free space: the bake needs " % out, out)
+    done = subprocess.run([bake.binary, "farm", "submit", scene, "--tasks", "2", "--engine", "script", "-o", out,
+                           "--no-space-check"], capture_output=True, text=True)
+    with open(os.path.join(out, "farm", "forest-demo.sh")) as f:
+        script = f.read()
+    if done.returncode != 0 or script.count(" --no-space-check") != 1:
+        raise Failed("--no-space-check: exit %d, the tasks %s the flag: %s"
+                     % (done.returncode, "lack" if " --no-space-check" not in script else "repeat", done.stderr))
 
 
 def limit_address_space():
