@@ -43,6 +43,7 @@ struct BakeConfig {
   CheckpointPolicy checkpoints;
   std::string generator = treeanim_generator();
   int threads = 0;                    // OpenMP threads; 0 = the OpenMP default
+  bool space_check = true;            // refuse a bake whose files need more than their disks' free space
 };
 
 // out_dir, --checkpoint-dir ("" = none) => the checkpoints' folder: OUT/checkpoints by default.

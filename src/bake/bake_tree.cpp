@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 
@@ -10,6 +11,7 @@
 #include "common/errors.h"
 #include "common/seconds_since.h"
 #include "io/checkpoint.h"
+#include "io/free_space.h"
 #include "sim/simulator.h"
 
 namespace treeanim {
@@ -80,6 +82,22 @@ JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool 
   return {plan.key.scene_hash, plan.written.first, model.vertex_count(), model.leaf_count(), velocities};
 }
 
+void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
+                const BakeFrames& frames) {
+  std::vector<SpaceNeed> needs;
+  for (const auto& [path, bytes] : frames.outputs.estimated_bytes()) needs.push_back({path, bytes});
+  if (plan.checkpoints.every > 0) {
+    const long long every = plan.checkpoints.every;
+    const long long checkpoints = (plan.written.last - plan.first) / every - (start.frame - plan.first) / every;
+    const long long records = plan.written.last - std::max(start.frame, plan.written.first) + 1;
+    needs.push_back({journal_path(plan.checkpoints.dir, plan.written.first),
+                     double(checkpoints) * estimated_checkpoint_bytes(model.vertex_count(), model.cluster_count(),
+                                                                      model.leaf_count()) +
+                         double(records) * double(journal_record_bytes(layout))});
+  }
+  check_free_space(needs);
+}
+
 LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes) {
   if (!plan.loop || !start.checkpoint.empty()) return {};
   return warm_up_loop(simulator, start.state, plan.first, plan.last - plan.first + 1, notes);
@@ -146,6 +164,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);
+  if (config.space_check) check_room(plan, start, tree.model, layout, frames);
   const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes);
   replay_journal(plan, layout, start, frames, log.notes);
   const auto run_began = std::chrono::steady_clock::now();

@@ -63,6 +63,12 @@ struct TreeBakeResult {
 // The journal of `plan` for a model whose outputs want velocities or not.
 JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities);
 
+// Room: the bytes that the outputs and, with checkpoints, the checkpoints and journal records
+// still to write from `start` will take, against the free space of each filesystem they go to
+// (io/free_space.h). Throws OutputError when some filesystem lacks room.
+void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
+                const BakeFrames& frames);
+
 // Warm up: a loop that starts afresh (not from a checkpoint, which lies past the warm-up) runs
 // whole periods until the tree's motion repeats; else nothing.
 LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes);

@@ -5,6 +5,8 @@
 #include <queue>
 
 #include "bake/prepare_tree.h"
+#include "io/checkpoint.h"
+#include "io/frame_journal.h"
 #include "io/output_estimate.h"
 
 namespace treeanim {
@@ -15,6 +17,7 @@ ForestEstimate estimate_forest(const Scene& scene) {
   std::vector<uint64_t> variant_cost(forest.variants.size(), 0);
   std::vector<double> variant_bytes(forest.variants.size(), 0);
   std::vector<size_t> variant_vertices(forest.variants.size(), 0);
+  std::vector<double> variant_checkpoint(forest.variants.size(), 0), variant_record(forest.variants.size(), 0);
   std::vector<bool> built(forest.variants.size(), false);
   for (size_t t = 0; t < forest.trees.size(); ++t) {
     const uint32_t v = forest.trees[t].variant;
@@ -23,6 +26,9 @@ ForestEstimate estimate_forest(const Scene& scene) {
     const Scene one = tree_scene(scene, t);
     const PreparedTree tree = prepare_tree(one);
     variant_vertices[v] = tree.model.vertex_count();
+    variant_checkpoint[v] = estimated_checkpoint_bytes(tree.model.vertex_count(), tree.model.cluster_count(),
+                                                       tree.model.leaf_count());
+    variant_record[v] = double(journal_record_bytes({"", 0, tree.model.vertex_count(), tree.model.leaf_count(), true}));
     variant_cost[v] = uint64_t(tree.model.vertex_count()) * uint64_t(steps);
     for (const OutputOptions& output : one.outputs)
       variant_bytes[v] += estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
@@ -33,6 +39,8 @@ ForestEstimate estimate_forest(const Scene& scene) {
     estimate.tree_cost.push_back(variant_cost[tree.variant]);
     estimate.tree_bytes.push_back(variant_bytes[tree.variant]);
     estimate.tree_vertices.push_back(variant_vertices[tree.variant]);
+    estimate.tree_checkpoint_bytes.push_back(variant_checkpoint[tree.variant]);
+    estimate.tree_record_bytes.push_back(variant_record[tree.variant]);
   }
   return estimate;
 }

@@ -20,6 +20,8 @@ struct ForestEstimate {
   std::vector<uint64_t> tree_cost;   // (trees) vertices x substeps of the bake
   std::vector<double> tree_bytes;    // (trees) estimated bytes of the tree's outputs
   std::vector<size_t> tree_vertices; // (trees) vertices of the tree's variant model
+  std::vector<double> tree_checkpoint_bytes;  // (trees) one checkpoint of the tree (an upper bound)
+  std::vector<double> tree_record_bytes;      // (trees) one frame of its journal, velocities included
 };
 
 // Builds each used variant's model once (derivation, mesh); no simulation. Throws InputError.

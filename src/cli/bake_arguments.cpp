@@ -62,6 +62,7 @@ BakeConfig bake_config(const RunRequest& request, const Scene& scene) {
   config.checkpoints = {request.checkpoint_every, request.resume,
                         checkpoint_folder(request.out_dir, request.checkpoint_dir)};
   config.threads = request.threads;
+  config.space_check = !request.no_space_check;
   return config;
 }
 

@@ -57,6 +57,9 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
   run_app->add_flag("--resume", args.run.resume,
                     "Continue from the newest usable checkpoint and complete every output; without "
                     "one, bake from the start");
+  run_app->add_flag("--no-space-check", args.run.no_space_check,
+                    "Bake even when the outputs' estimated size (with checkpoints and journal) exceeds the "
+                    "free space of their filesystems");
   run_app->add_option("--shard", args.run.shard,
                       "Bake only task I of N of a forest's trees (0-based, balanced by estimated cost; I may be "
                       "'auto' for $SLURM_ARRAY_TASK_ID); docs/farm.md");
@@ -105,6 +108,9 @@ void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
       ->required()->check(CLI::IsMember({"slurm", "script"}));
   submit->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(CLI::Range(1, 1'000'000));
   submit->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)");
+  submit->add_flag("--no-space-check", farm.no_space_check,
+                   "Submit even when the forest's estimated files exceed the output folder's free space (the "
+                   "tasks then skip their own check too)");
   submit->add_flag("--wait", farm.wait, "Wait for the gather job and exit with its status (slurm)");
   submit->add_option("--checkpoint-every", farm.checkpoint_every, "Frames between checkpoints (default: frames / 8)")
       ->check(CLI::Range(1LL, 1'000'000'000LL));

@@ -19,6 +19,7 @@ struct RunRequest {
   long long checkpoint_every = 0;             // frames between checkpoints; 0 = none
   std::filesystem::path checkpoint_dir;       // "" = out_dir/checkpoints
   bool resume = false;                        // start from the newest usable checkpoint
+  bool no_space_check = false;                // skip the estimate of the bake's files against the free space
   std::optional<std::string> shard;           // "I/N" or "auto/N": bake the forest's shard I of N only
   Verbosity verbosity = Verbosity::kNormal;
 };
@@ -46,6 +47,7 @@ struct FarmRequest {
   int cpus_per_task = 1;                      // submit: cores (OpenMP threads) of each task
   std::vector<std::string> sbatch_args;       // submit: extra #SBATCH options (--partition=x)
   std::filesystem::path logs;                 // gather: the tasks' logs (task-I.log) to point at
+  bool no_space_check = false;                // submit: skip the forest's estimate (and the tasks' own)
 };
 
 // Prints (and with --json writes) the tasks: trees per task, estimated core-hours and bytes.

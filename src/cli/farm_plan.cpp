@@ -5,22 +5,10 @@
 #include "bake/forest_tasks.h"
 #include "cli/commands.h"
 #include "common/errors.h"
+#include "io/free_space.h"
 #include "io/text_output.h"
 
 namespace treeanim {
-
-namespace {
-
-std::string bytes_text(double bytes) {
-  const char* units[] = {"B", "KB", "MB", "GB", "TB", "PB"};
-  int unit = 0;
-  while (bytes >= 1000 && unit < 5) bytes /= 1000, ++unit;
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g %s", bytes, units[unit]);
-  return text;
-}
-
-}  // namespace
 
 int farm_plan_command(const FarmRequest& request) {
   const Scene scene = load_scene(request.scene, request.overrides);

@@ -11,6 +11,7 @@
 #include "cli/run_program.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
+#include "io/free_space.h"
 #include "io/staged_files.h"
 #include "io/text_output.h"
 
@@ -32,13 +33,15 @@ struct FarmJob {
   long long checkpoint_every = 1;
   int cpus = 1;
   std::string overrides;  // " --set 'A=B'" ...
+  bool space_check = true;  // false: the tasks run with --no-space-check
 };
 
 // The command of task `index` (a shell expression, e.g. "$SLURM_ARRAY_TASK_ID").
 std::string task_command(const FarmJob& job, const std::string& index) {
   return shell_word(job.treeanim.string()) + " run " + shell_word(job.scene.string()) + " --shard \"" + index + "/" +
          std::to_string(job.tasks) + "\" -o " + shell_word(job.out.string()) + " --checkpoint-every " +
-         std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) + job.overrides;
+         std::to_string(job.checkpoint_every) + " --resume --threads " + std::to_string(job.cpus) +
+         (job.space_check ? "" : " --no-space-check") + job.overrides;
 }
 
 std::string gather_command(const FarmJob& job) {
@@ -89,26 +92,6 @@ std::string plain_script(const FarmJob& job) {
   return text;
 }
 
-// Folders made for a submission, removed again (when still empty) if it fails.
-class MadeFolders {
- public:
-  void make(const fs::path& folder) {
-    std::vector<fs::path> missing;
-    for (fs::path p = folder; !p.empty() && !fs::exists(p); p = p.parent_path()) missing.push_back(p);
-    std::error_code error;
-    fs::create_directories(folder, error);
-    if (error) throw OutputError(folder.string() + ": cannot create the folder: " + error.message());
-    made_.insert(made_.end(), missing.begin(), missing.end());
-  }
-  void undo() noexcept {
-    std::error_code ignored;
-    for (const fs::path& p : made_) fs::remove(p, ignored);  // deepest first; fails on a non-empty one
-  }
-
- private:
-  std::vector<fs::path> made_;
-};
-
 // The job id at the start of sbatch --parsable's output ("123" or "123;cluster"); "" if none.
 std::string job_id(const std::string& out) {
   size_t end = 0;
@@ -145,7 +128,9 @@ int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
                      "client commands), or write a plain script with --engine script; nothing was submitted");
   const fs::path array = job.farm / (job.name + ".sbatch"), gather = job.farm / (job.name + "-gather.sbatch");
   MadeFolders folders;
-  folders.make(job.logs);
+  std::error_code made;
+  folders.make(job.logs, made);
+  if (made) throw OutputError(job.logs.string() + ": cannot create the folder: " + made.message());
   // Submitted from temporaries (sbatch copies a script when it submits), renamed only when both are in.
   const fs::path array_temporary = temporary_path(array), gather_temporary = temporary_path(gather);
   const auto discard = [&] {
@@ -193,12 +178,22 @@ int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
   return report_submitted(job, request.wait, array_id, gather_id, second.status, array, gather);
 }
 
+// Every tree's outputs, checkpoints and journal: what the tasks will write under the output folder.
+double forest_bytes(const Scene& scene, const ForestEstimate& estimate, long long checkpoint_every) {
+  const long long checkpoints = (scene.time.frames - 1) / checkpoint_every;
+  double bytes = 0;
+  for (size_t t = 0; t < estimate.tree_bytes.size(); ++t)
+    bytes += estimate.tree_bytes[t] + double(checkpoints) * estimate.tree_checkpoint_bytes[t] +
+             double(scene.time.frames) * estimate.tree_record_bytes[t];
+  return bytes;
+}
+
 }  // namespace
 
 int farm_submit_command(const FarmRequest& request) {
   const Scene scene = load_scene(request.scene, request.overrides);
   if (!scene.forest) throw InputError(request.scene.string() + ": no /forest: farm submit bakes a forest's trees");
-  estimate_forest(scene);  // grows one tree of each variant: a bad grammar fails here, not in every task
+  const ForestEstimate estimate = estimate_forest(scene);  // a bad grammar fails here, not in every task
   FarmJob job;
   std::error_code error;
   job.treeanim = fs::read_symlink("/proc/self/exe", error);
@@ -214,6 +209,9 @@ int farm_submit_command(const FarmRequest& request) {
       request.checkpoint_every > 0 ? request.checkpoint_every : std::max(1LL, (scene.time.frames + 7) / 8);
   job.cpus = request.cpus_per_task;
   job.overrides = set_arguments(request.overrides);
+  job.space_check = !request.no_space_check;
+  if (job.space_check)
+    check_free_space({{job.out / "forest.json", forest_bytes(scene, estimate, job.checkpoint_every)}});
 
   if (request.engine == "slurm") return submit_to_slurm(job, request);
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");

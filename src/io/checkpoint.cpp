@@ -178,6 +178,13 @@ std::string scene_hash(const std::string& scene_json, const std::string& generat
   return text;
 }
 
+double estimated_checkpoint_bytes(size_t vertices, size_t clusters, size_t leaves) {
+  constexpr double kVertexBytes = 8 * 3 * 8;  // 8 arrays of (V x 3) doubles
+  constexpr double kClusterBytes = 8 * 8;     // rotation, shift and a damping term
+  constexpr double kLayoutBytes = 64 * 1024;  // HDF5's superblock, groups and attributes
+  return kVertexBytes * double(vertices) + kClusterBytes * double(clusters) + 2 * double(leaves) + kLayoutBytes;
+}
+
 fs::path checkpoint_path(const fs::path& dir, long long frame) {
   return dir / ("checkpoint-" + std::to_string(frame) + ".h5");
 }

@@ -29,6 +29,10 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& dir, long lon
 // none when dir does not exist.
 std::vector<std::pair<long long, std::filesystem::path>> list_checkpoints(const std::filesystem::path& dir);
 
+// A model's sizes => an upper bound of one checkpoint's bytes: the state's vertex arrays (positions,
+// velocities and the step prediction's six) and cluster arrays in double, flags, and the HDF5 layout.
+double estimated_checkpoint_bytes(size_t vertices, size_t clusters, size_t leaves);
+
 // The state after `frame` => `path`, atomically: a temporary beside it, flushed to disk, then
 // renamed. Throws OutputError naming the path.
 void write_checkpoint(const std::filesystem::path& path, const SimState& state, long long frame,

@@ -60,8 +60,8 @@ FrameJournal::~FrameJournal() {
   if (file_) std::fclose(file_);
 }
 
-uint64_t FrameJournal::record_bytes() const {
-  return 16 + 12 * layout_.vertices * (layout_.velocities ? 2 : 1) + layout_.leaves;
+uint64_t journal_record_bytes(const JournalLayout& layout) {
+  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves;
 }
 
 FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {

@@ -21,6 +21,9 @@ struct JournalLayout {
   bool velocities = false;      // records hold velocities (an output asked for them)
 };
 
+// A layout => the bytes of one record: frame, time, positions (and velocities), leaf flags.
+uint64_t journal_record_bytes(const JournalLayout& layout);
+
 class FrameJournal {
  public:
   // Creates (truncates) the journal at `path`. Throws OutputError.
@@ -45,7 +48,7 @@ class FrameJournal {
 
  private:
   FrameJournal(std::filesystem::path path, const JournalLayout& layout, std::FILE* file, long long records);
-  uint64_t record_bytes() const;
+  uint64_t record_bytes() const { return journal_record_bytes(layout_); }
   std::filesystem::path path_;
   JournalLayout layout_;
   std::FILE* file_ = nullptr;

@@ -15,7 +15,9 @@
 
 #include "common/errors.h"
 #include "io/frame_sink.h"
+#include "io/output_estimate.h"
 #include "io/output_formats.h"
+#include "io/output_lock.h"
 #include "io/staged_files.h"
 #include "io/vertex_normals.h"
 
@@ -40,6 +42,7 @@ struct Worker {
   std::unique_ptr<FrameSink> sink;
   FrameSelection selection;
   fs::path first_path;  // for messages about failures that do not name a path themselves
+  double estimated_bytes = 0;  // of the frames it will write (estimated_output_bytes)
   std::thread thread;
   std::mutex mutex;
   std::condition_variable changed;  // queue, closing, stopping or error changed
@@ -101,6 +104,14 @@ struct OutputSet::Impl {
   std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
   bool leaf_flags = false;  // some output writes the leaves' attached flags
   bool done = false;  // finished or aborted
+  OutputLocks locks;  // one per output, held from the checks to the end (io/output_lock.h)
+  MadeFolders folders;  // made for the outputs: removed, when empty, if the bake fails
+
+  // A failed bake's locks dropped and the folders it made removed (a lock file would keep one).
+  void undo() noexcept {
+    locks.release();
+    folders.undo();
+  }
 
   explicit Impl(const TreeModel& m) : model(m) {}
 };
@@ -116,7 +127,8 @@ fs::path resolve(const fs::path& path, const fs::path& out_dir) {
 // leaves nothing created; the second creates folders and probes them. A sequence has a target
 // per frame, so this runs on strings: path comparisons per component cost ~20 us a target, a
 // minute for a million-frame sequence.
-void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs) {
+void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs,
+                   MadeFolders& made) {
   const fs::path cwd = fs::current_path();
   std::unordered_map<std::string, size_t> writer;  // absolute file written => output index
   std::unordered_set<std::string> folders;         // absolute folders seen
@@ -143,7 +155,7 @@ void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const st
       if (folders.insert(absolute.substr(0, absolute.rfind('/'))).second) probes.push_back(file);
     });
   }
-  for (const fs::path& file : probes) check_writable_target(file);
+  for (const fs::path& file : probes) check_writable_target(file, made);
 }
 
 }  // namespace
@@ -157,12 +169,20 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     worker->selection = {info.frame_start, info.frame_count, options.frame_step};
     const auto summary = worker->sink->summary_paths();
     worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();
+    worker->estimated_bytes = estimated_output_bytes(options, model.vertex_count(), model.triangle_count(),
+                                                     model.cluster_count(), info.frame_count);
     impl_->velocities = impl_->velocities || options.velocities;
     impl_->normals = impl_->normals || options.normals;
     impl_->leaf_flags = impl_->leaf_flags || options.format->leaf_flags;
     impl_->workers.push_back(std::move(worker));
   }
-  check_targets(impl_->workers, outputs);
+  try {
+    check_targets(impl_->workers, outputs, impl_->folders);
+    for (const OutputOptions& options : outputs) impl_->locks.lock(resolve(options.path, out_dir));
+  } catch (...) {
+    impl_->undo();
+    throw;
+  }
   if (impl_->normals) impl_->rest_normals = rest_normals(model);
 }
 
@@ -225,6 +245,7 @@ void OutputSet::finish() {
     abort();
     throw;
   }
+  impl_->locks.release();
   impl_->done = true;
 }
 
@@ -240,6 +261,7 @@ void OutputSet::abort() noexcept {
     if (worker->thread.joinable()) worker->thread.join();
     worker->sink->abort();
   }
+  impl_->undo();
   impl_->done = true;
 }
 
@@ -248,6 +270,12 @@ std::vector<std::pair<fs::path, std::string>> OutputSet::reports() const {
   for (const auto& worker : impl_->workers)
     if (std::string line = worker->sink->report(); !line.empty()) reports.emplace_back(worker->first_path, line);
   return reports;
+}
+
+std::vector<std::pair<fs::path, double>> OutputSet::estimated_bytes() const {
+  std::vector<std::pair<fs::path, double>> bytes;
+  for (const auto& worker : impl_->workers) bytes.emplace_back(worker->first_path, worker->estimated_bytes);
+  return bytes;
 }
 
 std::vector<fs::path> OutputSet::files(size_t k) const {

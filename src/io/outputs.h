@@ -51,10 +51,12 @@ struct FrameData {
 class OutputSet {
  public:
   // Resolves relative paths against out_dir (when not empty), checks every target (folder
-  // exists or can be made, writable, format limits such as 4 GiB GLB) before simulation. The
+  // exists or can be made, writable, format limits such as 4 GiB GLB) and locks each output
+  // against other bakes (io/output_lock.h) before simulation; finish() and abort() unlock. The
   // options are as the scene reader checked them. Throws InputError for a target no output may
   // write (a directory, one written twice, a GLB past 4 GiB), OutputError naming the path for
-  // unwritable targets.
+  // unwritable targets
+  // and for an output another bake holds.
   OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
             const TreeModel& model, const BakeInfo& info);
   ~OutputSet();  // abort()s when finish() was not reached
@@ -74,6 +76,8 @@ class OutputSet {
   std::vector<std::filesystem::path> final_paths() const;
   // Every file of output k, in the order of its sink (a sequence: each frame's file and the rest mesh).
   std::vector<std::filesystem::path> files(size_t k) const;
+  // Each output's first file and the bytes of the frames it will write (estimated_output_bytes).
+  std::vector<std::pair<std::filesystem::path, double>> estimated_bytes() const;
   // After finish(): what outputs have to say besides their paths (a fit's error), by output path.
   std::vector<std::pair<std::filesystem::path, std::string>> reports() const;
 

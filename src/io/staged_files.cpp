@@ -65,10 +65,23 @@ std::string non_regular_kind(const fs::path& path) {
   return kind_of(fs::symlink_status(path, error));
 }
 
-void check_writable_target(const fs::path& target) {
+void MadeFolders::make(const fs::path& folder, std::error_code& error) {
+  std::vector<fs::path> missing;
+  for (fs::path p = folder; !p.empty() && !fs::exists(p, error); p = p.parent_path()) missing.push_back(p);
+  fs::create_directories(folder, error);
+  made_.insert(made_.begin(), missing.begin(), missing.end());  // later folders first: deeper or apart
+}
+
+void MadeFolders::undo() noexcept {
+  std::error_code ignored;
+  for (const fs::path& p : made_) fs::remove(p, ignored);  // fails, harmlessly, on a folder not empty
+  made_.clear();
+}
+
+void check_writable_target(const fs::path& target, MadeFolders& made) {
   const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
   std::error_code error;
-  fs::create_directories(folder, error);
+  made.make(folder, error);
   if (error || !fs::is_directory(folder))
     throw OutputError(target.string() + ": cannot create the folder " + folder.string() +
                       (error ? ": " + error.message() : ": a file is in the way"));

@@ -27,10 +27,23 @@ OutputTarget resolve_output_target(const std::filesystem::path& target);
 // opens the path (opening a FIFO blocks) and never follows a link.
 std::string non_regular_kind(const std::filesystem::path& path);
 
+// Folders made for a bake or a submission, removed again (when still empty) if it fails, so
+// that a failure leaves what stood before and nothing else.
+class MadeFolders {
+ public:
+  // create_directories(folder), remembering the folders that did not exist.
+  void make(const std::filesystem::path& folder, std::error_code& error);
+  // Removes the remembered folders that are empty, deepest first. Never throws.
+  void undo() noexcept;
+
+ private:
+  std::vector<std::filesystem::path> made_;  // deepest first within each make()
+};
+
 // Checks, before anything is simulated, that a file can be created in `target`'s folder: the
-// folder exists or is created, and a probe temporary is created and removed. Throws OutputError
-// naming the path.
-void check_writable_target(const std::filesystem::path& target);
+// folder exists or is created (into `made`), and a probe temporary is created and removed.
+// Throws OutputError naming the path.
+void check_writable_target(const std::filesystem::path& target, MadeFolders& made);
 
 class StagedFiles {
  public:

@@ -23,7 +23,7 @@ bool is_index(const std::string& token) {
 
 TimeOptions read_time_options(SceneObject section) {
   TimeOptions time;
-  time.fps = section.number("fps", time.fps, Range{0.0, 1000.0, true, false});
+  time.fps = section.number("fps", time.fps, Range::between(1, 1000));
   time.frames = section.integer("frames", time.frames, 1, 10'000'000);
   time.start = section.integer("start", time.start, -1'000'000'000, 1'000'000'000);
   time.substeps = static_cast<int>(section.integer("substeps", time.substeps, 1, 10'000));

@@ -13,6 +13,10 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Wind speed and gust amplitude, m/s: no recorded gust exceeds 113 m/s (Barrow Island, 1996), so a
+// larger value is a slip (1,000,000 for 10), not a storm.
+const Range kWindSpeed = Range::between(0, 113);
+
 // A direction vector => unit vector; zero or non-finite => nullopt.
 std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
   const double n = v.norm();
@@ -20,8 +24,9 @@ std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
   return Eigen::Vector3d(v / n);
 }
 
-// One field of a CSV line => finite number; throws "name:line: column 'what': ...".
-double csv_number(const std::string& cell, const std::string& where, const std::string& column) {
+// One field of a CSV line => finite number within `range`; throws "name:line: column 'what': ...".
+double csv_number(const std::string& cell, const std::string& where, const std::string& column,
+                  const Range& range = Range::any()) {
   size_t used = 0;
   double v = 0;
   try {
@@ -32,6 +37,8 @@ double csv_number(const std::string& cell, const std::string& where, const std::
   while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
   if (used == 0 || used != cell.size() || !std::isfinite(v))
     throw InputError(where + ": column '" + column + "': expected a finite number, got '" + cell + "'");
+  if (!range.contains(v))
+    throw InputError(where + ": column '" + column + "': expected " + range.describe() + ", got '" + cell + "'");
   return v;
 }
 
@@ -75,11 +82,11 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.k_d = section.number("k_d", o.k_d, Range::between(0, 1));
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
   o.leaf_turn = section.number("leaf_turn", o.leaf_turn, Range::between(0, 1));
-  o.yield_strain = section.number("yield_strain", o.yield_strain, Range::positive());
+  o.yield_strain = section.number("yield_strain", o.yield_strain, {0, 0.1, true, false});
   o.root_flexibility = section.number("root_flexibility", o.root_flexibility, Range::non_negative());
   // Below ~1 MPa (softer than any self-supporting plant tissue; green wood is 5-12 GPa) a
   // branch has no stiffness to speak of and the wind carries the tree away.
-  o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::at_least(1e6));
+  o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::between(1e6, 5e10));
   o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
   o.max_frequency = section.number("max_frequency", o.max_frequency, Range::positive());
   o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, Range::positive());
@@ -132,16 +139,14 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
                        std::to_string(cells.size()));
     WindKey key;
     key.time = csv_number(cells[0], where, "time");
-    key.speed = csv_number(cells[1], where, "speed");
-    if (key.speed < 0) throw InputError(where + ": column 'speed': expected a number >= 0, got '" + cells[1] + "'");
+    key.speed = csv_number(cells[1], where, "speed", kWindSpeed);
     const Eigen::Vector3d d(csv_number(cells[2], where, "dx"), csv_number(cells[3], where, "dy"),
                             csv_number(cells[4], where, "dz"));
     const auto direction = unit(d);
     if (!direction) throw InputError(where + ": columns 'dx,dy,dz': the direction must not be zero");
     key.direction = *direction;
     if (has_gust) {
-      key.gust = csv_number(cells[5], where, "gust");
-      if (key.gust < 0) throw InputError(where + ": column 'gust': expected a number >= 0, got '" + cells[5] + "'");
+      key.gust = csv_number(cells[5], where, "gust", kWindSpeed);
     }
     keys.push_back(key);
     if (const std::string error = order_error(keys, keys.size() - 1); !error.empty())
@@ -162,11 +167,11 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
     SceneObject& k = key_objects[i];
     WindKey key;
     key.time = k.number("time", 0, Range::any());
-    key.speed = k.number("speed", 0, Range::non_negative());
+    key.speed = k.number("speed", 0, kWindSpeed);
     const auto direction = unit(k.vector3("direction", key.direction));
     if (!direction) k.fail("direction", "expected a non-zero vector");
     key.direction = *direction;
-    key.gust = k.number("gust", 0, Range::non_negative());
+    key.gust = k.number("gust", 0, kWindSpeed);
     o.keys.push_back(key);
     if (const std::string error = order_error(o.keys, i); !error.empty()) k.fail("time", error);
   }
@@ -176,11 +181,11 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
       section.fail("file", "cannot open wind file '" + o.file->string() + "' (" + reason + ")");
     o.keys = parse_wind_csv(text, o.file->string());
   }
-  o.air_density = section.number("air_density", o.air_density, Range::non_negative());
+  o.air_density = section.number("air_density", o.air_density, Range::between(0, 1.6));
   o.branch_drag_coefficient = section.number("branch_drag_coefficient", o.branch_drag_coefficient, Range::between(0, 10));
   o.leaf_drag_coefficient = section.number("leaf_drag_coefficient", o.leaf_drag_coefficient, Range::between(0, 10));
   o.turbulence_intensity = section.number("turbulence_intensity", o.turbulence_intensity, Range::between(0, 10));
-  o.turbulence_length = section.number("turbulence_length", o.turbulence_length, {0, kInf, true, false});
+  o.turbulence_length = section.number("turbulence_length", o.turbulence_length, {0, 1000, true, false});
   o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::non_negative());
   o.turbulence_modes = static_cast<int>(section.integer("turbulence_modes", o.turbulence_modes, 1, 64));
   o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::non_negative());

@@ -35,9 +35,9 @@ TreeOptions read_tree_options(SceneObject section) {
   o.scale = section.number("scale", o.scale, Range::positive());
   o.width_scale = section.number("width_scale", o.width_scale, Range::positive());
   o.ring_sides = int(section.integer("ring_sides", o.ring_sides, 3, 256));
-  o.trunk_radius = section.number("trunk_radius", o.trunk_radius, Range::positive());
+  o.trunk_radius = section.number("trunk_radius", o.trunk_radius, {0, 10, true, false});
   o.min_radius = section.number("min_radius", o.min_radius, Range::positive());
-  o.wood_density = section.number("wood_density", o.wood_density, Range::positive());
+  o.wood_density = section.number("wood_density", o.wood_density, Range::between(50, 1500));
   o.pipe_exponent = section.number("pipe_exponent", o.pipe_exponent, Range::between(1.0, 4.0));
   o.tip_taper = section.number("tip_taper", o.tip_taper, Range::between(0.0, 1.0));
   o.bark_color = read_color(section, "bark_color", o.bark_color);

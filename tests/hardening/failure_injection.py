@@ -8,6 +8,7 @@ sequence, glb and pc2) from a fresh copy in a temporary folder. Works as root: a
 output is a path below a regular file or in /proc, not a chmod that root ignores.
 """
 import os
+import re
 import resource
 import shutil
 import signal
@@ -58,6 +59,7 @@ class Bake:
         self.scene = os.path.join(tmp, "bake.json")
         self.wind = os.path.join(tmp, "wind.csv")
         self.out = os.path.join(tmp, "out")
+        self.cleanups = []  # run when the scenario ends (a mounted filesystem: unmounted)
 
     def args(self, frames, extra=(), out=None):
         return [self.binary, "run", self.scene, "-o", out or self.out, "--quiet",
@@ -295,6 +297,33 @@ def interrupted(signal_number, code, name):
     return scenario
 
 
+def folders_under(folder):
+    """folder => every folder below it, itself included (relative paths); [] when absent."""
+    return sorted(os.path.relpath(root, folder) for root, _, _ in os.walk(folder))
+
+
+def interrupted_removes_made_folders(bake):
+    """SIGTERM during a bake into folders it made (-o out, the OBJ sequence's seq/): exit 143 and
+    those folders gone; folders that stood before (out/kept, empty) stay."""
+    process = bake.start(30000)
+    bake.wait_until_writing(process)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    expect(subprocess.CompletedProcess(process.args, process.returncode, "", stderr), 143, "interrupted by SIGTERM",
+           bake.out)
+    if os.path.exists(bake.out):
+        raise Failed("folders the bake made are left: %s" % folders_under(bake.out))
+    os.makedirs(os.path.join(bake.out, "kept"))
+    os.makedirs(os.path.join(bake.out, "seq"))
+    process = bake.start(30000, ["--set", "outputs.1.path=seq/new/tree.%04d.obj"])
+    bake.wait_until_writing(process)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    if process.returncode != 143 or folders_under(bake.out) != [".", "kept", "seq"]:
+        raise Failed("exit %d, folders %s; expected 143 and the folders that stood before: %s"
+                     % (process.returncode, folders_under(bake.out), stderr))
+
+
 def wind_file_deleted(bake):
     """The wind file is gone when the bake starts: bad input (2) naming /wind/file."""
     os.remove(bake.wind)
@@ -353,6 +382,97 @@ def glb_far_too_large_under_ulimit_v(bake):
     expect(done, 4, "over glTF's 4 GiB GLB limit", bake.out)
 
 
+def second_writer_refused(bake):
+    """A second bake of the same outputs while the first writes: exit 4 at once naming the
+    first's process, nothing of the first touched; the first completes, and leaves no lock file."""
+    first = bake.start(3000)
+    bake.wait_until_writing(first)
+    began = time.monotonic()
+    second = bake.run(3000)
+    seconds = time.monotonic() - began
+    if second.returncode != 4 or "another bake is writing this output (process %d, lock " % first.pid not in second.stderr:
+        first.kill()
+        raise Failed("the second bake: exit %d: %s" % (second.returncode, second.stderr))
+    if seconds > 5:
+        first.kill()
+        raise Failed("the refusal took %.1f s: it must come before simulating" % seconds)
+    _, stderr = first.communicate(timeout=300)
+    if first.returncode != 0:
+        raise Failed("the first bake: exit %d: %s" % (first.returncode, stderr))
+    left = files_under(bake.out)
+    if "bake.h5" not in left or any(".lock" in f or ".tmp-" in f for f in left):
+        raise Failed("unexpected files after the first bake: %s" % [f for f in left if "seq/" not in f])
+
+
+def resume_after_kill_not_blocked(bake):
+    """A bake killed with SIGKILL holds no lock any more: its --resume bakes to the end, reusing
+    and then removing the lock files it left."""
+    extra = ["--checkpoint-every", "100", "--resume"]
+    first = bake.start(3000, extra)
+    bake.wait_until_writing(first)
+    first.kill()
+    first.communicate()
+    if not any(f.endswith(".lock") for f in files_under(bake.out)):
+        raise Failed("no lock file was left by the killed bake: the scenario tests nothing")
+    done = bake.run(3000, extra, timeout=300)
+    if done.returncode != 0:
+        raise Failed("the resumed bake: exit %d: %s" % (done.returncode, done.stderr))
+    left = files_under(bake.out)  # the killed bake's temporaries stay (docs/outputs.md)
+    if "bake.h5" not in left or any(f.endswith(".lock") for f in left):
+        raise Failed("unexpected files after the resumed bake: %s" % [f for f in left if "seq/" not in f])
+
+
+def small_filesystem(bake):
+    """=> a 4 MiB tmpfs mounted at <tmp>/small (unmounted when the scenario's folder goes), or
+    None where mounting is not permitted."""
+    folder = os.path.join(bake.tmp, "small")
+    os.makedirs(folder)
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", folder], capture_output=True).returncode:
+        return None
+    bake.cleanups.append(lambda: subprocess.run(["umount", "-l", folder]))
+    return folder
+
+
+def no_room_for_the_outputs(bake):
+    """Outputs estimated past the free space of their filesystem (~200 MB for 3000 frames on a
+    4 MiB tmpfs): exit 4 before simulating, naming the path, what is needed and what is free."""
+    out = small_filesystem(bake)
+    if out is None:
+        print("skipped: mounting a tmpfs is not permitted here")
+        return SKIP
+    began = time.monotonic()
+    done = bake.run(3000, out=os.path.join(out, "out"))
+    seconds = time.monotonic() - began
+    expect(done, 4, "output failed: %s/out/bake.h5: not enough free space: the bake needs " % out, out)
+    if not re.search(r"needs [0-9.]+ MB on its filesystem, [0-9.]+ MB free", done.stderr):
+        raise Failed("the message lacks what is needed and what is free: " + done.stderr)
+    if seconds > 5:
+        raise Failed("the refusal took %.1f s: it must come before simulating" % seconds)
+    # Without the estimate the bake starts and meets the full disk while writing.
+    expect(bake.run(3000, ["--no-space-check"], out=os.path.join(out, "out")), 4,
+           "write failed: No space left on device", out)
+
+
+def no_room_for_the_forest(bake):
+    """farm submit estimates the whole forest against its output folder's free space; with
+    --no-space-check it writes the script, whose tasks skip their own estimate too."""
+    out = small_filesystem(bake)
+    if out is None:
+        print("skipped: mounting a tmpfs is not permitted here")
+        return SKIP
+    scene = os.path.join(HERE, "..", "..", "configs", "forest-demo.json")
+    done = subprocess.run([bake.binary, "farm", "submit", scene, "--tasks", "2", "--engine", "script", "-o", out],
+                          capture_output=True, text=True)
+    expect(done, 4, "%s/forest.json: not enough free space: the bake needs " % out, out)
+    done = subprocess.run([bake.binary, "farm", "submit", scene, "--tasks", "2", "--engine", "script", "-o", out,
+                           "--no-space-check"], capture_output=True, text=True)
+    with open(os.path.join(out, "farm", "forest-demo.sh")) as f:
+        script = f.read()
+    if done.returncode != 0 or script.count(" --no-space-check") != 1:
+        raise Failed("--no-space-check: exit %d, the tasks %s the flag: %s"
+                     % (done.returncode, "lack" if " --no-space-check" not in script else "repeat", done.stderr))
+
+
 def limit_address_space():
     """preexec: ulimit -v 4000000 (KiB), a render-farm node's share of memory."""
     limit = 4000000 * 1024
@@ -382,12 +502,17 @@ SCENARIOS = {
     "disk-full-efbig": disk_full_efbig,
     "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
     "sigterm": interrupted(signal.SIGTERM, 143, "SIGTERM"),
+    "interrupted-removes-made-folders": interrupted_removes_made_folders,
     "wind-file-deleted": wind_file_deleted,
     "wind-file-truncated": wind_file_truncated,
     "wind-file-deleted-mid-bake": wind_file_deleted_mid_bake,
     "module-cap-under-ulimit-v": module_cap_under_ulimit_v,
     "glb-too-large": glb_too_large,
     "glb-far-too-large-under-ulimit-v": glb_far_too_large_under_ulimit_v,
+    "no-room-for-the-outputs": no_room_for_the_outputs,
+    "second-writer-refused": second_writer_refused,
+    "resume-after-kill-not-blocked": resume_after_kill_not_blocked,
+    "no-room-for-the-forest": no_room_for_the_forest,
 }
 
 
@@ -402,11 +527,15 @@ def main():
         print("\n".join(n + (" defect" if n in OPEN_DEFECTS else "") for n in SCENARIOS))
         return 0
     with tempfile.TemporaryDirectory(prefix="treeanim-fi-") as tmp:
+        bake = Bake(binary, tmp)
         try:
-            result = SCENARIOS[name](Bake(binary, tmp))
+            result = SCENARIOS[name](bake)
         except Failed as failure:
             print("FAIL %s: %s" % (name, failure))
             return 1
+        finally:
+            for cleanup in bake.cleanups:
+                cleanup()
     print("ok %s" % name)
     return result or 0
 

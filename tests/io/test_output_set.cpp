@@ -2,9 +2,11 @@
 // the GLB size limit refused early with the number of frames that would fit.
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -40,7 +42,7 @@ TEST_F(OutputSetTest, AbortMidBakeLeavesNoFile) {
   set.push(small_frame(m, 0));
   set.push(small_frame(m, 1));
   set.abort();
-  EXPECT_EQ(entries(), (std::vector<std::string>{"gltf", "obj"}));  // folders made by the checks
+  EXPECT_EQ(entries(), std::vector<std::string>{});  // the folders the checks made are gone too
 }
 
 TEST_F(OutputSetTest, DestructorWithoutFinishLeavesNoFile) {
@@ -50,7 +52,48 @@ TEST_F(OutputSetTest, DestructorWithoutFinishLeavesNoFile) {
     set.begin();
     set.push(small_frame(m, 0));
   }
-  EXPECT_EQ(entries(), (std::vector<std::string>{"gltf", "obj"}));
+  EXPECT_EQ(entries(), std::vector<std::string>{});
+}
+
+TEST_F(OutputSetTest, AbortKeepsFoldersThatStoodBefore) {
+  const TreeModel m = small_model();
+  std::filesystem::create_directories(dir_ / "obj");
+  OutputSet set(every_format(), dir_, m, small_info(5, 0));
+  set.begin();
+  set.push(small_frame(m, 0));
+  set.abort();
+  EXPECT_EQ(entries(), std::vector<std::string>{"obj"});  // empty, yet not the bake's to remove
+}
+
+TEST_F(OutputSetTest, SecondSetOfTheSameOutputIsRefusedNamingTheHolder) {
+  const TreeModel m = small_model();
+  const std::vector<OutputOptions> outputs = {output("pc2", "tree.pc2")};
+  // A lock is per process, so the holder is a child that locks the output and waits.
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    OutputSet held(outputs, dir_, m, small_info(5, 0));
+    char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(1);
+    ::pause();
+    ::_exit(0);
+  }
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+  try {
+    OutputSet second(outputs, dir_, m, small_info(5, 0));
+    ADD_FAILURE() << "a second writer of the same output was let in";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "tree.pc2").string() + ": another bake is writing this output (process " +
+                                         std::to_string(child) + ", lock " + (dir_ / ".tree.pc2.lock").string() +
+                                         "); nothing was written: wait for it to end, or write elsewhere (-o)");
+  }
+  ::kill(child, SIGKILL);  // the kernel drops its lock: the output is free again
+  ::waitpid(child, nullptr, 0);
+  OutputSet third(outputs, dir_, m, small_info(5, 0));
+  third.abort();
+  EXPECT_EQ(entries(), std::vector<std::string>{});  // the dead holder's lock file removed with ours
 }
 
 TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {

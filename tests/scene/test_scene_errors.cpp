@@ -52,12 +52,12 @@ TEST(SceneErrors, UnknownTimeKey) {
 
 TEST(SceneErrors, FpsWrongType) {
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": "fast"}})"),
-            "s.json: /time/fps: expected a number in (0, 1000], got \"fast\"");
+            "s.json: /time/fps: expected a number in [1, 1000], got \"fast\"");
 }
 
 TEST(SceneErrors, FpsZero) {
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": 0}})"),
-            "s.json: /time/fps: expected a number in (0, 1000], got 0");
+            "s.json: /time/fps: expected a number in [1, 1000], got 0");
 }
 
 TEST(SceneErrors, FramesZero) {
@@ -112,7 +112,7 @@ TEST(SceneErrors, OverrideWithoutEquals) {
 
 TEST(SceneErrors, OverrideValueIsValidated) {
   EXPECT_EQ(error_of(kValid, {"time.fps=-1"}),
-            "s.json: /time/fps: expected a number in (0, 1000], got -1");
+            "s.json: /time/fps: expected a number in [1, 1000], got -1");
 }
 
 TEST(SceneErrors, MissingFileNamesTheResolvedPath) {

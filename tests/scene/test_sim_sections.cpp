@@ -93,7 +93,7 @@ TEST(WindOptions, RejectsBadKeys) {
   EXPECT_EQ(error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"direction": [0, 0, 0]}]}})")); }),
             "s.json: /wind/keys/0/direction: expected a non-zero vector");
   EXPECT_EQ(error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"speed": -1}]}})")); }),
-            "s.json: /wind/keys/0/speed: expected a number >= 0, got -1");
+            "s.json: /wind/keys/0/speed: expected a number in [0, 113], got -1");
 }
 
 TEST(WindOptions, ReadsCsvFileRelativeToTheScene) {
