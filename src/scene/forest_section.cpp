@@ -17,6 +17,14 @@ namespace {
 
 constexpr uint64_t kSeedMask = (1ull << 53) - 1;  // seeds are JSON integers: at most 2^53
 
+// A coordinate on the ground, m: 10 km from the origin a float position (what the outputs store)
+// rounds to 1 mm, the least motion of a twig worth baking.
+constexpr Range kGround = Range{-1e4, 1e4, false, false};
+// A turn about +Y, degrees: a turn past a full one repeats a smaller one, so a larger value is a slip.
+constexpr Range kTurn = Range{-360, 360, false, false};
+// A tree's size factor: 100 times its variant makes a 1 m sapling near the tallest tree known (116 m).
+constexpr Range kTreeScale = Range{0, 100, true, false};
+
 // A name that is safe as (part of) a file name on every system a farm uses.
 bool is_file_safe(const std::string& name) {
   if (name.empty() || name.size() > 64 || name[0] == '.' || name[0] == '-') return false;
@@ -102,9 +110,9 @@ ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, con
     element.fail("variant", "expected one of the variants' names (" + names + "), got \"" + variant + "\"");
   }
   tree.variant = static_cast<uint32_t>(found - variants.begin());
-  tree.position = element.vector3("position", Eigen::Vector3d::Zero());
-  tree.rotation = element.number("rotation", 0);
-  tree.scale = element.number("scale", 1, Range::positive());
+  tree.position = element.vector3("position", Eigen::Vector3d::Zero(), kGround);
+  tree.rotation = element.number("rotation", 0, kTurn);
+  tree.scale = element.number("scale", 1, kTreeScale);
   uint64_t state = scene_seed ^ 0x7472656573656564ull ^ (uint64_t(index) << 20);  // "treeseed", by index
   tree.seed = static_cast<uint64_t>(
       element.integer("seed", static_cast<long long>(splitmix64(state) & kSeedMask), 0, 1LL << 53));
@@ -117,14 +125,14 @@ ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, con
 void scatter_trees(SceneObject scatter, long long count, Forest& forest, uint64_t scene_seed) {
   if (!scatter.has("min") || !scatter.has("max"))
     scatter.fail(scatter.has("min") ? "max" : "min", "expected the area's corners min and max, each [x, z] in m");
-  const auto min = scatter.pair("min", {0, 0}), max = scatter.pair("max", {0, 0});
+  const auto min = scatter.pair("min", {0, 0}, kGround), max = scatter.pair("max", {0, 0}, kGround);
   const ScatterArea area{{min[0], min[1]}, {max[0], max[1]}};
   if (!(area.min.array() <= area.max.array()).all())
     scatter.fail("max", "expected a corner at or beyond min in x and z");
   const auto seed = static_cast<uint64_t>(scatter.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
   const long long attempts = scatter.integer("attempts", 1000, 1, 1'000'000);
-  const auto rotation = scatter.pair("rotation", {0, 360});
-  const auto scale = scatter.pair("scale", {1, 1}, Range::positive());
+  const auto rotation = scatter.pair("rotation", {0, 360}, kTurn);
+  const auto scale = scatter.pair("scale", {1, 1}, kTreeScale);
   if (rotation[0] > rotation[1]) scatter.fail_expected("rotation", "[lo, hi] degrees with lo <= hi");
   if (scale[0] > scale[1]) scatter.fail_expected("scale", "[lo, hi] with lo <= hi");
   double total_weight = 0;
@@ -167,7 +175,7 @@ Forest read_forest(SceneObject section, const ForestDefaults& defaults) {
   Forest forest;
   // Keys with defaults first: adding a key to this object moves its members, and the sections
   // read below keep pointers into them.
-  forest.spacing = section.number("spacing", 0, Range::non_negative());
+  forest.spacing = section.number("spacing", 0, Range::between(0, 1000));
   forest.variants = read_variants(section, defaults);
   std::vector<SceneObject> listed;
   if (section.has("trees")) listed = section.array_of_objects("trees");

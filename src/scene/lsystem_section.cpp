@@ -63,7 +63,7 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
   if (auto n = section.optional_integer("iterations", 0, 10000)) options.iterations = static_cast<int>(*n);
   options.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
   options.step = section.number("step", 1.0, Range::positive());
-  options.angle = section.optional_number("angle");
+  options.angle = section.optional_number("angle", Range::between(-360, 360));
   options.max_modules = static_cast<size_t>(section.integer("max_modules", 20'000'000, 1, 1LL << 29));
   options.width_factor = section.optional_number("width_factor", Range::positive());
   options.tropism = section.optional_vector3("tropism");

@@ -147,19 +147,20 @@ std::string SceneObject::choice(const std::string& key, const std::string& fallb
                 (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
 }
 
-std::optional<Eigen::Vector3d> SceneObject::optional_vector3(const std::string& key) {
+std::optional<Eigen::Vector3d> SceneObject::optional_vector3(const std::string& key, Range range) {
   declare(key);
   const Json* value = find(key);
   if (!value || value->is_null()) return std::nullopt;
   Eigen::Vector3d v;
   bool ok = value->is_array() && value->size() == 3;
-  for (int i = 0; ok && i < 3; ++i) ok = as_finite_number((*value)[i], &v[i]);
-  if (!ok) fail_expected(key, "an array of 3 finite numbers");
+  for (int i = 0; ok && i < 3; ++i) ok = as_finite_number((*value)[i], &v[i]) && range.contains(v[i]);
+  const bool bounded = std::isfinite(range.lo) || std::isfinite(range.hi);
+  if (!ok) fail_expected(key, bounded ? "an array of 3 numbers, each " + range.describe() : "an array of 3 finite numbers");
   return v;
 }
 
-Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector3d& fallback) {
-  if (auto v = optional_vector3(key)) return *v;
+Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector3d& fallback, Range range) {
+  if (auto v = optional_vector3(key, range)) return *v;
   (*node_)[key] = Json::array({fallback.x(), fallback.y(), fallback.z()});
   return fallback;
 }

@@ -53,8 +53,9 @@ class SceneObject {
   // One of `choices`; the message lists them.
   std::string choice(const std::string& key, const std::string& fallback,
                      const std::vector<std::string>& choices);
-  Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback);
-  std::optional<Eigen::Vector3d> optional_vector3(const std::string& key);
+  // Three finite numbers, each within `range`.
+  Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback, Range range = Range::any());
+  std::optional<Eigen::Vector3d> optional_vector3(const std::string& key, Range range = Range::any());
   // Two finite numbers, each within `range` ([x, z] on the ground, a [lo, hi] interval).
   std::array<double, 2> pair(const std::string& key, std::array<double, 2> fallback, Range range = Range::any());
   // A path string resolved against the scene file's folder (absolute paths kept).

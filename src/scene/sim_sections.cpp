@@ -17,6 +17,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // larger value is a slip (1,000,000 for 10), not a storm.
 const Range kWindSpeed = Range::between(0, 113);
 
+// A solver frequency, rad/s: at the shortest step the time keys allow (1000 fps, 10,000 substeps)
+// the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
+const Range kSolverFrequency = {0, 1.5e7, true, false};
+
 // A direction vector => unit vector; zero or non-finite => nullopt.
 std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
   const double n = v.norm();
@@ -83,20 +87,20 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
   o.leaf_turn = section.number("leaf_turn", o.leaf_turn, Range::between(0, 1));
   o.yield_strain = section.number("yield_strain", o.yield_strain, {0, 0.1, true, false});
-  o.root_flexibility = section.number("root_flexibility", o.root_flexibility, Range::non_negative());
+  o.root_flexibility = section.number("root_flexibility", o.root_flexibility, Range::between(0, 100));
   // Below ~1 MPa (softer than any self-supporting plant tissue; green wood is 5-12 GPa) a
   // branch has no stiffness to speak of and the wind carries the tree away.
   o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::between(1e6, 5e10));
-  o.global_scale = section.number("global_scale", o.global_scale, Range::non_negative());
-  o.max_frequency = section.number("max_frequency", o.max_frequency, Range::positive());
-  o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, Range::positive());
-  o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::non_negative());
+  o.global_scale = section.number("global_scale", o.global_scale, Range::between(0, 100));
+  o.max_frequency = section.number("max_frequency", o.max_frequency, kSolverFrequency);
+  o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, kSolverFrequency);
+  o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::between(0, 1.5e7));
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
-  o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::non_negative());
+  o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::between(0, 1e4));
   o.gravity = section.vector3("gravity", o.gravity);
   o.sleep = section.boolean("sleep", o.sleep);
-  o.sleep_velocity = section.number("sleep_velocity", o.sleep_velocity, Range::positive());
-  o.sleep_distance = section.number("sleep_distance", o.sleep_distance, Range::positive());
+  o.sleep_velocity = section.number("sleep_velocity", o.sleep_velocity, {0, 1, true, false});
+  o.sleep_distance = section.number("sleep_distance", o.sleep_distance, {0, 1, true, false});
   o.rotation_iterations =
       static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
   o.precision = section.choice("precision", "double", {"double", "float"}) == "double" ? Precision::kDouble
@@ -186,9 +190,9 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
   o.leaf_drag_coefficient = section.number("leaf_drag_coefficient", o.leaf_drag_coefficient, Range::between(0, 10));
   o.turbulence_intensity = section.number("turbulence_intensity", o.turbulence_intensity, Range::between(0, 10));
   o.turbulence_length = section.number("turbulence_length", o.turbulence_length, {0, 1000, true, false});
-  o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::non_negative());
+  o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::between(0, 1000));
   o.turbulence_modes = static_cast<int>(section.integer("turbulence_modes", o.turbulence_modes, 1, 64));
-  o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::non_negative());
+  o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::between(0, 10));
   o.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0,
                                                  std::numeric_limits<long long>::max()));
   return o;

@@ -2,13 +2,17 @@
 
 namespace treeanim {
 
+// A branch radius, m: the thickest trunk known (the Arbol del Tule, about 11 m across) has a radius
+// under 6 m.
+constexpr Range kRadius{0, 10, true, false};
+
 // /tree/leaf object => leaf options (defaults written back into the scene).
 static LeafOptions read_leaf_options(SceneObject section) {
   LeafOptions o;
-  o.size = section.number("size", o.size, Range::positive());
-  o.aspect = section.number("aspect", o.aspect, Range::positive());
-  o.petiole = section.number("petiole", o.petiole, Range::non_negative());
-  o.areal_density = section.number("areal_density", o.areal_density, Range::positive());
+  o.size = section.number("size", o.size, {0, 25, true, false});
+  o.aspect = section.number("aspect", o.aspect, {0, 10, true, false});
+  o.petiole = section.number("petiole", o.petiole, Range::between(0, 10));
+  o.areal_density = section.number("areal_density", o.areal_density, {0, 20, true, false});
   o.mesh = section.optional_path("mesh");
   return o;
 }
@@ -32,11 +36,11 @@ static ClusterOptions read_cluster_options(SceneObject section) {
 
 TreeOptions read_tree_options(SceneObject section) {
   TreeOptions o;
-  o.scale = section.number("scale", o.scale, Range::positive());
+  o.scale = section.number("scale", o.scale, {0, 100, true, false});
   o.width_scale = section.number("width_scale", o.width_scale, Range::positive());
   o.ring_sides = int(section.integer("ring_sides", o.ring_sides, 3, 256));
-  o.trunk_radius = section.number("trunk_radius", o.trunk_radius, {0, 10, true, false});
-  o.min_radius = section.number("min_radius", o.min_radius, Range::positive());
+  o.trunk_radius = section.number("trunk_radius", o.trunk_radius, kRadius);
+  o.min_radius = section.number("min_radius", o.min_radius, kRadius);
   o.wood_density = section.number("wood_density", o.wood_density, Range::between(50, 1500));
   o.pipe_exponent = section.number("pipe_exponent", o.pipe_exponent, Range::between(1.0, 4.0));
   o.tip_taper = section.number("tip_taper", o.tip_taper, Range::between(0.0, 1.0));

@@ -52,7 +52,7 @@ std::string error_of(const std::string& text) {
 TEST(TreeOptions, BadValuesNameThePointer) {
   EXPECT_EQ(error_of(R"({"tree": {"ring_sides": 2}})"),
             "s.json: /tree/ring_sides: expected an integer in [3, 256], got 2");
-  EXPECT_EQ(error_of(R"({"tree": {"leaf": {"size": 0}}})"), "s.json: /tree/leaf/size: expected a number > 0, got 0");
+  EXPECT_EQ(error_of(R"({"tree": {"leaf": {"size": 0}}})"), "s.json: /tree/leaf/size: expected a number in (0, 25], got 0");
   EXPECT_EQ(error_of(R"({"tree": {"cluster": {"segment_per_cluster": 2}}})"),
             "s.json: /tree/cluster/segment_per_cluster: unknown key (did you mean "
             "/tree/cluster/segments_per_cluster?)");
