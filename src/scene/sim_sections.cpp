@@ -97,7 +97,7 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::between(0, 1.5e7));
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
   o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::between(0, 1e4));
-  o.gravity = section.vector3("gravity", o.gravity);
+  o.gravity = section.vector3("gravity", o.gravity, Range::between(-100, 100));
   o.sleep = section.boolean("sleep", o.sleep);
   o.sleep_velocity = section.number("sleep_velocity", o.sleep_velocity, {0, 1, true, false});
   o.sleep_distance = section.number("sleep_distance", o.sleep_distance, {0, 1, true, false});
