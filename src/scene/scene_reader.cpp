@@ -187,24 +187,21 @@ std::optional<std::filesystem::path> SceneObject::optional_path(const std::strin
   return p.is_absolute() ? p : (reader_->scene_dir() / p).lexically_normal();
 }
 
-SceneObject SceneObject::object(const std::string& key) {
+Json& SceneObject::declared_or(const std::string& key, Json empty) {
   declare(key);
-  Json* value = node_->contains(key) ? &(*node_)[key] : nullptr;
-  if (!value || value->is_null()) {
-    (*node_)[key] = Json::object();
-    value = &(*node_)[key];
-  }
+  Json& value = (*node_)[key];  // a missing key is created as null
+  if (value.is_null()) value = std::move(empty);
+  return value;
+}
+
+SceneObject SceneObject::object(const std::string& key) {
+  Json* value = &declared_or(key, Json::object());
   if (!value->is_object()) fail_expected(key, "an object");
   return SceneObject(reader_, value, pointer_of(key));
 }
 
 std::vector<SceneObject> SceneObject::array_of_objects(const std::string& key) {
-  declare(key);
-  Json* value = node_->contains(key) ? &(*node_)[key] : nullptr;
-  if (!value || value->is_null()) {
-    (*node_)[key] = Json::array();
-    value = &(*node_)[key];
-  }
+  Json* value = &declared_or(key, Json::array());
   if (!value->is_array()) fail_expected(key, "an array of objects");
   std::vector<SceneObject> out;
   for (size_t i = 0; i < value->size(); ++i) {

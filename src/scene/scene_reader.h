@@ -84,6 +84,8 @@ class SceneObject {
 
  private:
   const Json* find(const std::string& key) const;
+  // key, the empty value of its type => its value, declared; absent or null becomes `empty`.
+  Json& declared_or(const std::string& key, Json empty);
   SceneReader* reader_;
   Json* node_;
   std::string pointer_;
