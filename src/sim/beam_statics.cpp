@@ -274,13 +274,18 @@ inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Re
   back += ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15];
 }
 
+// Where the goal writes go: per vertex its goal (prediction.goal) and damping compliance.
+template <typename Real>
+struct GoalRows {
+  Real *x, *y, *z, *compliance;
+};
+
 // Vertex v's sums over its clusters and share = 1 / their number => its goal, the mean, and
 // its damping compliance, never below 0.
 template <typename Real>
 inline void store_goal(const GoalRows<Real>& out, size_t v, Real ox, Real oy, Real oz, Real back, Real share) {
-  const size_t k = v - out.first;
-  out.x[k] = ox * share, out.y[k] = oy * share, out.z[k] = oz * share;
-  out.compliance[k] = std::max(back * share, Real(0));
+  out.x[v] = ox * share, out.y[v] = oy * share, out.z[v] = oz * share;
+  out.compliance[v] = std::max(back * share, Real(0));
 }
 
 // A run [v, run_end) of vertices in the same N clusters (SolverModel::vertex_run_end) => their
@@ -313,7 +318,8 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
 
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, const GoalRows<Real>& out, size_t begin, size_t end) {
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end) {
   const TreeModel& tree = model.tree;
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
   // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
@@ -325,6 +331,8 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
+  const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
+                              prediction.goal.col(2).data(), prediction.damping_compliance.data()};
   with_kernel_isa([&] {
     for (size_t v = begin; v < end;) {
       const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
@@ -356,7 +364,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   template void deflect_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,              \
                                   StepScratch<Real>&);                                                              \
   template void write_static_offsets(const SolverModel<Real>&, const Attachment<Real>&, const StepScratch<Real>&, \
-                                     const GoalRows<Real>&, size_t, size_t);
+                                     StepPrediction<Real>&, size_t, size_t);
 TREEANIM_BEAM_STATICS(float)
 TREEANIM_BEAM_STATICS(double)
 #undef TREEANIM_BEAM_STATICS

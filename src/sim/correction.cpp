@@ -12,55 +12,131 @@
 
 #include "common/errors.h"
 #include "sim/kernel_isa.h"
+#include "sim/prediction.h"
 #include "sim/solver_step.h"
-#include "sim/vertex_pass.h"
 
 namespace treeanim {
 
+namespace {
 
+// Vertex v => the mean of its clusters' corrections, summed in membership order (never the
+// sum: Eq. 7 with overlaps). A released membership's row holds 0.
 template <typename Real>
-uint32_t deflect_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                             StepScratch<Real>& scratch, size_t first, size_t last, bool any_asleep,
-                             VertexPass pass) {
-  StepPrediction<Real>& prediction = state.prediction<Real>();
-  const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
-  // The state's velocities are taken at its time: the first kick from them is half a step's.
-  const Real kick = load ? Real(0.5) : Real(1);
-  if (end) write_state(model, attachment, state, any_asleep, first, last);
-  // 1. The static deflection under that drag, and the prediction of the next step.
-  if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
-  auto goals = [&](size_t begin, size_t stop) {
-    if (model.beam) write_static_offsets(model, attachment, scratch, goal_rows(prediction, 0), begin, stop);
-  };
-  return with_kernel_isa([&] {
-    return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !load, false, any_asleep, false,
-                             goals, [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                               return end ? predict_block<false>(model, attachment, scratch, prediction, begin, n,
-                                                                 in, kick, block)
-                                          : predict_block<true>(model, attachment, scratch, prediction, begin, n,
-                                                                in, kick, block);
-                             });
-  }).first;
+inline Eigen::Matrix<Real, 1, 3> mean_correction(const TreeModel& tree, const Attachment<Real>& attachment,
+                                                 const StepScratch<Real>& scratch, uint32_t v) {
+  Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
+  for (uint32_t s = tree.vertex_cluster_offsets[v]; s < tree.vertex_cluster_offsets[v + 1]; ++s)
+    pull += scratch.member_correction.row(tree.vertex_memberships[s]);
+  return pull * attachment.vertex_inv_count[v];
 }
 
+// Shared vertices in [first, last) => their mean correction in their pull row, read by the
+// direct vertex pass.
 template <typename Real>
-void throw_vertex_fault(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
-                        long long frame, int substep, uint32_t bad, uint32_t runaway) {
-  // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
-  auto where = [&](uint32_t v) {
-    return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-           std::to_string(attachment.vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
-  };
-  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
-  if (runaway != kNone) {
-    char distances[160];
-    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
-                  state.prediction<Real>().offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
-                  std::sqrt(model.runaway_distance2) / kRunawaySizes);
-    throw SimulationError(where(runaway) + distances +
-                          ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                          StepScratch<Real>& scratch, size_t first, size_t last) {
+  const auto from = std::lower_bound(model.shared_vertices.begin(), model.shared_vertices.end(), first);
+  const auto to = std::lower_bound(from, model.shared_vertices.end(), last);
+  for (auto it = from; it != to; ++it)
+    scratch.member_correction.row(attachment.vertex_pull_row[*it]) = mean_correction(model.tree, attachment, scratch, *it);
+}
+
+// Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
+// asleep), their factors and, `with_pull`, block.pull, each vertex's mean correction;
+// kFromState first loads u = x - x0 and v from the state (anchors included: they hold where
+// they are).
+template <typename Real>
+void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                  const StepScratch<Real>& scratch, bool load_state, bool with_pull, bool any_asleep, size_t begin,
+                  int n, VertexBlock<Real>& block) {
+  const TreeModel& tree = model.tree;
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  for (int k = 0; k < n; ++k) {
+    const size_t v = begin + k;
+    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
+                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+    block.moving[k] = still ? 0 : 1;
+    block.drag[k] = still ? Real(0) : model.vertex_drag[v];
+    block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
+    block.global[k] = still ? Real(0) : attachment.vertex_global[v];
+    block.flying[k] = still ? 0 : attachment.vertex_flying[v];
+    Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
+    if (load_state) {
+      prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
+      prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
+    } else if (with_pull && !still) {
+      pull = mean_correction(tree, attachment, scratch, static_cast<uint32_t>(v)).transpose();
+    }
+    for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
   }
 }
+
+// The corrected vertices [first, last) (prediction) => the state's positions and velocities,
+// in double; a vertex that does not move keeps its values.
+template <typename Real>
+void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                 bool any_asleep, size_t first, size_t last) {
+  const TreeModel& tree = model.tree;
+  const StepPrediction<Real>& prediction = state.prediction<Real>();
+  for (size_t v = first; v < last; ++v) {
+    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
+                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+    if (still) continue;
+    state.positions.col(v) = tree.rest_positions.col(v) + prediction.offset.row(v).transpose().template cast<double>();
+    state.velocities.col(v) = prediction.velocity.row(v).transpose().template cast<double>();
+  }
+}
+
+// One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
+// values are not finite and (`check_runaway`) the lowest attached one farther than the
+// runaway limit. `before` runs on each block's range first.
+// Without sleeping islands every free vertex reads its mean correction from one row
+// (anchors: the zero row, with factors that keep them still), which the first pass of a step
+// averages (`first_pass`); otherwise, and when a frame starts from the state, each block is
+// gathered lane by lane.
+template <typename Real, typename Before, typename Kernel>
+std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                                                SimState& state, StepScratch<Real>& scratch, size_t first,
+                                                size_t last, bool load_state, bool with_pull, bool first_pass,
+                                                bool any_asleep, bool check_runaway, Before before, Kernel kernel) {
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  uint32_t bad = kNone, runaway = kNone;
+  const bool direct = !load_state && !any_asleep;
+  if (direct && with_pull && first_pass) average_shared_pulls(model, attachment, scratch, first, last);
+  const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
+                                scratch.member_correction.col(2).data()};
+  VertexBlock<Real> block;
+  for (size_t begin = first; begin < last; begin += kVertexBlock) {
+    const int n = static_cast<int>(std::min<size_t>(kVertexBlock, last - begin));
+    before(begin, begin + n);
+    VertexInputs<Real> in;
+    if (direct) {
+      in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
+            model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
+            attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
+      std::fill(block.moving, block.moving + n, uint8_t(1));
+    } else {
+      gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
+      in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
+            block.global, block.flying, {}, nullptr};
+    }
+    for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
+    in.kicked = model.vertex_shape_kick.data() + begin;
+    if (!kernel(begin, n, in, block)) continue;
+    // Rare: find the first vertex at fault, as the scalar tests would.
+    for (int k = 0; k < n; ++k) {
+      if (!block.moving[k]) continue;
+      const uint32_t v = static_cast<uint32_t>(begin + k);
+      if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite()) bad = std::min(bad, v);
+      if (check_runaway && !attachment.vertex_flying[v] &&
+          prediction.offset.row(v).template cast<double>().squaredNorm() > model.runaway_distance2)
+        runaway = std::min(runaway, v);
+    }
+  }
+  return {bad, runaway};
+}
+
+}  // namespace
 
 // One parallel region: the correction (and load) pass; after a barrier, the state (kLastStep)
 // and the bar chain's passes; the prediction, each block's goals first. A failure found by a
@@ -72,6 +148,8 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
   const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
+  // The state's velocities are taken at its time: the first kick from them is half a step's.
+  const Real kick = load ? Real(0.5) : Real(1);
   uint32_t bad = kNone, runaway = kNone, bad_prediction = kNone;
   auto nothing = [](size_t, size_t) {};
 #pragma omp parallel if (model.parallel)
@@ -85,7 +163,11 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
       return for_vertex_blocks(
           model, attachment, state, scratch, first, last, load, !load, true, any_asleep, end, nothing,
           [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-            return correct_any(model, attachment, scratch, prediction, begin, n, in, block, end);
+            if (model.store_drag_force)
+              return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                         : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
+            return end ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
+                       : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
           });
     });
     if (my_bad != kNone || my_runaway != kNone) {
@@ -94,16 +176,43 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
     }
 #pragma omp barrier
     if (bad == kNone && runaway == kNone) {
-      const uint32_t my_bad_prediction =
-          deflect_and_predict(model, attachment, state, scratch, first, last, any_asleep, pass);
+      if (end) write_state(model, attachment, state, any_asleep, first, last);
+      // 1. The static deflection under that drag, and the prediction of the next step.
+      if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
+      auto goals = [&](size_t begin, size_t stop) {
+        if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
+      };
+      const uint32_t my_bad_prediction = with_kernel_isa([&] {
+        return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !load, false, any_asleep,
+                                 false, goals,
+                                 [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+                                   return end ? predict_block<false>(model, attachment, scratch, prediction, begin,
+                                                                     n, in, kick, block)
+                                              : predict_block<true>(model, attachment, scratch, prediction, begin, n,
+                                                                    in, kick, block);
+                                 });
+      }).first;
       if (my_bad_prediction != kNone) {
 #pragma omp critical(treeanim_correction_failure)
         bad_prediction = std::min(bad_prediction, my_bad_prediction);
       }
     }
   }
-  throw_vertex_fault(model, attachment, state, frame, substep, bad, runaway);
-  throw_vertex_fault(model, attachment, state, frame, substep, bad_prediction, kNone);
+  // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
+  auto where = [&](uint32_t v) {
+    return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+           std::to_string(attachment.vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
+  };
+  if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
+  if (runaway != kNone) {
+    char distances[160];
+    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
+                  prediction.offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
+                  std::sqrt(model.runaway_distance2) / kRunawaySizes);
+    throw SimulationError(where(runaway) + distances +
+                          ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+  }
+  if (bad_prediction != kNone) throw SimulationError(where(bad_prediction) + "non-finite position or velocity");
   return any_asleep;
 }
 
@@ -126,14 +235,6 @@ template bool correct_and_predict(const SolverModel<float>&, const Attachment<fl
                                   VertexPass, long long, int);
 template bool correct_and_predict(const SolverModel<double>&, const Attachment<double>&, SimState&,
                                   StepScratch<double>&, VertexPass, long long, int);
-template uint32_t deflect_and_predict(const SolverModel<float>&, const Attachment<float>&, SimState&,
-                                      StepScratch<float>&, size_t, size_t, bool, VertexPass);
-template uint32_t deflect_and_predict(const SolverModel<double>&, const Attachment<double>&, SimState&,
-                                      StepScratch<double>&, size_t, size_t, bool, VertexPass);
-template void throw_vertex_fault(const SolverModel<float>&, const Attachment<float>&, const SimState&, long long,
-                                 int, uint32_t, uint32_t);
-template void throw_vertex_fault(const SolverModel<double>&, const Attachment<double>&, const SimState&, long long,
-                                 int, uint32_t, uint32_t);
 template void predict_from_state(const SolverModel<float>&, const Attachment<float>&, SimState&, StepScratch<float>&,
                                  long long);
 template void predict_from_state(const SolverModel<double>&, const Attachment<double>&, SimState&,

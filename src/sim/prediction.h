@@ -31,7 +31,6 @@ struct VertexInputs {
   const Real *drag, *half_damping, *global;
   const uint8_t* flying;
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
-  const Real* compliance;  // s: the damping compliance of that goal (StepPrediction::damping_compliance)
   const uint8_t* kicked;  // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
 };
 
@@ -46,8 +45,6 @@ struct VertexBlock {
   Real half_damping[kVertexBlock];         // velocity factor per half step
   Real global[kVertexBlock];               // global rate per step
   uint8_t flying[kVertexBlock];            // 1 on a flying leaf
-  Real goal[3][kVertexBlock];              // m, goals written for this block alone (cluster_sweep.cpp)
-  Real compliance[kVertexBlock];           // s, their damping compliances
   Real check[kVertexBlock];                // sum of the new values: finite iff all are
   Real excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
 };
@@ -122,7 +119,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
       force[i] = prediction.drag_force.col(i).data() + begin;
       damped[i] = prediction.damping_offset.col(i).data() + begin;
     }
-  const Real* compliance = in.compliance;
+  const Real* compliance = prediction.damping_compliance.data() + begin;
   Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
   const double* rotation = scratch.cluster_rotation_matrix.data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;

@@ -3,7 +3,6 @@
 #include "sim/simulator.h"
 
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -91,9 +90,6 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
   if (!model.options.sleep || wake_islands(model, attachment, state, start)) {
     // 1. Predict the first step, unless the frame that wrote the state did.
     if (!predicted) predict_from_state(model, attachment, state, scratch, frame);
-    // A frame with every island awake and no leaf that may detach runs as one sweep per step.
-    const bool sweep = !model.detach_enabled && std::none_of(state.island_asleep.begin(), state.island_asleep.end(),
-                                                             [](uint8_t asleep) { return asleep != 0; });
     bool skipped_sleepers = false;
     for (int k = 0; k < model.substeps; ++k) {
       const bool last = k + 1 == model.substeps;
@@ -102,10 +98,6 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
       // 2, 3. Match the clusters on the predicted positions, branches, then attached leaves;
       // each samples the air of the next step (after the last: the next frame's first).
       set_air_time(model.wind, last ? start + model.frame_dt : start + (k + 1) * model.h, model.h, scratch.air);
-      if (sweep) {
-        sweep_clusters(model, attachment, state, scratch, k == 0, last, frame, k);
-        continue;
-      }
       match_clusters(model, attachment, state, scratch, frame, k);
       // 4, 1. Correct, and predict the next step; the last step writes the frame.
       skipped_sleepers = correct_and_predict(model, attachment, state, scratch,

@@ -94,35 +94,6 @@ void precompute_pins(SolverModel<Real>& m, Attachment<Real>& a) {
   }
 }
 
-// Memberships and pins => the runs of vertices the cluster sweep steps in their own cluster's
-// turn, and the runs of the others (SolverModel::cluster_runs, gathered_runs).
-template <typename Real>
-void precompute_sweep(SolverModel<Real>& m) {
-  const TreeModel& tree = m.tree;
-  std::vector<uint8_t> pinned(m.C, 0);
-  for (uint32_t c : m.pinned_leaf_clusters) pinned[c] = 1;
-  std::vector<uint32_t> own(m.V, kNone);  // (V) the vertex's one cluster, where the sweep steps it
-  for (size_t v = 0; v < m.V; ++v) {
-    const uint32_t begin = tree.vertex_cluster_offsets[v];
-    if (tree.vertex_cluster_offsets[v + 1] != begin + 1) continue;
-    const uint32_t c = m.member_cluster[tree.vertex_memberships[begin]];
-    if (!pinned[c]) own[v] = c;
-  }
-  // Vertex v => appended to `runs`, extending the last run from index `first` on when it ends at v.
-  auto add_run = [](std::vector<VertexRun>& runs, size_t first, uint32_t v) {
-    if (runs.size() > first && runs.back().end == v) ++runs.back().end;
-    else runs.push_back({v, v + 1});
-  };
-  m.cluster_run_offsets.assign(m.C + 1, 0);
-  for (size_t c = 0; c < m.C; ++c) {
-    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s)
-      if (own[tree.cluster_members[s]] == c) add_run(m.cluster_runs, m.cluster_run_offsets[c], tree.cluster_members[s]);
-    m.cluster_run_offsets[c + 1] = static_cast<uint32_t>(m.cluster_runs.size());
-  }
-  for (size_t v = 0; v < m.V; ++v)
-    if (own[v] == kNone) add_run(m.gathered_runs, 0, static_cast<uint32_t>(v));
-}
-
 // Drag areas and coefficients => per-vertex drag constants.
 template <typename Real>
 void precompute_drag(SolverModel<Real>& m, const WindOptions& w) {
@@ -234,7 +205,6 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   Attachment<Real>& a = all_attached;
   precompute_members(*this, a);
   precompute_pins(*this, a);
-  precompute_sweep(*this);
   for (size_t c = 0; c < C; ++c) rebuild_cluster_rest(*this, a, static_cast<uint32_t>(c));
   const StepRates rates = compute_step_rates(tree, options, chain, h);  // before the leaves join the chain
   cluster_alpha = rates.cluster_alpha;

@@ -39,11 +39,6 @@ constexpr double kRunawaySizes = 2.5;
 // vertices are in one, the rings where two clusters overlap in two.
 constexpr uint32_t kMaxRunClusters = 4;
 
-// Vertices [begin, end), consecutive.
-struct VertexRun {
-  uint32_t begin, end;
-};
-
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,
 // and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
 // detachment.cpp changes it when a leaf detaches, and rebuilds it from the model for a state
@@ -136,13 +131,6 @@ struct SolverModel {
   // writes take a run as one loop on its clusters' values.
   std::vector<uint32_t> vertex_run_end;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
-  // --- the cluster sweep (docs/solver.md, "One sweep"): a vertex in one cluster alone, which
-  // is matched in the sweep (not an attached leaf), is predicted, fitted, corrected and loaded
-  // in its cluster's turn; every other vertex (the overlap rings, the attached leaves, a vertex
-  // in no cluster) is predicted before the sweep and corrected after it ---
-  std::vector<uint32_t> cluster_run_offsets;    // (C+1) CSR into cluster_runs
-  std::vector<VertexRun> cluster_runs;          // each cluster's own vertices, in runs
-  std::vector<VertexRun> gathered_runs;         // every other vertex, in runs
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
   std::vector<uint32_t> island_vertices;        // non-anchored vertices, ascending per island

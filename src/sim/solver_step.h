@@ -8,20 +8,6 @@
 
 namespace treeanim {
 
-// Where the goals of vertices [first, ...) are written or read: vertex v's goal offset and
-// damping compliance at index v - first (the prediction's rows, or a block's own buffer).
-template <typename Real>
-struct GoalRows {
-  Real *x, *y, *z, *compliance;
-  size_t first;
-};
-// The prediction's goal rows from vertex `first`.
-template <typename Real>
-inline GoalRows<Real> goal_rows(StepPrediction<Real>& prediction, size_t first) {
-  return {prediction.goal.col(0).data() + first, prediction.goal.col(1).data() + first,
-          prediction.goal.col(2).data() + first, prediction.damping_compliance.data() + first, first};
-}
-
 // --- air.cpp ---
 // t, step h => the wind terms every cluster shares at t (mean, gust, turbulence amplitude,
 // phases), each wave averaged over the step (WindField::sample_time).
@@ -45,32 +31,10 @@ enum class VertexPass {
 template <typename Real>
 bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep);
-// Inside a parallel region, every thread, once the corrections and loads are complete: the
-// state's write (kLastStep) of vertices [first, last), the bar chain's passes, and the next
-// step's prediction of those vertices => the lowest vertex whose prediction is not finite.
-template <typename Real>
-uint32_t deflect_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                             StepScratch<Real>& scratch, size_t first, size_t last, bool any_asleep, VertexPass pass);
-// The lowest vertex with a non-finite value (bad) or past the runaway limit, kNone for none =>
-// SimulationError naming it, frame and substep (nothing when both are kNone).
-template <typename Real>
-void throw_vertex_fault(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
-                        long long frame, int substep, uint32_t bad, uint32_t runaway);
 // State at time t => the prediction of the first step from its positions and velocities.
 template <typename Real>
 void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                         StepScratch<Real>& scratch, long long frame);
-
-// --- cluster_sweep.cpp ---
-// A substep as one sweep over the clusters (docs/solver.md, "One sweep"): the prediction
-// (unless `predicted`: the first step of a frame, predicted by the frame before or from the
-// state), the match, the correction and the next step's loads, then the bar chain; the last
-// step of a frame (`end`) writes the state and predicts the next frame's first step. The
-// bytes of match_clusters + correct_and_predict, for a frame with no island asleep and no
-// leaf that may detach. Throws SimulationError as they do.
-template <typename Real>
-void sweep_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                    StepScratch<Real>& scratch, bool predicted, bool end, long long frame, int substep);
 
 // --- beam_statics.cpp ---
 // The attachment's active members and flying clusters => its cluster_drag_area and
@@ -84,11 +48,11 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
 template <typename Real>
 void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                        StepScratch<Real>& scratch);
-// The deflected chain => vertices [begin, end)'s offsets from rest in it and their damping
-// compliances, into `out`.
+// The deflected chain => vertices [begin, end)'s offsets from rest in it (prediction.goal).
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, const GoalRows<Real>& out, size_t begin, size_t end);
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end);
 
 // --- shape_matching.cpp ---
 // Predicted positions => rotations, shifts and per-membership corrections of every awake
