@@ -12,6 +12,7 @@
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -78,12 +79,7 @@ TEST(Cpfg, SameSymbolWithDifferentAritiesAndDeepHomomorphism) {
 }
 
 std::string error_of(const std::string& text, int steps = 1) {
-  try {
-    derive_text(text, steps);
-  } catch (const InputError& e) {
-    return std::string(e.what());
-  }
-  return "no error";
+  return input_error_of([&] { derive_text(text, steps); });
 }
 
 TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {

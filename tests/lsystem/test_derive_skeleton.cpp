@@ -7,6 +7,7 @@
 
 #include "common/errors.h"
 #include "lsystem/lsystem.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -16,13 +17,8 @@ std::filesystem::path grammar_file(const std::string& name) {
 }
 
 std::string error_of(const LsystemOptions& options) {
-  try {
-    GrowthStats stats;
-    grow_skeleton(options, &stats);
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "no error";
+  GrowthStats stats;
+  return input_error_of([&] { grow_skeleton(options, &stats); });
 }
 
 TEST(GrowSkeleton, InlineGrammarWithHomomorphismAndDefines) {

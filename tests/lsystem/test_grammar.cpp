@@ -8,6 +8,7 @@
 
 #include "common/errors.h"
 #include "lsystem/grammar.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -17,12 +18,7 @@ Grammar parse(const std::string& text, const std::vector<std::pair<std::string, 
 }
 
 std::string error_of(const std::string& text) {
-  try {
-    parse(text);
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "no error";
+  return input_error_of([&] { parse(text); });
 }
 
 TEST(Grammar, DirectivesAndRules) {

@@ -3,6 +3,7 @@
 
 #include "common/errors.h"
 #include "scene/lsystem_section.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -16,12 +17,7 @@ LsystemOptions read(Json& scene) {
 
 std::string error_of(const char* text) {
   Json scene = Json::parse(text);
-  try {
-    read(scene);
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "no error";
+  return input_error_of([&] { read(scene); });
 }
 
 TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {

@@ -3,6 +3,7 @@
 #include "common/errors.h"
 #include "io/output_formats.h"
 #include "scene/output_section.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -19,12 +20,7 @@ OutputOptions read_first(const std::string& text, Json* resolved = nullptr) {
 }
 
 std::string error_of(const std::string& text) {
-  try {
-    read_first(text);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
+  return input_error_of([&] { read_first(text); });
 }
 
 TEST(OutputOptions, DefaultsAreFilledIn) {

@@ -8,6 +8,7 @@
 #include "common/errors.h"
 #include "scene/sim_sections.h"
 #include "sim/wind.h"
+#include "input_error_of.h"
 
 namespace treeanim {
 namespace {
@@ -26,14 +27,7 @@ WindOptions read_wind(Json document, const std::filesystem::path& dir = "/scenes
   return o;
 }
 
-std::string error_of(auto&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
-}
+std::string error_of(auto&& f) { return input_error_of(f); }
 
 TEST(HsmOptions, DefaultsAreFilledIn) {
   Json document = Json::object();
