@@ -97,10 +97,12 @@ struct MemberLoads {
   const Real* arm[3];
 };
 
-// Membership s of vertex v => the vertex's share of the loads and their moments, added in lane l.
+// Membership s of vertex v, `on` 1 when it is active, else 0 => the vertex's share of the loads
+// and their moments, added in lane l. `on` comes as a Real: a byte read in the vector loop would
+// make GCC run it in 8-byte vectors.
 template <typename Real>
-inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, int l, LoadLanes<Real>& sum) {
-  const Real share = in.inv_count[v] * static_cast<Real>(in.active[s]);
+inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Real on, int l, LoadLanes<Real>& sum) {
+  const Real share = in.inv_count[v] * on;
   const Real gx = in.force[0][v] * share, gy = in.force[1][v] * share, gz = in.force[2][v] * share;
   const Real d = 2 * in.drag_damping[v] * share;
   const Real ax = in.arm[0][s], ay = in.arm[1][s], az = in.arm[2][s];
@@ -165,27 +167,32 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
   const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-  for (size_t c = first; c < last; ++c) {
-    LoadLanes<Real> sum = {};
-    if (!attachment.cluster_flying[c]) {
-      const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
-      for (uint32_t base = begin; base < end; base += kLoadLanes) {
-        // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
-        const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
-        if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
+  with_kernel_isa([&, first = first, last = last] {
+    for (size_t c = first; c < last; ++c) {
+      LoadLanes<Real> sum = {};
+      if (!attachment.cluster_flying[c]) {
+        const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+        for (uint32_t base = begin; base < end; base += kLoadLanes) {
+          // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
+          const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
+          Real on[kLoadLanes];
+          for (uint32_t l = 0; l < n; ++l) on[l] = static_cast<Real>(loads.active[base + l]);
+          if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
 #pragma omp simd
-          for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, l, sum);
-        } else {
-          for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], int(l), sum);
+            for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, on[l], l, sum);
+          } else {
+            for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], on[l], int(l), sum);
+          }
         }
       }
+      scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
+      scratch.cluster_moment.col(c) =
+          Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
+      scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
+      scratch.cluster_damping_moment.col(c) =
+          Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
     }
-    scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
-    scratch.cluster_moment.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
-    scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
-    scratch.cluster_damping_moment.col(c) =
-        Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
-  }
+  });
 #pragma omp barrier
   // 2. Children before parents: a joint carries the moment of everything beyond it. The
   // limbs below the trunk in parallel, then the trunk (BarChain::walk_trunk).

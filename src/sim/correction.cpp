@@ -59,7 +59,7 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
     block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
-    block.flying[k] = still ? 0 : attachment.vertex_flying[v];
+    block.flying[k] = still ? Real(0) : Real(attachment.vertex_flying[v]);
     Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
     if (load_state) {
       prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
@@ -113,15 +113,17 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     if (direct) {
       in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
             model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
-            attachment.vertex_global.data() + begin, attachment.vertex_flying.data() + begin, {}, nullptr};
+            attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
       std::fill(block.moving, block.moving + n, uint8_t(1));
+      std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);
     } else {
       gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
       in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
             block.global, block.flying, {}, nullptr};
     }
     for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
-    in.kicked = model.vertex_shape_kick.data() + begin;
+    std::copy_n(model.vertex_shape_kick.data() + begin, n, block.kicked);
+    in.kicked = block.kicked;
     if (!kernel(begin, n, in, block)) continue;
     // Rare: find the first vertex at fault, as the scalar tests would.
     for (int k = 0; k < n; ++k) {

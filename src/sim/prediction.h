@@ -23,15 +23,17 @@ inline const std::array<uint32_t, kVertexBlock> kLaneIndex = [] {
 }();
 
 // Where the kernels read a block's vertices: the mean correction of vertex k is row
-// pull_row[k] of `pull`; the factors are per vertex.
+// pull_row[k] of `pull`; the factors are per vertex. Every value a kernel reads is 4 or 8
+// bytes wide: a byte among them makes GCC vectorise the loop 16 lanes at a time, and its
+// `omp simd` private arrays (16 lanes) then allow only 16-byte vectors for the whole loop.
 template <typename Real>
 struct VertexInputs {
   const Real* pull[3];
   const uint32_t* pull_row;
   const Real *drag, *half_damping, *global;
-  const uint8_t* flying;
+  const Real* flying;   // 1 on a flying leaf, else 0
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
-  const uint8_t* kicked;  // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
+  const Real* kicked;   // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
 };
 
 template <typename Real>
@@ -44,7 +46,8 @@ struct VertexBlock {
   Real drag[kVertexBlock];                 // 1/m, drag acceleration per (m/s)^2
   Real half_damping[kVertexBlock];         // velocity factor per half step
   Real global[kVertexBlock];               // global rate per step
-  uint8_t flying[kVertexBlock];            // 1 on a flying leaf
+  Real flying[kVertexBlock];               // 1 on a flying leaf
+  Real kicked[kVertexBlock];               // SolverModel::vertex_shape_kick, as a factor
   Real check[kVertexBlock];                // sum of the new values: finite iff all are
   Real excess[kVertexBlock];               // m^2, > 0: ran farther than the runaway limit
 };
@@ -69,7 +72,7 @@ template <typename Real>
 inline CorrectedLane<Real> correct_lane(const VertexInputs<Real>& in, const Real* const offset[3],
                                         const Real* const velocity[3], int k, Real inv_h) {
   const uint32_t row = in.pull_row[k];
-  const Real now = Real(1) - static_cast<Real>(in.kicked[k]);
+  const Real now = Real(1) - in.kicked[k];
   const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
   return {offset[0][k] + px * now,         offset[1][k] + py * now,         offset[2][k] + pz * now,
           velocity[0][k] + px * now * inv_h, velocity[1][k] + py * now * inv_h, velocity[2][k] + pz * now * inv_h,
@@ -178,7 +181,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
       block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
       Real excess = 0;  // > 0: an attached vertex ran away
       if constexpr (kEnd)
-        excess = (1 - static_cast<Real>(in.flying[k])) * (ux * ux + uy * uy + uz * uz) - limit2;
+        excess = (1 - in.flying[k]) * (ux * ux + uy * uy + uz * uz) - limit2;
       block.excess[k] = excess;
     }
     first = stop;
@@ -232,13 +235,13 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     // with the beam the global pull toward the goal on an attached vertex), half the drag,
     // half the damping. Each half is exact for its own term, so the whole is second order in
     // h and never overshoots (docs/solver.md, "One step").
-    const Real half = in.half_damping[k], falling = static_cast<Real>(in.flying[k]);
+    const Real half = in.half_damping[k], falling = in.flying[k];
     const Real pull_back = in.global[k] * inv_h * kicked, drag = in.drag[k] * std::max(direct, falling);
     vx *= half, vy *= half, vz *= half;
     Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
     const uint32_t row = in.pull_row[k];
-    const Real shape = static_cast<Real>(in.kicked[k]) * inv_h;
+    const Real shape = in.kicked[k] * inv_h;
     vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][row];
     vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][row];
     vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][row];

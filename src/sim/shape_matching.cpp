@@ -4,7 +4,9 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <string>
+#include <type_traits>
 
 #include "common/errors.h"
 #include "sim/kernel_isa.h"
@@ -79,15 +81,26 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
   const Eigen::Matrix<Real, 3, 1> t = shift.template cast<Real>();
   const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
   const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
+  const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+  // A cluster without released memberships (every cluster until a leaf detaches) runs a loop
+  // that reads no byte flag: one would make GCC vectorise it 32 floats at a time, more than a
+  // cluster holds.
+  auto correct = [&](auto any_released) {
 #pragma omp simd
-  for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
-    const uint32_t v = members[s];
-    const Real x = qx[s], y = qy[s], z = qz[s];
-    const Real weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
-    cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
-    cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
-    cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
-  }
+    for (uint32_t s = begin; s < end; ++s) {
+      const uint32_t v = members[s];
+      const Real x = qx[s], y = qy[s], z = qz[s];
+      Real weight = alpha;
+      if constexpr (any_released) weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
+      cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
+      cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
+      cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
+    }
+  };
+  if (std::find(active + begin, active + end, uint8_t(0)) == active + end)
+    correct(std::false_type{});
+  else
+    correct(std::true_type{});
 }
 
 template <typename Real>
