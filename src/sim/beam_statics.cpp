@@ -295,26 +295,25 @@ inline void store_goal(const GoalRows<Real>& out, size_t v, Real ox, Real oy, Re
   out.compliance[v] = std::max(back * share, Real(0));
 }
 
-// A run [v, run_end) of vertices in the same N clusters (SolverModel::vertex_run_end) => their
-// goals and damping compliances, each the vertex loop's sum over its memberships in order, the
-// lanes vectorised. A mean over one takes the share 1 as a constant.
+// Vertices [v, stop) of `run`, which holds N clusters => their goals and damping compliances,
+// each the vertex loop's sum over its memberships in order, the lanes vectorised. A mean over
+// one takes the share 1 as a constant.
 template <int N, typename Real>
 void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachment, const StepScratch<Real>& scratch,
-               const GoalRows<Real>& out, size_t v, size_t run_end) {
-  const TreeModel& tree = model.tree;
+               const GoalRows<Real>& out, const VertexRun& run, size_t v, size_t stop) {
   static_assert(N >= 1 && N <= int(kMaxRunClusters));
   const Real* k[N];
   const Real *ax[N], *ay[N], *az[N];
   for (int j = 0; j < N; ++j) {
-    const uint32_t slot = tree.vertex_memberships[tree.vertex_cluster_offsets[v] + j];
+    const uint32_t slot = run.first_slot[j];
     k[j] = &scratch.cluster_pose(0, model.member_cluster[slot]);
-    ax[j] = model.member_arm.col(0).data() + slot - v;
-    ay[j] = model.member_arm.col(1).data() + slot - v;
-    az[j] = model.member_arm.col(2).data() + slot - v;
+    ax[j] = model.member_arm.col(0).data() + slot - run.begin;
+    ay[j] = model.member_arm.col(1).data() + slot - run.begin;
+    az[j] = model.member_arm.col(2).data() + slot - run.begin;
   }
   const Real* inv_count = attachment.vertex_inv_count.data();
 #pragma omp simd
-  for (size_t u = v; u < run_end; ++u) {
+  for (size_t u = v; u < stop; ++u) {
     Real ox = 0, oy = 0, oz = 0, back = 0;
     for (int j = 0; j < N; ++j) add_deflected(k[j], ax[j][u], ay[j][u], az[j][u], ox, oy, oz, back);
     store_goal(out, u, ox, oy, oz, back, N == 1 ? Real(1) : inv_count[u]);
@@ -331,7 +330,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
   // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
   // everything moves with it (docs/solver.md, "Aerodynamic damping"). A run of vertices in the
-  // same clusters, whose memberships are consecutive in each (SolverModel::vertex_run_end), is
+  // same clusters, whose memberships are consecutive in each (SolverModel::vertex_runs), is
   // one loop on those clusters' poses, vectorised, with the operations of the vertex loop.
   const Real *arm_x = model.member_arm.col(0).data(), *arm_y = model.member_arm.col(1).data(),
              *arm_z = model.member_arm.col(2).data();
@@ -340,17 +339,21 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const uint8_t* active = attachment.member_active.data();
   const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
                               prediction.goal.col(2).data(), prediction.damping_compliance.data()};
+  const std::vector<VertexRun>& runs = model.vertex_runs;
   with_kernel_isa([&] {
+    auto run = std::upper_bound(runs.begin(), runs.end(), begin,
+                                [](size_t v, const VertexRun& r) { return v < r.end; });  // the first ending after begin
     for (size_t v = begin; v < end;) {
-      const size_t run_end = std::min<size_t>(model.vertex_run_end[v], end);
-      if (run_end > v) {
-        switch (offsets[v + 1] - offsets[v]) {
-          case 1: write_run<1>(model, attachment, scratch, out, v, run_end); break;
-          case 2: write_run<2>(model, attachment, scratch, out, v, run_end); break;
-          case 3: write_run<3>(model, attachment, scratch, out, v, run_end); break;
-          default: write_run<kMaxRunClusters>(model, attachment, scratch, out, v, run_end); break;
+      if (run != runs.end() && run->begin <= v) {
+        const size_t stop = std::min<size_t>(run->end, end);
+        switch (run->count) {
+          case 1: write_run<1>(model, attachment, scratch, out, *run, v, stop); break;
+          case 2: write_run<2>(model, attachment, scratch, out, *run, v, stop); break;
+          case 3: write_run<3>(model, attachment, scratch, out, *run, v, stop); break;
+          default: write_run<kMaxRunClusters>(model, attachment, scratch, out, *run, v, stop); break;
         }
-        v = run_end;
+        if (stop == run->end) ++run;
+        v = stop;
         continue;
       }
       Real ox = 0, oy = 0, oz = 0, back = 0;

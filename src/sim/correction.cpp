@@ -19,26 +19,32 @@ namespace treeanim {
 
 namespace {
 
-// Vertex v => the mean of its clusters' corrections, summed in membership order (never the
-// sum: Eq. 7 with overlaps). A released membership's row holds 0.
+// A vertex's memberships slots[0, n) and 1 / its active ones => the mean of its clusters'
+// corrections, summed in membership order (never the sum: Eq. 7 with overlaps). A released
+// membership's row holds 0.
 template <typename Real>
-inline Eigen::Matrix<Real, 1, 3> mean_correction(const TreeModel& tree, const Attachment<Real>& attachment,
-                                                 const StepScratch<Real>& scratch, uint32_t v) {
+inline Eigen::Matrix<Real, 1, 3> mean_correction(const StepScratch<Real>& scratch, const uint32_t* slots, uint32_t n,
+                                                 Real share) {
   Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
-  for (uint32_t s = tree.vertex_cluster_offsets[v]; s < tree.vertex_cluster_offsets[v + 1]; ++s)
-    pull += scratch.member_correction.row(tree.vertex_memberships[s]);
-  return pull * attachment.vertex_inv_count[v];
+  for (uint32_t k = 0; k < n; ++k) pull += scratch.member_correction.row(slots[k]);
+  return pull * share;
 }
 
 // Shared vertices in [first, last) => their mean correction in their pull row, read by the
-// direct vertex pass.
+// direct vertex pass. Their memberships come from the model's own list, read in order.
 template <typename Real>
 void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           StepScratch<Real>& scratch, size_t first, size_t last) {
-  const auto from = std::lower_bound(model.shared_vertices.begin(), model.shared_vertices.end(), first);
-  const auto to = std::lower_bound(from, model.shared_vertices.end(), last);
-  for (auto it = from; it != to; ++it)
-    scratch.member_correction.row(attachment.vertex_pull_row[*it]) = mean_correction(model.tree, attachment, scratch, *it);
+  const std::vector<uint32_t>& shared = model.shared_vertices;
+  const size_t from = std::lower_bound(shared.begin(), shared.end(), first) - shared.begin();
+  const size_t to = std::lower_bound(shared.begin() + from, shared.end(), last) - shared.begin();
+  const uint32_t* offsets = model.shared_membership_offsets.data();
+  for (size_t i = from; i < to; ++i) {
+    const uint32_t v = shared[i];
+    scratch.member_correction.row(attachment.vertex_pull_row[v]) =
+        mean_correction(scratch, model.shared_memberships.data() + offsets[i], offsets[i + 1] - offsets[i],
+                        attachment.vertex_inv_count[v]);
+  }
 }
 
 // Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
@@ -65,7 +71,10 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
       prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
       prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
     } else if (with_pull && !still) {
-      pull = mean_correction(tree, attachment, scratch, static_cast<uint32_t>(v)).transpose();
+      const uint32_t* slots = tree.vertex_memberships.data() + tree.vertex_cluster_offsets[v];
+      pull = mean_correction(scratch, slots, tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v],
+                             attachment.vertex_inv_count[v])
+                 .transpose();
     }
     for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
   }

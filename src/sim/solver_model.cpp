@@ -40,13 +40,19 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   a.vertex_inv_count.assign(m.V, 0);
   a.vertex_air_cluster.assign(m.V, 0);
   a.vertex_pull_row.assign(m.V, static_cast<uint32_t>(m.M));
+  m.shared_membership_offsets.assign(1, 0);
   for (size_t v = 0; v < m.V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     a.vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
     a.vertex_air_cluster[v] = end > begin ? m.member_cluster[tree.vertex_memberships[begin]] : 0;
     if (tree.vertex_anchored[v] || end == begin) continue;
     a.vertex_pull_row[v] = tree.vertex_memberships[begin];
-    if (end - begin > 1) m.shared_vertices.push_back(static_cast<uint32_t>(v));
+    if (end - begin > 1) {
+      m.shared_vertices.push_back(static_cast<uint32_t>(v));
+      m.shared_memberships.insert(m.shared_memberships.end(), tree.vertex_memberships.begin() + begin,
+                                  tree.vertex_memberships.begin() + end);
+      m.shared_membership_offsets.push_back(static_cast<uint32_t>(m.shared_memberships.size()));
+    }
   }
   const std::vector<uint32_t>& offsets = tree.vertex_cluster_offsets;
   std::vector<uint8_t> runs(m.V, 0);  // (V) 1: in 1 to kMaxRunClusters clusters, whose memberships stay
@@ -62,10 +68,16 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     }
     return true;
   };
-  m.vertex_run_end.assign(m.V, 0);
-  for (size_t v = m.V; v-- > 0;) {
-    if (!runs[v]) continue;
-    m.vertex_run_end[v] = v + 1 < m.V && continues(v) ? m.vertex_run_end[v + 1] : static_cast<uint32_t>(v + 1);
+  for (size_t v = 0; v < m.V;) {
+    if (!runs[v]) {
+      ++v;
+      continue;
+    }
+    VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}};
+    for (uint32_t j = 0; j < run.count; ++j) run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
+    while (v + 1 < m.V && continues(v)) ++v;
+    run.end = static_cast<uint32_t>(++v);
+    m.vertex_runs.push_back(run);
   }
 }
 

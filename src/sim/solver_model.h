@@ -35,9 +35,16 @@ using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;
 // half turn at the root), the rest a margin for a swing past it and the clusters' stretch.
 constexpr double kRunawaySizes = 2.5;
 
-// The most clusters a vertex of a run may be in (SolverModel::vertex_run_end): a branch's
+// The most clusters a vertex of a run may be in (SolverModel::vertex_runs): a branch's
 // vertices are in one, the rings where two clusters overlap in two.
 constexpr uint32_t kMaxRunClusters = 4;
+
+// Vertices [begin, end) in the same `count` clusters: vertex v's membership in the j-th is
+// first_slot[j] + (v - begin).
+struct VertexRun {
+  uint32_t begin, end, count;
+  uint32_t first_slot[kMaxRunClusters];
+};
 
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,
 // and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
@@ -125,11 +132,15 @@ struct SolverModel {
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   Rows3<Real> member_arm;                  // (M x 3) m, with the beam: x0 - the joint of the member's cluster
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
-  // (V) for a vertex in 1 to kMaxRunClusters clusters (and no leaf's shared vertex, whose
-  // memberships may be released), the end of the run it is in: consecutive vertices in the
-  // same clusters, in the same order, with consecutive memberships in each; else 0. The goal
-  // writes take a run as one loop on its clusters' values.
-  std::vector<uint32_t> vertex_run_end;
+  // Their memberships, in each vertex's order: those of shared_vertices[i] are
+  // shared_memberships[shared_membership_offsets[i], shared_membership_offsets[i + 1])
+  std::vector<uint32_t> shared_membership_offsets, shared_memberships;
+  // Runs of vertices in 1 to kMaxRunClusters clusters (and no leaf's shared vertex, whose
+  // memberships may be released): consecutive vertices in the same clusters, in the same order,
+  // with consecutive memberships in each, ascending. The goal writes take a run as one loop on
+  // its clusters' values, read from this table in order (not through each vertex's memberships,
+  // a chain of dependent loads per run).
+  std::vector<VertexRun> vertex_runs;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices

@@ -123,32 +123,38 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
   std::vector<uint8_t> leaf_shared(tree.vertex_count(), 0);
   for (uint32_t v : tree.leaf_attachment_vertex) leaf_shared[v] = 1;
   const auto& offsets = tree.vertex_cluster_offsets;
-  size_t in_runs = 0, shared_in_runs = 0;
-  for (size_t v = 0; v < tree.vertex_count();) {
-    const size_t end = model.vertex_run_end[v];
-    if (end == 0) {
-      ++v;
-      continue;
-    }
+  size_t in_runs = 0, shared_in_runs = 0, previous_end = 0;
+  for (const VertexRun& run : model.vertex_runs) {
+    const size_t v = run.begin, end = run.end;
+    ASSERT_GE(v, previous_end);  // ascending, disjoint
     ASSERT_GT(end, v);
     ASSERT_LE(end, tree.vertex_count());
     const uint32_t n = offsets[v + 1] - offsets[v];
+    ASSERT_EQ(run.count, n);
     ASSERT_GE(n, 1u);
     ASSERT_LE(n, kMaxRunClusters);
     for (size_t u = v; u < end; ++u) {
-      ASSERT_EQ(model.vertex_run_end[u], end) << u;
       ASSERT_FALSE(leaf_shared[u]) << u;
       ASSERT_EQ(offsets[u + 1] - offsets[u], n) << u;
       for (uint32_t j = 0; j < n; ++j) {
-        const uint32_t first = tree.vertex_memberships[offsets[v] + j], slot = tree.vertex_memberships[offsets[u] + j];
+        const uint32_t first = run.first_slot[j], slot = tree.vertex_memberships[offsets[u] + j];
+        ASSERT_EQ(first, tree.vertex_memberships[offsets[v] + j]);
         ASSERT_EQ(slot, first + (u - v)) << u;
         ASSERT_EQ(model.member_cluster[slot], model.member_cluster[first]) << u;
         ASSERT_EQ(tree.cluster_members[slot], u);
       }
     }
+    // A run is as long as it can be: the next vertex does not continue it.
+    if (end < tree.vertex_count() && offsets[end + 1] - offsets[end] == n && !leaf_shared[end]) {
+      bool continues = true;
+      for (uint32_t j = 0; j < n; ++j)
+        continues = continues && tree.vertex_memberships[offsets[end] + j] == run.first_slot[j] + (end - v) &&
+                    model.member_cluster[tree.vertex_memberships[offsets[end] + j]] == model.member_cluster[run.first_slot[j]];
+      EXPECT_FALSE(continues) << end;
+    }
     in_runs += end - v;
     if (n > 1) shared_in_runs += end - v;
-    v = end;
+    previous_end = end;
   }
   EXPECT_GT(in_runs, tree.vertex_count() * 9 / 10);
   EXPECT_GT(shared_in_runs, 0u);
