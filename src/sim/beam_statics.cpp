@@ -306,7 +306,7 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
   const Real *ax[N], *ay[N], *az[N];
   for (int j = 0; j < N; ++j) {
     const uint32_t slot = run.first_slot[j];
-    k[j] = &scratch.cluster_pose(0, model.member_cluster[slot]);
+    k[j] = &scratch.cluster_pose(0, run.cluster[j]);
     ax[j] = model.member_arm.col(0).data() + slot - run.begin;
     ay[j] = model.member_arm.col(1).data() + slot - run.begin;
     az[j] = model.member_arm.col(2).data() + slot - run.begin;

@@ -73,8 +73,11 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
       ++v;
       continue;
     }
-    VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}};
-    for (uint32_t j = 0; j < run.count; ++j) run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
+    VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}, {}};
+    for (uint32_t j = 0; j < run.count; ++j) {
+      run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
+      run.cluster[j] = m.member_cluster[run.first_slot[j]];
+    }
     while (v + 1 < m.V && continues(v)) ++v;
     run.end = static_cast<uint32_t>(++v);
     m.vertex_runs.push_back(run);

@@ -39,11 +39,11 @@ constexpr double kRunawaySizes = 2.5;
 // vertices are in one, the rings where two clusters overlap in two.
 constexpr uint32_t kMaxRunClusters = 4;
 
-// Vertices [begin, end) in the same `count` clusters: vertex v's membership in the j-th is
+// Vertices [begin, end) in the same `count` clusters: vertex v's membership in cluster[j] is
 // first_slot[j] + (v - begin).
 struct VertexRun {
   uint32_t begin, end, count;
-  uint32_t first_slot[kMaxRunClusters];
+  uint32_t first_slot[kMaxRunClusters], cluster[kMaxRunClusters];
 };
 
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,

@@ -139,6 +139,7 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
       for (uint32_t j = 0; j < n; ++j) {
         const uint32_t first = run.first_slot[j], slot = tree.vertex_memberships[offsets[u] + j];
         ASSERT_EQ(first, tree.vertex_memberships[offsets[v] + j]);
+        ASSERT_EQ(run.cluster[j], model.member_cluster[first]);
         ASSERT_EQ(slot, first + (u - v)) << u;
         ASSERT_EQ(model.member_cluster[slot], model.member_cluster[first]) << u;
         ASSERT_EQ(tree.cluster_members[slot], u);
