@@ -19,31 +19,32 @@ namespace treeanim {
 
 namespace {
 
-// A vertex's memberships slots[0, n) and 1 / its active ones => the mean of its clusters'
-// corrections, summed in membership order (never the sum: Eq. 7 with overlaps). A released
-// membership's row holds 0.
-template <typename Real>
-inline Eigen::Matrix<Real, 1, 3> mean_correction(const StepScratch<Real>& scratch, const uint32_t* slots, uint32_t n,
-                                                 Real share) {
+// A vertex's n memberships, the k-th's correction in row row_of(k), and 1 / its active ones
+// => the mean of its clusters' corrections, summed in membership order (never the sum: Eq. 7
+// with overlaps). A released membership's row holds 0.
+template <typename Real, typename RowOf>
+inline Eigen::Matrix<Real, 1, 3> mean_correction(const StepScratch<Real>& scratch, uint32_t n, Real share,
+                                                 RowOf row_of) {
   Eigen::Matrix<Real, 1, 3> pull = Eigen::Matrix<Real, 1, 3>::Zero();
-  for (uint32_t k = 0; k < n; ++k) pull += scratch.member_correction.row(slots[k]);
+  for (uint32_t k = 0; k < n; ++k) pull += scratch.member_correction.row(row_of(k));
   return pull * share;
 }
 
-// Shared vertices in [first, last) => their mean correction in their pull row, read by the
-// direct vertex pass. Their memberships come from the model's own list, read in order.
+// Shared vertices in [first, last) => their mean correction in their own row, read by the
+// direct vertex pass. Their memberships' rows come from the model's own list, read in order.
 template <typename Real>
 void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           StepScratch<Real>& scratch, size_t first, size_t last) {
   const std::vector<uint32_t>& shared = model.shared_vertices;
   const size_t from = std::lower_bound(shared.begin(), shared.end(), first) - shared.begin();
   const size_t to = std::lower_bound(shared.begin() + from, shared.end(), last) - shared.begin();
-  const uint32_t* offsets = model.shared_membership_offsets.data();
+  const uint32_t* offsets = model.shared_row_offsets.data();
   for (size_t i = from; i < to; ++i) {
     const uint32_t v = shared[i];
-    scratch.member_correction.row(attachment.vertex_pull_row[v]) =
-        mean_correction(scratch, model.shared_memberships.data() + offsets[i], offsets[i + 1] - offsets[i],
-                        attachment.vertex_inv_count[v]);
+    const uint32_t* rows = model.shared_correction_rows.data() + offsets[i];
+    scratch.member_correction.row(v) = mean_correction(scratch, offsets[i + 1] - offsets[i],
+                                                       attachment.vertex_inv_count[v],
+                                                       [rows](uint32_t k) { return rows[k]; });
   }
 }
 
@@ -72,8 +73,9 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
       prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
     } else if (with_pull && !still) {
       const uint32_t* slots = tree.vertex_memberships.data() + tree.vertex_cluster_offsets[v];
-      pull = mean_correction(scratch, slots, tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v],
-                             attachment.vertex_inv_count[v])
+      pull = mean_correction(scratch, tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v],
+                             attachment.vertex_inv_count[v],
+                             [&](uint32_t k) { return model.member_correction_row[slots[k]]; })
                  .transpose();
     }
     for (int i = 0; i < 3; ++i) block.pull[i][k] = pull[i];
@@ -99,9 +101,9 @@ void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachm
 // One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
 // values are not finite and (`check_runaway`) the lowest attached one farther than the
 // runaway limit. `before` runs on each block's range first.
-// Without sleeping islands every free vertex reads its mean correction from one row
-// (anchors: the zero row, with factors that keep them still), which the first pass of a step
-// averages (`first_pass`); otherwise, and when a frame starts from the state, each block is
+// Without sleeping islands every vertex reads its mean correction from its own row (anchors:
+// a zero row, with factors that keep them still), which the first pass of a step averages for
+// the shared vertices (`first_pass`); otherwise, and when a frame starts from the state, each block is
 // gathered lane by lane.
 template <typename Real, typename Before, typename Kernel>
 std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
@@ -120,14 +122,14 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     before(begin, begin + n);
     VertexInputs<Real> in;
     if (direct) {
-      in = {{corrections[0], corrections[1], corrections[2]}, attachment.vertex_pull_row.data() + begin,
+      in = {{corrections[0] + begin, corrections[1] + begin, corrections[2] + begin},
             model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
             attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
       std::fill(block.moving, block.moving + n, uint8_t(1));
       std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);
     } else {
       gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
-      in = {{block.pull[0], block.pull[1], block.pull[2]}, kLaneIndex.data(), block.drag, block.half_damping,
+      in = {{block.pull[0], block.pull[1], block.pull[2]}, block.drag, block.half_damping,
             block.global, block.flying, {}, nullptr};
     }
     for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;

@@ -25,13 +25,12 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     if ((owner == c) == goes_with_leaf || !a.member_active[slot]) continue;
     a.member_active[slot] = 0;
     a.member_in_fit[slot] = 0;
-    if (corrections) corrections->row(slot).setZero();
+    if (corrections) corrections->row(model.member_correction_row[slot]).setZero();
     if (owner != c) rebuild_cluster_rest(model, a, owner);
   }
   a.cluster_pin_slot[c] = kNone;  // a flying leaf turns about its centre: new rest data, once
   rebuild_cluster_rest(model, a, c);
-  // The shared vertex reads its mean correction from (and feels the air of) its first
-  // cluster that still holds it.
+  // The shared vertex feels the air of its first cluster that still holds it.
   uint32_t active = 0, first = kNone;
   for (uint32_t s = tree.vertex_cluster_offsets[shared]; s < tree.vertex_cluster_offsets[shared + 1]; ++s) {
     const uint32_t slot = tree.vertex_memberships[s];
@@ -39,10 +38,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     if (active++ == 0) first = slot;
   }
   a.vertex_inv_count[shared] = active ? Real(1.0 / active) : Real(0.0);
-  if (first != kNone) {
-    a.vertex_air_cluster[shared] = model.member_cluster[first];
-    if (a.vertex_pull_row[shared] != model.M) a.vertex_pull_row[shared] = first;
-  }
+  if (first != kNone) a.vertex_air_cluster[shared] = model.member_cluster[first];
   a.cluster_flying[c] = 1;
   for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
     const uint32_t v = tree.cluster_members[s];

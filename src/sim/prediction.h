@@ -5,7 +5,6 @@
 // damping, gravity, the global pull toward the static deflection (Eq. 8) and the exact
 // quadratic drag => v* and u_p = u + h v*. Loops without branches, vectorised across
 // vertices; correction.cpp drives them.
-#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -15,21 +14,13 @@ namespace treeanim {
 
 // One block of a thread's vertices, on its stack (no allocation).
 constexpr int kVertexBlock = 256;
-// 0, 1, ..., kVertexBlock - 1: a block's own lanes as rows.
-inline const std::array<uint32_t, kVertexBlock> kLaneIndex = [] {
-  std::array<uint32_t, kVertexBlock> lanes{};
-  for (int k = 0; k < kVertexBlock; ++k) lanes[k] = static_cast<uint32_t>(k);
-  return lanes;
-}();
-
-// Where the kernels read a block's vertices: the mean correction of vertex k is row
-// pull_row[k] of `pull`; the factors are per vertex. Every value a kernel reads is 4 or 8
+// Where the kernels read a block's vertices, each array from the block's first: the mean
+// correction of vertex k, its factors. Every value a kernel reads is 4 or 8
 // bytes wide: a byte among them makes GCC vectorise the loop 16 lanes at a time, and its
 // `omp simd` private arrays (16 lanes) then allow only 16-byte vectors for the whole loop.
 template <typename Real>
 struct VertexInputs {
   const Real* pull[3];
-  const uint32_t* pull_row;
   const Real *drag, *half_damping, *global;
   const Real* flying;   // 1 on a flying leaf, else 0
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
@@ -71,9 +62,8 @@ struct CorrectedLane {
 template <typename Real>
 inline CorrectedLane<Real> correct_lane(const VertexInputs<Real>& in, const Real* const offset[3],
                                         const Real* const velocity[3], int k, Real inv_h) {
-  const uint32_t row = in.pull_row[k];
   const Real now = Real(1) - in.kicked[k];
-  const Real px = in.pull[0][row], py = in.pull[1][row], pz = in.pull[2][row];
+  const Real px = in.pull[0][k], py = in.pull[1][k], pz = in.pull[2][k];
   return {offset[0][k] + px * now,         offset[1][k] + py * now,         offset[2][k] + pz * now,
           velocity[0][k] + px * now * inv_h, velocity[1][k] + py * now * inv_h, velocity[2][k] + pz * now * inv_h,
           px,                              py,                              pz,
@@ -240,11 +230,10 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     vx *= half, vy *= half, vz *= half;
     Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
-    const uint32_t row = in.pull_row[k];
     const Real shape = in.kicked[k] * inv_h;
-    vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][row];
-    vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][row];
-    vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][row];
+    vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][k];
+    vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][k];
+    vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][k];
     share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx = (vx + (ax - vx) * share) * half, vy = (vy + (ay - vy) * share) * half, vz = (vz + (az - vz) * share) * half;
     Real px = ux + step * vx, py = uy + step * vy, pz = uz + step * vz;

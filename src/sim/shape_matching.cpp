@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <string>
 #include <type_traits>
 
@@ -82,25 +83,39 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
   const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
   const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
   const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
-  // A cluster without released memberships (every cluster until a leaf detaches) runs a loop
+  // A run of memberships whose rows are consecutive is one loop; where the rows are the member
+  // vertices' own (a free vertex in this cluster alone), their u is read in order too. A
+  // cluster without released memberships (every cluster until a leaf detaches) runs a loop
   // that reads no byte flag: one would make GCC vectorise it 32 floats at a time, more than a
   // cluster holds.
-  auto correct = [&](auto any_released) {
+  auto correct = [&](const CorrectionRun& run, auto own_rows, auto any_released) {
+    const ptrdiff_t to_row = ptrdiff_t(run.row) - ptrdiff_t(run.begin);
 #pragma omp simd
-    for (uint32_t s = begin; s < end; ++s) {
-      const uint32_t v = members[s];
+    for (uint32_t s = run.begin; s < run.end; ++s) {
       const Real x = qx[s], y = qy[s], z = qz[s];
+      Real vx, vy, vz;
+      if constexpr (own_rows) {
+        vx = ux[s + to_row], vy = uy[s + to_row], vz = uz[s + to_row];
+      } else {
+        const uint32_t v = members[s];
+        vx = ux[v], vy = uy[v], vz = uz[v];
+      }
       Real weight = alpha;
       if constexpr (any_released) weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
-      cx[s] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - ux[v]);
-      cy[s] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - uy[v]);
-      cz[s] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - uz[v]);
+      cx[s + to_row] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - vx);
+      cy[s + to_row] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - vy);
+      cz[s + to_row] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
     }
   };
-  if (std::find(active + begin, active + end, uint8_t(0)) == active + end)
-    correct(std::false_type{});
-  else
-    correct(std::true_type{});
+  const bool released = std::find(active + begin, active + end, uint8_t(0)) != active + end;
+  for (uint32_t i = model.correction_run_offsets[c]; i < model.correction_run_offsets[c + 1]; ++i) {
+    const CorrectionRun& run = model.correction_runs[i];
+    const bool own = run.row < model.V;
+    if (!released)
+      own ? correct(run, std::true_type{}, std::false_type{}) : correct(run, std::false_type{}, std::false_type{});
+    else
+      own ? correct(run, std::true_type{}, std::true_type{}) : correct(run, std::false_type{}, std::true_type{});
+  }
 }
 
 template <typename Real>

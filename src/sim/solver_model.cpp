@@ -39,20 +39,38 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   a.cluster_rest_moment.setZero(9, m.C);
   a.vertex_inv_count.assign(m.V, 0);
   a.vertex_air_cluster.assign(m.V, 0);
-  a.vertex_pull_row.assign(m.V, static_cast<uint32_t>(m.M));
-  m.shared_membership_offsets.assign(1, 0);
+  // A free vertex's only membership writes to the vertex's row; every other membership gets a
+  // row past V, in membership order (a cluster's ring of shared vertices stays consecutive).
+  m.member_correction_row.assign(m.M, kNone);
+  for (size_t v = 0; v < m.V; ++v) {
+    const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+    if (!tree.vertex_anchored[v] && end - begin == 1) m.member_correction_row[tree.vertex_memberships[begin]] = v;
+  }
+  uint32_t rows = static_cast<uint32_t>(m.V);
+  for (uint32_t& row : m.member_correction_row)
+    if (row == kNone) row = rows++;
+  m.correction_run_offsets.assign(1, 0);
+  for (size_t c = 0; c < m.C; ++c) {
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
+      const uint32_t row = m.member_correction_row[s];
+      CorrectionRun* run = m.correction_runs.size() > m.correction_run_offsets.back() ? &m.correction_runs.back() : nullptr;
+      if (run && run->row + (s - run->begin) == row && (run->row < m.V) == (row < m.V))
+        run->end = s + 1;  // the next row, of the same kind (a vertex's own, or a membership's)
+      else
+        m.correction_runs.push_back({s, s + 1, row});
+    }
+    m.correction_run_offsets.push_back(static_cast<uint32_t>(m.correction_runs.size()));
+  }
+  m.shared_row_offsets.assign(1, 0);
   for (size_t v = 0; v < m.V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     a.vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
     a.vertex_air_cluster[v] = end > begin ? m.member_cluster[tree.vertex_memberships[begin]] : 0;
-    if (tree.vertex_anchored[v] || end == begin) continue;
-    a.vertex_pull_row[v] = tree.vertex_memberships[begin];
-    if (end - begin > 1) {
-      m.shared_vertices.push_back(static_cast<uint32_t>(v));
-      m.shared_memberships.insert(m.shared_memberships.end(), tree.vertex_memberships.begin() + begin,
-                                  tree.vertex_memberships.begin() + end);
-      m.shared_membership_offsets.push_back(static_cast<uint32_t>(m.shared_memberships.size()));
-    }
+    if (tree.vertex_anchored[v] || end - begin < 2) continue;
+    m.shared_vertices.push_back(static_cast<uint32_t>(v));
+    for (uint32_t s = begin; s < end; ++s)
+      m.shared_correction_rows.push_back(m.member_correction_row[tree.vertex_memberships[s]]);
+    m.shared_row_offsets.push_back(static_cast<uint32_t>(m.shared_correction_rows.size()));
   }
   const std::vector<uint32_t>& offsets = tree.vertex_cluster_offsets;
   std::vector<uint8_t> runs(m.V, 0);  // (V) 1: in 1 to kMaxRunClusters clusters, whose memberships stay
@@ -301,7 +319,7 @@ void rebuild_cluster_rest(const SolverModel<Real>& model, Attachment<Real>& a, u
 
 template <typename Real>
 StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
-  member_correction.setZero(m.M + 1, 3);
+  member_correction.setZero(m.M > 0 ? *std::max_element(m.member_correction_row.begin(), m.member_correction_row.end()) + 1 : m.V, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
   cluster_load.setZero(3, m.C);

@@ -46,6 +46,13 @@ struct VertexRun {
   uint32_t first_slot[kMaxRunClusters], cluster[kMaxRunClusters];
 };
 
+// Memberships [begin, end) of one cluster whose corrections go to consecutive rows of
+// StepScratch::member_correction from `row` (SolverModel::correction_runs). Below V the row is
+// the member vertex itself.
+struct CorrectionRun {
+  uint32_t begin, end, row;
+};
+
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,
 // and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
 // detachment.cpp changes it when a leaf detaches, and rebuilds it from the model for a state
@@ -84,9 +91,6 @@ struct Attachment {
   std::vector<Real> vertex_global;         // (V) global rate per step (0: off, anchored, flying)
   std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
-  // (V) row of StepScratch::member_correction that holds the vertex's mean correction: its
-  // first active membership (M: anchored), so that a released row is never written
-  std::vector<uint32_t> vertex_pull_row;
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
 };
 
@@ -131,10 +135,18 @@ struct SolverModel {
   std::vector<Real> vertex_mass;           // (V) kg, the tree's masses rounded to Real, as the drag's force reads them
   BarChain chain;                          // the beam's joints and compliances (a leaf's: its petiole's)
   Rows3<Real> member_arm;                  // (M x 3) m, with the beam: x0 - the joint of the member's cluster
+  // (M) the row of StepScratch::member_correction that a membership's correction is written
+  // to: its vertex's own row v when it is the only membership of a free vertex (so the vertex
+  // passes read it in order, not gathered), else a row of its own past V, in membership order
+  std::vector<uint32_t> member_correction_row;
+  // Those rows as runs, cluster c's in correction_runs[correction_run_offsets[c],
+  // correction_run_offsets[c + 1]), so that the fit writes them as vectors, not scattered.
+  std::vector<uint32_t> correction_run_offsets;
+  std::vector<CorrectionRun> correction_runs;
   std::vector<uint32_t> shared_vertices;   // free vertices in two or more clusters, ascending
-  // Their memberships, in each vertex's order: those of shared_vertices[i] are
-  // shared_memberships[shared_membership_offsets[i], shared_membership_offsets[i + 1])
-  std::vector<uint32_t> shared_membership_offsets, shared_memberships;
+  // The rows of their memberships' corrections, in each vertex's order: those of
+  // shared_vertices[i] are shared_correction_rows[shared_row_offsets[i], shared_row_offsets[i + 1])
+  std::vector<uint32_t> shared_row_offsets, shared_correction_rows;
   // Runs of vertices in 1 to kMaxRunClusters clusters (and no leaf's shared vertex, whose
   // memberships may be released): consecutive vertices in the same clusters, in the same order,
   // with consecutive memberships in each, ascending. The goal writes take a run as one loop on
@@ -155,8 +167,11 @@ struct SolverModel {
 // Per-step buffers: written before they are read within a step (no allocation in the step).
 template <typename Real>
 struct StepScratch {
-  // ((M + 1) x 3) m, alpha_c (g - p) of the current step; row M stays 0 (the pull of an
-  // anchor). Before the vertex prediction, a shared vertex's pull row takes its mean correction.
+  // (rows x 3) m: row v the mean correction of vertex v (0 for an anchor or a vertex in no
+  // cluster), the others alpha_c (g - p) of the memberships that are not a vertex's only one
+  // (SolverModel::member_correction_row), of the current step. A free vertex in one cluster
+  // has its membership's correction written straight to its row; a shared vertex's row is
+  // averaged from its memberships' rows before the vertex passes read it.
   Rows3<Real> member_correction;
   Rows3<Real> cluster_air;                 // (C x 3) m/s, air velocity at the cluster for the step being predicted
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rotation_matrix;  // (9 x C) R of this step's fit, column-major

@@ -161,6 +161,49 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
   EXPECT_GT(shared_in_runs, 0u);
 }
 
+TEST(Beam, CorrectionRowsAreOneAMembershipAndAFreeVertexInOneClusterWritesItsOwn) {
+  // The fit writes each membership's correction to its own row (the vertex passes read a free
+  // vertex in one cluster from its vertex row, in order); the rows of a cluster's runs follow
+  // its memberships one by one, and an anchor's vertex row is never written.
+  const TreeModel tree = testing::grown_tree(5, 2, 2);
+  const SolverModel<float> model(tree, HsmOptions{}, WindOptions{}, 1.0 / 24, 2);
+  const auto& offsets = tree.vertex_cluster_offsets;
+  std::vector<uint8_t> used(model.V + model.M, 0);
+  for (size_t v = 0; v < model.V; ++v)
+    for (uint32_t k = offsets[v]; k < offsets[v + 1]; ++k) {
+      const uint32_t slot = tree.vertex_memberships[k], row = model.member_correction_row[slot];
+      const bool own = !tree.vertex_anchored[v] && offsets[v + 1] - offsets[v] == 1;
+      if (own) {
+        EXPECT_EQ(row, v);
+      } else {
+        EXPECT_GE(row, model.V) << v;
+      }
+      ASSERT_LT(row, used.size());
+      EXPECT_FALSE(used[row]) << row;
+      used[row] = 1;
+    }
+  for (size_t c = 0; c < model.C; ++c) {
+    uint32_t next = tree.cluster_offsets[c];
+    for (uint32_t i = model.correction_run_offsets[c]; i < model.correction_run_offsets[c + 1]; ++i) {
+      const CorrectionRun& run = model.correction_runs[i];
+      ASSERT_EQ(run.begin, next);
+      ASSERT_GT(run.end, run.begin);
+      for (uint32_t s = run.begin; s < run.end; ++s) {
+        EXPECT_EQ(model.member_correction_row[s], run.row + (s - run.begin)) << s;
+        if (run.row < model.V) {
+          EXPECT_EQ(tree.cluster_members[s], run.row + (s - run.begin)) << s;
+        }
+      }
+      next = run.end;
+    }
+    EXPECT_EQ(next, tree.cluster_offsets[c + 1]) << c;
+  }
+  size_t shared = 0;
+  for (size_t v = 0; v < model.V; ++v) shared += !tree.vertex_anchored[v] && offsets[v + 1] - offsets[v] > 1;
+  EXPECT_EQ(model.shared_vertices.size(), shared);
+  EXPECT_GT(shared, 0u);
+}
+
 TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
   // Uniform drag load q = 1/2 rho Cd (2r) U^2 on a clamped-free beam:
   // delta(x) = q L^4 (x^4 - 4x^3 + 6x^2) / (24 E I), x = s / L. Settled with critical damping.
