@@ -112,9 +112,7 @@ Skin build_skin(const TreeModel& model, size_t max_joints) {
     shares.clear();
     const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
     for (uint32_t k = begin; k < end; ++k) {
-      const uint32_t slot = model.vertex_memberships[k];
-      const auto c = uint32_t(std::upper_bound(model.cluster_offsets.begin(), model.cluster_offsets.end(), slot) -
-                              model.cluster_offsets.begin() - 1);
+      const uint32_t c = model.member_cluster[model.vertex_memberships[k]];
       const auto joint = uint32_t(joint_of_head[head[c]]);
       auto same = std::find_if(shares.begin(), shares.end(), [&](const auto& s) { return s.second == joint; });
       if (same == shares.end()) shares.emplace_back(1.0, joint);

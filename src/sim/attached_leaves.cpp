@@ -19,7 +19,7 @@ void match_attached_leaves(const SolverModel<Real>& model, const Attachment<Real
     // from its rest position t0_b + q_b: shift_b + (R_b - I) q_b, written without the rest
     // terms that cancel (their round-off would pull every resting leaf).
     const uint32_t pin = attachment.cluster_pin_slot[c];
-    const uint32_t branch = model.member_cluster[pin];
+    const uint32_t branch = model.tree.member_cluster[pin];
     const Eigen::Vector3d branch_offset = attachment.member_offset.row(pin).transpose().template cast<double>();
     const Eigen::Vector3d held =
         state.cluster_shift.col(branch) +

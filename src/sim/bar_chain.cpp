@@ -158,9 +158,7 @@ std::vector<double> limb_frequencies(const TreeModel& tree, const BarChain& chai
       if (tree.vertex_anchored[v] || end == begin) continue;
       const Eigen::Vector3d f = load * (tree.vertex_mass[v] / double(end - begin));
       for (uint32_t s = begin; s < end; ++s) {
-        const uint32_t c = static_cast<uint32_t>(
-            std::upper_bound(tree.cluster_offsets.begin(), tree.cluster_offsets.end(), tree.vertex_memberships[s]) -
-            tree.cluster_offsets.begin() - 1);
+        const uint32_t c = tree.member_cluster[tree.vertex_memberships[s]];
         force.col(c) += f;
         moment.col(c) += (tree.rest_positions.col(v) - chain.cluster_joint.col(c)).cross(f);
       }
@@ -176,9 +174,7 @@ std::vector<double> limb_frequencies(const TreeModel& tree, const BarChain& chai
     for (size_t v = 0; v < V; ++v) {
       const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
       if (tree.vertex_anchored[v] || end == begin) continue;
-      int32_t c = static_cast<int32_t>(
-          std::upper_bound(tree.cluster_offsets.begin(), tree.cluster_offsets.end(), tree.vertex_memberships[end - 1]) -
-          tree.cluster_offsets.begin() - 1);
+      int32_t c = static_cast<int32_t>(tree.member_cluster[tree.vertex_memberships[end - 1]]);
       const double m = tree.vertex_mass[v];
       Eigen::Vector3d u = Eigen::Vector3d::Zero();
       for (; c >= 0; c = tree.cluster_parent[c]) {

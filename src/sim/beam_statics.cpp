@@ -335,7 +335,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const Real *arm_x = model.member_arm.col(0).data(), *arm_y = model.member_arm.col(1).data(),
              *arm_z = model.member_arm.col(2).data();
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
-  const uint32_t* member_cluster = model.member_cluster.data();
+  const uint32_t* member_cluster = model.tree.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
   const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
                               prediction.goal.col(2).data(), prediction.damping_compliance.data()};

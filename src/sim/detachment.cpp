@@ -21,7 +21,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
   const bool goes_with_leaf = tree.vertex_leaf[shared] == static_cast<int32_t>(leaf);
   for (uint32_t s = tree.vertex_cluster_offsets[shared]; s < tree.vertex_cluster_offsets[shared + 1]; ++s) {
     const uint32_t slot = tree.vertex_memberships[s];
-    const uint32_t owner = model.member_cluster[slot];
+    const uint32_t owner = model.tree.member_cluster[slot];
     if ((owner == c) == goes_with_leaf || !a.member_active[slot]) continue;
     a.member_active[slot] = 0;
     a.member_in_fit[slot] = 0;
@@ -38,7 +38,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     if (active++ == 0) first = slot;
   }
   a.vertex_inv_count[shared] = active ? Real(1.0 / active) : Real(0.0);
-  if (first != kNone) a.vertex_air_cluster[shared] = model.member_cluster[first];
+  if (first != kNone) a.vertex_air_cluster[shared] = model.tree.member_cluster[first];
   a.cluster_flying[c] = 1;
   for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
     const uint32_t v = tree.cluster_members[s];

@@ -24,10 +24,6 @@ uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
 template <typename Real>
 void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   const TreeModel& tree = m.tree;
-  m.member_cluster.resize(m.M);
-  for (size_t c = 0; c < m.C; ++c)
-    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s)
-      m.member_cluster[s] = static_cast<uint32_t>(c);
   a.member_offset.setZero(m.M, 3);
   a.member_centre_weight.assign(m.M, 0);
   a.member_active.assign(m.M, 1);
@@ -65,7 +61,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   for (size_t v = 0; v < m.V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     a.vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
-    a.vertex_air_cluster[v] = end > begin ? m.member_cluster[tree.vertex_memberships[begin]] : 0;
+    a.vertex_air_cluster[v] = end > begin ? m.tree.member_cluster[tree.vertex_memberships[begin]] : 0;
     if (tree.vertex_anchored[v] || end - begin < 2) continue;
     m.shared_vertices.push_back(static_cast<uint32_t>(v));
     for (uint32_t s = begin; s < end; ++s)
@@ -82,7 +78,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     if (!runs[v + 1] || offsets[v + 2] - offsets[v + 1] != n) return false;
     for (uint32_t j = 0; j < n; ++j) {
       const uint32_t slot = tree.vertex_memberships[offsets[v] + j], next = tree.vertex_memberships[offsets[v + 1] + j];
-      if (next != slot + 1 || m.member_cluster[next] != m.member_cluster[slot]) return false;
+      if (next != slot + 1 || m.tree.member_cluster[next] != m.tree.member_cluster[slot]) return false;
     }
     return true;
   };
@@ -94,7 +90,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}, {}};
     for (uint32_t j = 0; j < run.count; ++j) {
       run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
-      run.cluster[j] = m.member_cluster[run.first_slot[j]];
+      run.cluster[j] = m.tree.member_cluster[run.first_slot[j]];
     }
     while (v + 1 < m.V && continues(v)) ++v;
     run.end = static_cast<uint32_t>(++v);
@@ -116,8 +112,8 @@ void precompute_pins(SolverModel<Real>& m, Attachment<Real>& a) {
     uint32_t own = kNone, pin = kNone;
     for (uint32_t s = tree.vertex_cluster_offsets[shared]; s < tree.vertex_cluster_offsets[shared + 1]; ++s) {
       const uint32_t slot = tree.vertex_memberships[s];
-      if (m.member_cluster[slot] == c) own = slot;
-      else if (pin == kNone && tree.cluster_kind[m.member_cluster[slot]] == kClusterBranch) pin = slot;
+      if (m.tree.member_cluster[slot] == c) own = slot;
+      else if (pin == kNone && tree.cluster_kind[m.tree.member_cluster[slot]] == kClusterBranch) pin = slot;
     }
     if (own == kNone || pin == kNone) continue;
     a.cluster_pin_slot[c] = pin;
@@ -169,7 +165,7 @@ void precompute_beam(SolverModel<Real>& m, const WindOptions& wind) {
   m.member_arm.resize(m.M, 3);
   for (size_t s = 0; s < m.M; ++s)
     m.member_arm.row(s) =
-        (m.tree.rest_positions.col(m.tree.cluster_members[s]) - m.chain.cluster_joint.col(m.member_cluster[s]))
+        (m.tree.rest_positions.col(m.tree.cluster_members[s]) - m.chain.cluster_joint.col(m.tree.member_cluster[s]))
             .transpose()
             .template cast<Real>();
   if (m.kick)
@@ -192,8 +188,8 @@ void precompute_islands(SolverModel<Real>& m) {
     if (tree.vertex_anchored[v]) continue;
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     for (uint32_t s = begin + 1; s < end; ++s) {
-      const uint32_t a = find_root(parent, m.member_cluster[tree.vertex_memberships[begin]]);
-      const uint32_t b = find_root(parent, m.member_cluster[tree.vertex_memberships[s]]);
+      const uint32_t a = find_root(parent, m.tree.member_cluster[tree.vertex_memberships[begin]]);
+      const uint32_t b = find_root(parent, m.tree.member_cluster[tree.vertex_memberships[s]]);
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
   }
@@ -210,7 +206,7 @@ void precompute_islands(SolverModel<Real>& m) {
   for (size_t v = 0; v < V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v];
     if (tree.vertex_anchored[v] || begin == tree.vertex_cluster_offsets[v + 1]) continue;
-    m.vertex_island[v] = m.cluster_island[m.member_cluster[tree.vertex_memberships[begin]]];
+    m.vertex_island[v] = m.cluster_island[m.tree.member_cluster[tree.vertex_memberships[begin]]];
     ++m.island_vertex_offsets[m.vertex_island[v] + 1];
   }
   for (size_t i = 0; i < m.I; ++i) m.island_vertex_offsets[i + 1] += m.island_vertex_offsets[i];

@@ -119,7 +119,6 @@ struct SolverModel {
   bool store_drag_force;                   // the prediction keeps each vertex's drag (detachment, beam)
   bool parallel;                           // at least kParallelMemberships: the loops run on several threads
 
-  std::vector<uint32_t> member_cluster;    // (M) cluster of the membership
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint32_t> cluster_pin_own_slot;  // (C) leaf pinned to a branch: membership of the shared vertex in the leaf

@@ -167,9 +167,7 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
     if (model.vertex_anchored[v] || begin == end) continue;
     double global = 0, omega = 0;
     for (uint32_t s = begin; s < end; ++s) {
-      const uint32_t c = static_cast<uint32_t>(
-          std::upper_bound(model.cluster_offsets.begin(), model.cluster_offsets.end(), model.vertex_memberships[s]) -
-          model.cluster_offsets.begin() - 1);
+      const uint32_t c = model.member_cluster[model.vertex_memberships[s]];
       global += cluster_global[c];
       omega += cluster_damping_frequency[c];
     }

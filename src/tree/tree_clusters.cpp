@@ -104,9 +104,10 @@ void for_each_membership(const Skeleton& skeleton, const SegmentTopology& topolo
   }
 }
 
-// cluster_members (ascending per cluster) => vertex_cluster_offsets / vertex_memberships, whose
-// slots come out in ascending cluster id because clusters are visited in order.
-void invert_memberships(TreeModel& model) {
+}  // namespace
+
+// The slots come out in ascending cluster id because they are visited in order.
+void index_memberships(TreeModel& model) {
   const size_t V = model.vertex_count();
   model.vertex_cluster_offsets.assign(V + 1, 0);
   for (uint32_t v : model.cluster_members) ++model.vertex_cluster_offsets[v + 1];
@@ -115,9 +116,11 @@ void invert_memberships(TreeModel& model) {
   model.vertex_memberships.resize(model.cluster_members.size());
   for (uint32_t slot = 0; slot < model.cluster_members.size(); ++slot)
     model.vertex_memberships[cursor[model.cluster_members[slot]]++] = slot;
+  model.member_cluster.resize(model.cluster_members.size());
+  for (size_t c = 0; c + 1 < model.cluster_offsets.size(); ++c)
+    std::fill(model.member_cluster.begin() + model.cluster_offsets[c], model.member_cluster.begin() + model.cluster_offsets[c + 1],
+              static_cast<uint32_t>(c));
 }
-
-}  // namespace
 
 void build_clusters(const Skeleton& skeleton, const SegmentTopology& topology,
                     const TreeOptions& options, const BranchRings& rings,
@@ -139,7 +142,7 @@ void build_clusters(const Skeleton& skeleton, const SegmentTopology& topology,
   for (size_t c = 0; c < C; ++c)
     std::sort(model.cluster_members.begin() + model.cluster_offsets[c],
               model.cluster_members.begin() + model.cluster_offsets[c + 1]);
-  invert_memberships(model);
+  index_memberships(model);
 }
 
 }  // namespace treeanim

@@ -37,9 +37,10 @@ struct TreeModel {
   std::vector<double> cluster_length;             // (C) m, axis length (leaf: leaf length)
   std::vector<double> cluster_radius;             // (C) m, mean branch radius (leaf: 0)
 
-  // --- vertex => clusters, CSR, for a fixed-order gather of goals ---
+  // --- vertex => clusters, CSR, for a fixed-order gather of goals (index_memberships) ---
   std::vector<uint32_t> vertex_cluster_offsets;   // (V+1) into vertex_memberships
   std::vector<uint32_t> vertex_memberships;       // (M) membership slots (indices into cluster_members), ascending cluster id
+  std::vector<uint32_t> member_cluster;           // (M) the cluster of each membership slot
 
   // --- leaves (L) ---
   std::vector<uint32_t> leaf_cluster;             // (L) the leaf's cluster
@@ -60,6 +61,10 @@ struct TreeModel {
   size_t leaf_count() const { return leaf_cluster.size(); }
   size_t segment_count() const { return segment_start.size(); }
 };
+
+// cluster_offsets and cluster_members => the vertex => clusters index (vertex_cluster_offsets,
+// vertex_memberships, whose slots come out in ascending cluster id) and member_cluster.
+void index_memberships(TreeModel& model);
 
 // Range-checks every index array and size (cheap, always on). Throws InputError.
 void validate_tree_model(const TreeModel& model);

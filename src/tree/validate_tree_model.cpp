@@ -83,7 +83,8 @@ void check_clusters(const TreeModel& m) {
 }
 
 // The vertex => cluster CSR must list every membership slot exactly once, at its own vertex,
-// in ascending cluster order, and give every vertex at least one cluster.
+// in ascending cluster order, and give every vertex at least one cluster; member_cluster must
+// name the cluster that holds each slot.
 void check_vertex_memberships(const TreeModel& m) {
   const size_t V = m.vertex_count(), M = m.membership_count();
   expect_offsets("vertex_cluster_offsets", m.vertex_cluster_offsets, V, M);
@@ -102,6 +103,12 @@ void check_vertex_memberships(const TreeModel& m) {
         fail("vertex_memberships of vertex " + std::to_string(v) + " not in ascending cluster order");
     }
   }
+  expect_size("member_cluster", m.member_cluster.size(), M);
+  for (size_t c = 0; c < m.cluster_count(); ++c)
+    for (uint32_t s = m.cluster_offsets[c]; s < m.cluster_offsets[c + 1]; ++s)
+      if (m.member_cluster[s] != c)
+        fail("member_cluster[" + std::to_string(s) + "] = " + std::to_string(m.member_cluster[s]) + " is not cluster " +
+             std::to_string(c) + ", which holds the slot");
 }
 
 void check_leaves_and_segments(const TreeModel& m) {

@@ -46,6 +46,7 @@ inline TreeModel small_model() {
   m.cluster_radius = {0.05, 0.0};
   m.vertex_cluster_offsets = {0, 1, 2, 3, 5, 6, 7};
   m.vertex_memberships = {0, 1, 2, 3, 4, 5, 6};
+  m.member_cluster = {0, 0, 0, 0, 1, 1, 1};
   m.leaf_cluster = {1};
   m.leaf_attachment_vertex = {3};
   m.segment_start = {Eigen::Vector3d(0.05, 0, 0)};

@@ -113,17 +113,7 @@ TreeModel ModelBuilder::finish() {
   m.cluster_radius = radius;
   m.cluster_leaf.assign(C, -1);
   for (size_t l = 0; l < leaf_cluster.size(); ++l) m.cluster_leaf[leaf_cluster[l]] = static_cast<int32_t>(l);
-  std::vector<std::vector<uint32_t>> slots(V);
-  for (size_t c = 0; c < C; ++c)
-    for (uint32_t s = m.cluster_offsets[c]; s < m.cluster_offsets[c + 1]; ++s) {
-      const uint32_t v = m.cluster_members[s];
-      slots[v].push_back(s);
-    }
-  m.vertex_cluster_offsets.push_back(0);
-  for (size_t v = 0; v < V; ++v) {
-    for (uint32_t s : slots[v]) m.vertex_memberships.push_back(s);
-    m.vertex_cluster_offsets.push_back(static_cast<uint32_t>(m.vertex_memberships.size()));
-  }
+  index_memberships(m);
   m.leaf_cluster = leaf_cluster;
   m.leaf_attachment_vertex = leaf_attachment;
   return m;

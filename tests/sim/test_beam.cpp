@@ -139,9 +139,9 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
       for (uint32_t j = 0; j < n; ++j) {
         const uint32_t first = run.first_slot[j], slot = tree.vertex_memberships[offsets[u] + j];
         ASSERT_EQ(first, tree.vertex_memberships[offsets[v] + j]);
-        ASSERT_EQ(run.cluster[j], model.member_cluster[first]);
+        ASSERT_EQ(run.cluster[j], model.tree.member_cluster[first]);
         ASSERT_EQ(slot, first + (u - v)) << u;
-        ASSERT_EQ(model.member_cluster[slot], model.member_cluster[first]) << u;
+        ASSERT_EQ(model.tree.member_cluster[slot], model.tree.member_cluster[first]) << u;
         ASSERT_EQ(tree.cluster_members[slot], u);
       }
     }
@@ -150,7 +150,7 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
       bool continues = true;
       for (uint32_t j = 0; j < n; ++j)
         continues = continues && tree.vertex_memberships[offsets[end] + j] == run.first_slot[j] + (end - v) &&
-                    model.member_cluster[tree.vertex_memberships[offsets[end] + j]] == model.member_cluster[run.first_slot[j]];
+                    model.tree.member_cluster[tree.vertex_memberships[offsets[end] + j]] == model.tree.member_cluster[run.first_slot[j]];
       EXPECT_FALSE(continues) << end;
     }
     in_runs += end - v;

@@ -27,8 +27,10 @@ TEST(TreeClusters, EveryVertexIsInAClusterAndTheGatherIsOrdered) {
     const auto cs = clusters_of(m, v);
     ASSERT_FALSE(cs.empty()) << v;
     EXPECT_TRUE(std::is_sorted(cs.begin(), cs.end()) && std::adjacent_find(cs.begin(), cs.end()) == cs.end());
-    for (uint32_t i = m.vertex_cluster_offsets[v]; i < m.vertex_cluster_offsets[v + 1]; ++i)
+    for (uint32_t i = m.vertex_cluster_offsets[v]; i < m.vertex_cluster_offsets[v + 1]; ++i) {
       EXPECT_EQ(m.cluster_members[m.vertex_memberships[i]], v);
+      EXPECT_EQ(m.member_cluster[m.vertex_memberships[i]], cs[i - m.vertex_cluster_offsets[v]]) << v;
+    }
   }
   for (size_t c = 0; c < m.cluster_count(); ++c)
     EXPECT_TRUE(std::is_sorted(m.cluster_members.begin() + m.cluster_offsets[c],

@@ -35,6 +35,8 @@ TEST(ValidateTreeModel, CatchesCorruptedIndices) {
             "tree model: leaf_cluster[1] is not the leaf's cluster");
   EXPECT_EQ(error_after([](TreeModel& m) { std::swap(m.vertex_memberships[8], m.vertex_memberships[9]); }),
             "tree model: vertex_memberships of vertex 8 not in ascending cluster order");
+  EXPECT_EQ(error_after([](TreeModel& m) { m.member_cluster[5] = 1; }),
+            "tree model: member_cluster[5] = 1 is not cluster 0, which holds the slot");
   EXPECT_EQ(error_after([](TreeModel& m) { m.vertex_cluster_offsets.pop_back(); }),
             "tree model: vertex_cluster_offsets has 70 entries, expected 71");
   EXPECT_EQ(error_after([](TreeModel& m) { m.triangle_material[3] = 2; }),
