@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <type_traits>
 
 #include "sim/kernel_isa.h"
 #include "sim/solver_step.h"
@@ -170,13 +171,14 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
   with_kernel_isa([&, first = first, last = last] {
     for (size_t c = first; c < last; ++c) {
       LoadLanes<Real> sum = {};
-      if (!attachment.cluster_flying[c]) {
+      // A cluster without released memberships takes every member's flag as 1, read from no byte.
+      auto add_loads = [&](auto any_released) {
         const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
         for (uint32_t base = begin; base < end; base += kLoadLanes) {
           // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
           const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
           Real on[kLoadLanes];
-          for (uint32_t l = 0; l < n; ++l) on[l] = static_cast<Real>(loads.active[base + l]);
+          for (uint32_t l = 0; l < n; ++l) on[l] = any_released ? static_cast<Real>(loads.active[base + l]) : Real(1);
           if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
 #pragma omp simd
             for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, on[l], l, sum);
@@ -184,6 +186,12 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
             for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], on[l], int(l), sum);
           }
         }
+      };
+      if (!attachment.cluster_flying[c]) {
+        if (attachment.cluster_released[c])
+          add_loads(std::true_type{});
+        else
+          add_loads(std::false_type{});
       }
       scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
       scratch.cluster_moment.col(c) =

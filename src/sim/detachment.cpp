@@ -25,6 +25,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     if ((owner == c) == goes_with_leaf || !a.member_active[slot]) continue;
     a.member_active[slot] = 0;
     a.member_in_fit[slot] = 0;
+    a.cluster_released[owner] = 1;
     if (corrections) corrections->row(model.member_correction_row[slot]).setZero();
     if (owner != c) rebuild_cluster_rest(model, a, owner);
   }

@@ -82,12 +82,9 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
   const Eigen::Matrix<Real, 3, 1> t = shift.template cast<Real>();
   const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
   const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
-  const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
   // A run of memberships whose rows are consecutive is one loop; where the rows are the member
-  // vertices' own (a free vertex in this cluster alone), their u is read in order too. A
-  // cluster without released memberships (every cluster until a leaf detaches) runs a loop
-  // that reads no byte flag: one would make GCC vectorise it 32 floats at a time, more than a
-  // cluster holds.
+  // vertices' own (a free vertex in this cluster alone), their u is read in order too. Only a
+  // cluster with released memberships reads their flags (Attachment::cluster_released).
   auto correct = [&](const CorrectionRun& run, auto own_rows, auto any_released) {
     const ptrdiff_t to_row = ptrdiff_t(run.row) - ptrdiff_t(run.begin);
 #pragma omp simd
@@ -107,7 +104,7 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
       cz[s + to_row] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
     }
   };
-  const bool released = std::find(active + begin, active + end, uint8_t(0)) != active + end;
+  const bool released = a.cluster_released[c] != 0;
   for (uint32_t i = model.correction_run_offsets[c]; i < model.correction_run_offsets[c + 1]; ++i) {
     const CorrectionRun& run = model.correction_runs[i];
     const bool own = run.row < model.V;

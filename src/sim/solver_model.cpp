@@ -248,6 +248,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   precompute_beam(*this, w);
   precompute_islands(*this);
   a.cluster_flying.assign(C, 0);
+  a.cluster_released.assign(C, 0);
   a.vertex_flying.assign(V, 0);
   a.leaf_attached.assign(L, 1);
   sum_drag_areas(*this, a);

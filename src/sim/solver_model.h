@@ -82,6 +82,10 @@ struct Attachment {
   Eigen::Matrix<double, 9, Eigen::Dynamic> cluster_rest_moment;  // (9 x C) sum s (q - o)(q - o)^T, column-major: A_pq at rest
   std::vector<uint32_t> cluster_pin_slot;  // (C) attached leaf: membership of its shared vertex in the branch; else kNone
   std::vector<uint8_t> cluster_flying;     // (C) 1: a detached leaf (always awake)
+  // (C) 1: some membership of the cluster was released. Until then (every cluster until a leaf
+  // detaches) the loops over its members read no byte flag: each would make GCC vectorise the
+  // loop 32 floats at a time, more than a cluster holds, or cost a load and a conversion a member.
+  std::vector<uint8_t> cluster_released;
   // The drag per unit |u| u of the cluster and everything beyond it (0.5 rho Cd A, kg/m) and
   // its moment about the cluster's joint (3 x C, kg), with rest arms: the load of the air a
   // step leaves out (docs/solver.md, "What a step cannot resolve"), fixed by the attachment.

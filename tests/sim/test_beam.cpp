@@ -16,6 +16,7 @@
 #include "sim/bar_chain.h"
 #include "sim/simulator.h"
 #include "sim/solver_model.h"
+#include "sim/solver_step.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {
@@ -202,6 +203,29 @@ TEST(Beam, CorrectionRowsAreOneAMembershipAndAFreeVertexInOneClusterWritesItsOwn
   for (size_t v = 0; v < model.V; ++v) shared += !tree.vertex_anchored[v] && offsets[v + 1] - offsets[v] > 1;
   EXPECT_EQ(model.shared_vertices.size(), shared);
   EXPECT_GT(shared, 0u);
+}
+
+TEST(Beam, AClusterIsMarkedReleasedExactlyWhenItLostAMembership) {
+  // The loops over a cluster's members read the members' flags only where
+  // Attachment::cluster_released says one was released; detaching leaves must keep it exact.
+  const TreeModel tree = testing::grown_tree(5, 2, 2);
+  const SolverModel<float> model(tree, HsmOptions{}, WindOptions{}, 1.0 / 24, 2);
+  ASSERT_GT(model.L, 2u);
+  SimState state;
+  state.leaf_attached.assign(model.L, 1);
+  for (size_t l = 0; l < model.L; l += 2) state.leaf_attached[l] = 0;
+  Attachment<float> attachment = model.all_attached;
+  adopt_leaf_flags(model, state, attachment);
+  size_t released = 0;
+  for (size_t c = 0; c < model.C; ++c) {
+    bool lost = false;
+    for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) lost = lost || !attachment.member_active[s];
+    EXPECT_EQ(attachment.cluster_released[c] != 0, lost) << c;
+    released += lost;
+  }
+  EXPECT_GT(released, 0u);
+  EXPECT_TRUE(std::none_of(model.all_attached.cluster_released.begin(), model.all_attached.cluster_released.end(),
+                           [](uint8_t r) { return r != 0; }));
 }
 
 TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
