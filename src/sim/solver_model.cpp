@@ -42,9 +42,9 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     if (!tree.vertex_anchored[v] && end - begin == 1) m.member_correction_row[tree.vertex_memberships[begin]] = v;
   }
-  uint32_t rows = static_cast<uint32_t>(m.V);
+  m.correction_rows = m.V;
   for (uint32_t& row : m.member_correction_row)
-    if (row == kNone) row = rows++;
+    if (row == kNone) row = static_cast<uint32_t>(m.correction_rows++);
   m.correction_run_offsets.assign(1, 0);
   for (size_t c = 0; c < m.C; ++c) {
     for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {
@@ -61,7 +61,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
   for (size_t v = 0; v < m.V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     a.vertex_inv_count[v] = end > begin ? Real(1) / Real(end - begin) : Real(0);
-    a.vertex_air_cluster[v] = end > begin ? m.tree.member_cluster[tree.vertex_memberships[begin]] : 0;
+    a.vertex_air_cluster[v] = end > begin ? tree.member_cluster[tree.vertex_memberships[begin]] : 0;
     if (tree.vertex_anchored[v] || end - begin < 2) continue;
     m.shared_vertices.push_back(static_cast<uint32_t>(v));
     for (uint32_t s = begin; s < end; ++s)
@@ -78,7 +78,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     if (!runs[v + 1] || offsets[v + 2] - offsets[v + 1] != n) return false;
     for (uint32_t j = 0; j < n; ++j) {
       const uint32_t slot = tree.vertex_memberships[offsets[v] + j], next = tree.vertex_memberships[offsets[v + 1] + j];
-      if (next != slot + 1 || m.tree.member_cluster[next] != m.tree.member_cluster[slot]) return false;
+      if (next != slot + 1 || tree.member_cluster[next] != tree.member_cluster[slot]) return false;
     }
     return true;
   };
@@ -90,7 +90,7 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
     VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}, {}};
     for (uint32_t j = 0; j < run.count; ++j) {
       run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
-      run.cluster[j] = m.tree.member_cluster[run.first_slot[j]];
+      run.cluster[j] = tree.member_cluster[run.first_slot[j]];
     }
     while (v + 1 < m.V && continues(v)) ++v;
     run.end = static_cast<uint32_t>(++v);
@@ -112,8 +112,8 @@ void precompute_pins(SolverModel<Real>& m, Attachment<Real>& a) {
     uint32_t own = kNone, pin = kNone;
     for (uint32_t s = tree.vertex_cluster_offsets[shared]; s < tree.vertex_cluster_offsets[shared + 1]; ++s) {
       const uint32_t slot = tree.vertex_memberships[s];
-      if (m.tree.member_cluster[slot] == c) own = slot;
-      else if (pin == kNone && tree.cluster_kind[m.tree.member_cluster[slot]] == kClusterBranch) pin = slot;
+      if (tree.member_cluster[slot] == c) own = slot;
+      else if (pin == kNone && tree.cluster_kind[tree.member_cluster[slot]] == kClusterBranch) pin = slot;
     }
     if (own == kNone || pin == kNone) continue;
     a.cluster_pin_slot[c] = pin;
@@ -188,8 +188,8 @@ void precompute_islands(SolverModel<Real>& m) {
     if (tree.vertex_anchored[v]) continue;
     const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
     for (uint32_t s = begin + 1; s < end; ++s) {
-      const uint32_t a = find_root(parent, m.tree.member_cluster[tree.vertex_memberships[begin]]);
-      const uint32_t b = find_root(parent, m.tree.member_cluster[tree.vertex_memberships[s]]);
+      const uint32_t a = find_root(parent, tree.member_cluster[tree.vertex_memberships[begin]]);
+      const uint32_t b = find_root(parent, tree.member_cluster[tree.vertex_memberships[s]]);
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
   }
@@ -206,7 +206,7 @@ void precompute_islands(SolverModel<Real>& m) {
   for (size_t v = 0; v < V; ++v) {
     const uint32_t begin = tree.vertex_cluster_offsets[v];
     if (tree.vertex_anchored[v] || begin == tree.vertex_cluster_offsets[v + 1]) continue;
-    m.vertex_island[v] = m.cluster_island[m.tree.member_cluster[tree.vertex_memberships[begin]]];
+    m.vertex_island[v] = m.cluster_island[tree.member_cluster[tree.vertex_memberships[begin]]];
     ++m.island_vertex_offsets[m.vertex_island[v] + 1];
   }
   for (size_t i = 0; i < m.I; ++i) m.island_vertex_offsets[i + 1] += m.island_vertex_offsets[i];
@@ -316,7 +316,7 @@ void rebuild_cluster_rest(const SolverModel<Real>& model, Attachment<Real>& a, u
 
 template <typename Real>
 StepScratch<Real>::StepScratch(const SolverModel<Real>& m) {
-  member_correction.setZero(m.M > 0 ? *std::max_element(m.member_correction_row.begin(), m.member_correction_row.end()) + 1 : m.V, 3);
+  member_correction.setZero(m.correction_rows, 3);
   cluster_air.setZero(m.C, 3);
   cluster_rotation_matrix.setZero(9, m.C);
   cluster_load.setZero(3, m.C);

@@ -142,6 +142,7 @@ struct SolverModel {
   // to: its vertex's own row v when it is the only membership of a free vertex (so the vertex
   // passes read it in order, not gathered), else a row of its own past V, in membership order
   std::vector<uint32_t> member_correction_row;
+  size_t correction_rows;                  // V + the memberships with a row of their own
   // Those rows as runs, cluster c's in correction_runs[correction_run_offsets[c],
   // correction_run_offsets[c + 1]), so that the fit writes them as vectors, not scattered.
   std::vector<uint32_t> correction_run_offsets;
