@@ -6,6 +6,21 @@
 
 namespace treeanim {
 
+template <typename Real>
+bool match_attached_leaf(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                         StepScratch<Real>& scratch, uint32_t c) {
+  // The shared vertex's goal in its branch b, t0_b + shift_b + R_b q_b, as a displacement
+  // from its rest position t0_b + q_b: shift_b + (R_b - I) q_b, written without the rest
+  // terms that cancel (their round-off would pull every resting leaf).
+  const uint32_t pin = attachment.cluster_pin_slot[c];
+  const uint32_t branch = model.tree.member_cluster[pin];
+  const Eigen::Vector3d branch_offset = attachment.member_offset.row(pin).transpose().template cast<double>();
+  const Eigen::Vector3d held =
+      state.cluster_shift.col(branch) +
+      (Eigen::Map<const Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, branch)) * branch_offset - branch_offset);
+  return match_cluster(model, attachment, state, scratch, c, &held);
+}
+
 // Runs as an orphaned worksharing loop inside match_clusters' parallel region, after the
 // branches' fits (their rotations in the scratch, their shifts in the state) are complete.
 template <typename Real>
@@ -15,19 +30,14 @@ void match_attached_leaves(const SolverModel<Real>& model, const Attachment<Real
   for (size_t k = 0; k < model.pinned_leaf_clusters.size(); ++k) {
     const uint32_t c = model.pinned_leaf_clusters[k];
     if (attachment.cluster_pin_slot[c] == kNone || !cluster_awake(model, attachment, state, c)) continue;
-    // The shared vertex's goal in its branch b, t0_b + shift_b + R_b q_b, as a displacement
-    // from its rest position t0_b + q_b: shift_b + (R_b - I) q_b, written without the rest
-    // terms that cancel (their round-off would pull every resting leaf).
-    const uint32_t pin = attachment.cluster_pin_slot[c];
-    const uint32_t branch = model.tree.member_cluster[pin];
-    const Eigen::Vector3d branch_offset = attachment.member_offset.row(pin).transpose().template cast<double>();
-    const Eigen::Vector3d held =
-        state.cluster_shift.col(branch) +
-        (Eigen::Map<const Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, branch)) * branch_offset - branch_offset);
-    if (!match_cluster(model, attachment, state, scratch, c, &held)) bad = std::min(bad, c);
+    if (!match_attached_leaf(model, attachment, state, scratch, c)) bad = std::min(bad, c);
   }
 }
 
+template bool match_attached_leaf(const SolverModel<float>&, const Attachment<float>&, SimState&, StepScratch<float>&,
+                                  uint32_t);
+template bool match_attached_leaf(const SolverModel<double>&, const Attachment<double>&, SimState&,
+                                  StepScratch<double>&, uint32_t);
 template void match_attached_leaves(const SolverModel<float>&, const Attachment<float>&, SimState&,
                                     StepScratch<float>&, uint32_t&);
 template void match_attached_leaves(const SolverModel<double>&, const Attachment<double>&, SimState&,

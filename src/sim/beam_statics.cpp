@@ -145,18 +145,14 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
   }
 }
 
-template <typename Real>
-void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
-                       StepScratch<Real>& scratch) {
+namespace {
+
+// Clusters at(0), ..., at(n - 1) => their loads, summed over their members (deflect_bar_chain's 1).
+template <typename Real, typename ClusterAt>
+void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+               StepScratch<Real>& scratch, size_t n, ClusterAt at) {
   const TreeModel& tree = model.tree;
   const StepPrediction<Real>& prediction = state.prediction<Real>();
-  const size_t C = model.C;
-  // 1. Per cluster: its members' share of the loads, and their moment about its joint. The
-  // arms are those of the rest pose: the goal is then a linear function of the loads, with a
-  // potential, where arms of the current pose made it a follower load that chased a bent
-  // limb round in circles (docs/solver.md, "Bending"); the yield turn bounds large loads.
-  // Each thread sums the clusters whose vertices it corrected (balanced_range), in its cache.
-  const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
   const MemberLoads<Real> loads = {{prediction.drag_force.col(0).data(), prediction.drag_force.col(1).data(),
                                     prediction.drag_force.col(2).data()},
                                    scratch.vertex_drag_damping.data(),
@@ -165,11 +161,9 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
                                    {model.member_arm.col(0).data(), model.member_arm.col(1).data(),
                                     model.member_arm.col(2).data()}};
   const uint32_t* members = tree.cluster_members.data();
-  Eigen::Vector3d unresolved[6];
-  const bool averaged = unresolved_points(scratch.air, unresolved);
-  const auto [first, last] = balanced_range(tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-  with_kernel_isa([&, first = first, last = last] {
-    for (size_t c = first; c < last; ++c) {
+  with_kernel_isa([&] {
+    for (size_t i = 0; i < n; ++i) {
+      const size_t c = at(i);
       LoadLanes<Real> sum = {};
       // A cluster without released memberships takes every member's flag as 1, read from no byte.
       auto add_loads = [&](auto any_released) {
@@ -201,7 +195,37 @@ void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& a
           Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
     }
   });
+}
+
+}  // namespace
+
+template <typename Real>
+void sum_cluster_loads(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                       StepScratch<Real>& scratch, std::span<const uint32_t> clusters) {
+  sum_loads(model, attachment, state, scratch, clusters.size(), [&](size_t i) { return size_t(clusters[i]); });
+}
+
+template <typename Real>
+void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                       StepScratch<Real>& scratch) {
+  // 1. Per cluster: its members' share of the loads, and their moment about its joint. The
+  // arms are those of the rest pose: the goal is then a linear function of the loads, with a
+  // potential, where arms of the current pose made it a follower load that chased a bent
+  // limb round in circles (docs/solver.md, "Bending"); the yield turn bounds large loads.
+  // Each thread sums the clusters whose vertices it corrected (balanced_range), in its cache.
+  const auto [first, last] = balanced_range(model.tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+  sum_loads(model, attachment, state, scratch, last - first, [first = first](size_t i) { return first + i; });
 #pragma omp barrier
+  walk_bar_chain(model, attachment, scratch);
+}
+
+template <typename Real>
+void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, StepScratch<Real>& scratch) {
+  const TreeModel& tree = model.tree;
+  const size_t C = model.C;
+  const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
+  Eigen::Vector3d unresolved[6];
+  const bool averaged = unresolved_points(scratch.air, unresolved);
   // 2. Children before parents: a joint carries the moment of everything beyond it. The
   // limbs below the trunk in parallel, then the trunk (BarChain::walk_trunk).
   auto carry_up = [&](uint32_t c) {
@@ -381,6 +405,9 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   template void sum_drag_areas(const SolverModel<Real>&, Attachment<Real>&);                                       \
   template void deflect_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,              \
                                   StepScratch<Real>&);                                                              \
+  template void sum_cluster_loads(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,              \
+                                  StepScratch<Real>&, std::span<const uint32_t>);                                   \
+  template void walk_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, StepScratch<Real>&);             \
   template void write_static_offsets(const SolverModel<Real>&, const Attachment<Real>&, const StepScratch<Real>&, \
                                      StepPrediction<Real>&, size_t, size_t);
 TREEANIM_BEAM_STATICS(float)

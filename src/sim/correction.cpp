@@ -82,22 +82,6 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
   }
 }
 
-// The corrected vertices [first, last) (prediction) => the state's positions and velocities,
-// in double; a vertex that does not move keeps its values.
-template <typename Real>
-void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                 bool any_asleep, size_t first, size_t last) {
-  const TreeModel& tree = model.tree;
-  const StepPrediction<Real>& prediction = state.prediction<Real>();
-  for (size_t v = first; v < last; ++v) {
-    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
-                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
-    if (still) continue;
-    state.positions.col(v) = tree.rest_positions.col(v) + prediction.offset.row(v).transpose().template cast<double>();
-    state.velocities.col(v) = prediction.velocity.row(v).transpose().template cast<double>();
-  }
-}
-
 // One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
 // values are not finite and (`check_runaway`) the lowest attached one farther than the
 // runaway limit. `before` runs on each block's range first.
@@ -151,81 +135,113 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
 
 }  // namespace
 
-// One parallel region: the correction (and load) pass; after a barrier, the state (kLastStep)
-// and the bar chain's passes; the prediction, each block's goals first. A failure found by a
-// pass stops every thread after it; the exceptions are thrown outside the region.
 template <typename Real>
-bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                         StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
+std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                                               SimState& state, StepScratch<Real>& scratch, VertexPassMode mode,
+                                               size_t first, size_t last) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
-  const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
-                                      [](uint8_t a) { return a != 0; });
-  const bool load = pass == VertexPass::kFromState, end = pass == VertexPass::kLastStep;
-  // The state's velocities are taken at its time: the first kick from them is half a step's.
-  const Real kick = load ? Real(0.5) : Real(1);
-  uint32_t bad = kNone, runaway = kNone, bad_prediction = kNone;
   auto nothing = [](size_t, size_t) {};
-#pragma omp parallel if (model.parallel)
-  {
-    // Named, not a structured binding: the lambdas below capture them (clang before 16 cannot).
-    const std::pair<size_t, size_t> range =
-        balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    const size_t first = range.first, last = range.second;
-    // 4. Correct the matched step (or load the state), and measure the drag of the next one.
-    const auto [my_bad, my_runaway] = with_kernel_isa([&] {
-      return for_vertex_blocks(
-          model, attachment, state, scratch, first, last, load, !load, true, any_asleep, end, nothing,
-          [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-            if (model.store_drag_force)
-              return end ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
-                         : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
-            return end ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
-                       : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
-          });
-    });
-    if (my_bad != kNone || my_runaway != kNone) {
-#pragma omp critical(treeanim_correction_failure)
-      bad = std::min(bad, my_bad), runaway = std::min(runaway, my_runaway);
-    }
-#pragma omp barrier
-    if (bad == kNone && runaway == kNone) {
-      if (end) write_state(model, attachment, state, any_asleep, first, last);
-      // 1. The static deflection under that drag, and the prediction of the next step.
-      if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
-      auto goals = [&](size_t begin, size_t stop) {
-        if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
-      };
-      const uint32_t my_bad_prediction = with_kernel_isa([&] {
-        return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !load, false, any_asleep,
-                                 false, goals,
-                                 [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                                   return end ? predict_block<false>(model, attachment, scratch, prediction, begin,
-                                                                     n, in, kick, block)
-                                              : predict_block<true>(model, attachment, scratch, prediction, begin, n,
-                                                                    in, kick, block);
-                                 });
-      }).first;
-      if (my_bad_prediction != kNone) {
-#pragma omp critical(treeanim_correction_failure)
-        bad_prediction = std::min(bad_prediction, my_bad_prediction);
-      }
-    }
+  return with_kernel_isa([&] {
+    return for_vertex_blocks(
+        model, attachment, state, scratch, first, last, mode.from_state, !mode.from_state, true, mode.any_asleep,
+        mode.last, nothing, [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+          if (model.store_drag_force)
+            return mode.last ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                             : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
+          return mode.last ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
+                           : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
+        });
+  });
+}
+
+template <typename Real>
+uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last) {
+  StepPrediction<Real>& prediction = state.prediction<Real>();
+  // The state's velocities are taken at its time: the first kick from them is half a step's.
+  const Real kick = mode.from_state ? Real(0.5) : Real(1);
+  auto goals = [&](size_t begin, size_t stop) {
+    if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
+  };
+  return with_kernel_isa([&] {
+    return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !mode.from_state, false,
+                             mode.any_asleep, false, goals,
+                             [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+                               return mode.last ? predict_block<false>(model, attachment, scratch, prediction, begin,
+                                                                       n, in, kick, block)
+                                                : predict_block<true>(model, attachment, scratch, prediction, begin,
+                                                                      n, in, kick, block);
+                             });
+  }).first;
+}
+
+template <typename Real>
+void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                 bool any_asleep, size_t first, size_t last) {
+  const TreeModel& tree = model.tree;
+  const StepPrediction<Real>& prediction = state.prediction<Real>();
+  for (size_t v = first; v < last; ++v) {
+    const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
+                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+    if (still) continue;
+    state.positions.col(v) = tree.rest_positions.col(v) + prediction.offset.row(v).transpose().template cast<double>();
+    state.velocities.col(v) = prediction.velocity.row(v).transpose().template cast<double>();
   }
+}
+
+template <typename Real>
+void throw_vertex_failure(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                          long long frame, int substep, uint32_t bad, uint32_t runaway) {
   // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
   auto where = [&](uint32_t v) {
     return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
            std::to_string(attachment.vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
   };
   if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
-  if (runaway != kNone) {
-    char distances[160];
-    std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
-                  prediction.offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
-                  std::sqrt(model.runaway_distance2) / kRunawaySizes);
-    throw SimulationError(where(runaway) + distances +
-                          ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+  if (runaway == kNone) return;
+  const StepPrediction<Real>& prediction = state.prediction<Real>();
+  char distances[160];
+  std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
+                prediction.offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
+                std::sqrt(model.runaway_distance2) / kRunawaySizes);
+  throw SimulationError(where(runaway) + distances +
+                        ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+}
+
+// One parallel region: the correction (and load) pass; after a barrier, the state (kLastStep)
+// and the bar chain's passes; the prediction, each block's goals first. A failure found by a
+// pass stops every thread after it; the exceptions are thrown outside the region.
+template <typename Real>
+bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                         StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
+  const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
+                                      [](uint8_t a) { return a != 0; });
+  const VertexPassMode mode = {pass == VertexPass::kFromState, pass == VertexPass::kLastStep, any_asleep};
+  uint32_t bad = kNone, runaway = kNone, bad_prediction = kNone;
+#pragma omp parallel if (model.parallel)
+  {
+    const auto [first, last] =
+        balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+    // 4. Correct the matched step (or load the state), and measure the drag of the next one.
+    const auto [my_bad, my_runaway] = correct_vertices(model, attachment, state, scratch, mode, first, last);
+    if (my_bad != kNone || my_runaway != kNone) {
+#pragma omp critical(treeanim_correction_failure)
+      bad = std::min(bad, my_bad), runaway = std::min(runaway, my_runaway);
+    }
+#pragma omp barrier
+    if (bad == kNone && runaway == kNone) {
+      if (mode.last) write_state(model, attachment, state, any_asleep, first, last);
+      // 1. The static deflection under that drag, and the prediction of the next step.
+      if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
+      const uint32_t my_bad_prediction = predict_vertices(model, attachment, state, scratch, mode, first, last);
+      if (my_bad_prediction != kNone) {
+#pragma omp critical(treeanim_correction_failure)
+        bad_prediction = std::min(bad_prediction, my_bad_prediction);
+      }
+    }
   }
-  if (bad_prediction != kNone) throw SimulationError(where(bad_prediction) + "non-finite position or velocity");
+  throw_vertex_failure(model, attachment, state, frame, substep, bad, runaway);
+  throw_vertex_failure(model, attachment, state, frame, substep, bad_prediction, kNone);
   return any_asleep;
 }
 
@@ -252,5 +268,17 @@ template void predict_from_state(const SolverModel<float>&, const Attachment<flo
                                  long long);
 template void predict_from_state(const SolverModel<double>&, const Attachment<double>&, SimState&,
                                  StepScratch<double>&, long long);
+#define TREEANIM_VERTEX_PASSES(Real)                                                                             \
+  template std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>&, const Attachment<Real>&,    \
+                                                          SimState&, StepScratch<Real>&, VertexPassMode, size_t, \
+                                                          size_t);                                               \
+  template uint32_t predict_vertices(const SolverModel<Real>&, const Attachment<Real>&, SimState&,              \
+                                     StepScratch<Real>&, VertexPassMode, size_t, size_t);                       \
+  template void write_state(const SolverModel<Real>&, const Attachment<Real>&, SimState&, bool, size_t, size_t); \
+  template void throw_vertex_failure(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,         \
+                                     long long, int, uint32_t, uint32_t);
+TREEANIM_VERTEX_PASSES(float)
+TREEANIM_VERTEX_PASSES(double)
+#undef TREEANIM_VERTEX_PASSES
 
 }  // namespace treeanim

@@ -131,6 +131,23 @@ bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attac
   return finite;
 }
 
+template <typename Real>
+uint32_t match_listed_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                               StepScratch<Real>& scratch, std::span<const uint32_t> clusters) {
+  uint32_t bad = kNone;
+  with_kernel_isa([&] {
+    for (const uint32_t c : clusters) {
+      if (!cluster_awake(model, attachment, state, c)) continue;
+      const bool fitted = attachment.cluster_pin_slot[c] == kNone
+                              ? match_cluster(model, attachment, state, scratch, c, nullptr)
+                              : match_attached_leaf(model, attachment, state, scratch, c);
+      if (!fitted) bad = std::min(bad, c);
+      sample_cluster_air(model, attachment, state, scratch, c);
+    }
+  });
+  return bad;
+}
+
 // Branches and free leaves first, then the attached leaves, whose translation is pinned to
 // their branch's goal for the shared vertex (hierarchical: a 1 g leaf cannot drag its branch,
 // nor drift off it in a gale). Sampling the next step's air here, per cluster, saves a
@@ -158,9 +175,12 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
       match_attached_leaves(model, attachment, state, scratch, bad);
     }
   }
-  if (bad != kNone)
-    throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-                          std::to_string(bad) + ": the shape match produced a non-finite rotation or centre");
+  if (bad != kNone) throw_match_failure(frame, substep, bad);
+}
+
+void throw_match_failure(long long frame, int substep, uint32_t cluster) {
+  throw SimulationError("frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
+                        std::to_string(cluster) + ": the shape match produced a non-finite rotation or centre");
 }
 
 #define TREEANIM_SHAPE_MATCHING(Real)                                                                              \
@@ -171,7 +191,9 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
   template bool match_cluster(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,    \
                               size_t, const Eigen::Vector3d*);                                                     \
   template void match_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,   \
-                               long long, int);
+                               long long, int);                                                                    \
+  template uint32_t match_listed_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&,            \
+                                          StepScratch<Real>&, std::span<const uint32_t>);
 TREEANIM_SHAPE_MATCHING(float)
 TREEANIM_SHAPE_MATCHING(double)
 #undef TREEANIM_SHAPE_MATCHING

@@ -3,6 +3,7 @@
 #include "sim/simulator.h"
 
 #include <Eigen/Geometry>
+#include <cstdlib>
 #include <string>
 #include <utility>
 
@@ -26,8 +27,11 @@ struct Solver final : Simulator::Impl {
   Attachment<Real> attachment;  // for the leaf flags of the last state seen (adopt_leaf_flags)
   StepScratch<Real> scratch;
 
-  Solver(const TreeModel& tree, const HsmOptions& options, const WindOptions& wind, double frame_dt, int substeps)
-      : model(tree, options, wind, frame_dt, substeps), attachment(model.all_attached), scratch(model) {}
+  Solver(const TreeModel& tree, const HsmOptions& options, const WindOptions& wind, double frame_dt, int substeps,
+         size_t block_memberships)
+      : model(tree, options, wind, frame_dt, substeps, block_memberships),
+        attachment(model.all_attached),
+        scratch(model) {}
   SimState initial_state(double time) const override;
   void advance_frame(SimState& state, long long frame) override;
   void adopt(SimState& state, long long frame);
@@ -98,10 +102,15 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
       // 2, 3. Match the clusters on the predicted positions, branches, then attached leaves;
       // each samples the air of the next step (after the last: the next frame's first).
       set_air_time(model.wind, last ? start + model.frame_dt : start + (k + 1) * model.h, model.h, scratch.air);
-      match_clusters(model, attachment, state, scratch, frame, k);
-      // 4, 1. Correct, and predict the next step; the last step writes the frame.
-      skipped_sleepers = correct_and_predict(model, attachment, state, scratch,
-                                             last ? VertexPass::kLastStep : VertexPass::kStep, frame, k);
+      if (model.block_cluster_offsets.empty()) {
+        match_clusters(model, attachment, state, scratch, frame, k);
+        // 4, 1. Correct, and predict the next step; the last step writes the frame.
+        skipped_sleepers = correct_and_predict(model, attachment, state, scratch,
+                                               last ? VertexPass::kLastStep : VertexPass::kStep, frame, k);
+      } else {
+        // The same (1 of this step, 2, 3, 4), block by block while each is in cache.
+        skipped_sleepers = step_in_blocks(model, attachment, state, scratch, k > 0, last, frame, k);
+      }
     }
     complete = !skipped_sleepers;
   }
@@ -113,12 +122,27 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
 
 }  // namespace
 
+// A block's vertex, membership and cluster data (about 400 bytes a membership in float, 6.5 MB)
+// stays in the cache between its passes, two threads' blocks at once in a 32 MiB L3: 8,192
+// and 32,768 measured within a few per cent of it (docs/solver.md, "Cache blocks").
+constexpr size_t kBlockMemberships = 16384;
+
+size_t cache_block_memberships() {
+  static const size_t memberships = [] {
+    const char* asked = std::getenv("TREEANIM_BLOCKS");
+    char* end = nullptr;
+    const unsigned long long n = asked ? std::strtoull(asked, &end, 10) : 0;
+    return asked && *asked && *end == 0 ? size_t(n) : kBlockMemberships;
+  }();
+  return memberships;
+}
+
 Simulator::Simulator(const TreeModel& model, const HsmOptions& options, const WindOptions& wind,
-                     double frame_dt, int substeps) {
+                     double frame_dt, int substeps, size_t block_memberships) {
   if (options.precision == Precision::kFloat)
-    impl_ = std::make_unique<Solver<float>>(model, options, wind, frame_dt, substeps);
+    impl_ = std::make_unique<Solver<float>>(model, options, wind, frame_dt, substeps, block_memberships);
   else
-    impl_ = std::make_unique<Solver<double>>(model, options, wind, frame_dt, substeps);
+    impl_ = std::make_unique<Solver<double>>(model, options, wind, frame_dt, substeps, block_memberships);
 }
 
 Simulator::~Simulator() = default;

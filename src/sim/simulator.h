@@ -1,5 +1,6 @@
 #pragma once
 // Stage entry point: TreeModel + options => frames of SimState.
+#include <cstddef>
 #include <memory>
 
 #include "sim/sim_options.h"
@@ -8,11 +9,17 @@
 
 namespace treeanim {
 
+// Memberships per cache block of the step (docs/solver.md, "Cache blocks"): 16,384, or the
+// environment's TREEANIM_BLOCKS (a count; 0: no blocks, the separate passes) for tests and
+// benchmarks. Every value gives the same bytes. Read on the first call.
+size_t cache_block_memberships();
+
 class Simulator {
  public:
-  // model: read-only tree (must outlive the simulator); frame_dt: 1/fps; substeps per frame.
+  // model: read-only tree (must outlive the simulator); frame_dt: 1/fps; substeps per frame;
+  // block_memberships: see cache_block_memberships.
   Simulator(const TreeModel& model, const HsmOptions& options, const WindOptions& wind,
-            double frame_dt, int substeps);
+            double frame_dt, int substeps, size_t block_memberships = cache_block_memberships());
   ~Simulator();
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;

@@ -216,10 +216,93 @@ void precompute_islands(SolverModel<Real>& m) {
     if (m.vertex_island[v] != kNone) m.island_vertices[fill[m.vertex_island[v]]++] = static_cast<uint32_t>(v);
 }
 
+
+// Clusters => the step's cache blocks (SolverModel::block_cluster_offsets): the branch
+// clusters cut into runs of about `block_memberships` memberships with the leaves pinned to
+// them (a pinned leaf is matched after its branch), each vertex given to the block holding all
+// its clusters, or to the border.
+template <typename Real>
+void precompute_blocks(SolverModel<Real>& m, size_t block_memberships) {
+  const TreeModel& tree = m.tree;
+  const size_t blocks = block_memberships ? m.M / block_memberships : 0;
+  if (blocks < 2 || m.detach_enabled) return;
+  const Attachment<Real>& a = m.all_attached;
+  auto size = [&](uint32_t c) { return tree.cluster_offsets[c + 1] - tree.cluster_offsets[c]; };
+  std::vector<uint32_t> weight(m.C, 0), leaves_of_offsets(m.C + 1, 0), leaves_of;
+  std::vector<uint8_t> pinned(m.C, 0);
+  for (uint32_t c : m.pinned_leaf_clusters) {
+    pinned[c] = 1;
+    ++leaves_of_offsets[tree.member_cluster[a.cluster_pin_slot[c]] + 1];
+  }
+  for (size_t c = 0; c < m.C; ++c) leaves_of_offsets[c + 1] += leaves_of_offsets[c];
+  leaves_of.resize(leaves_of_offsets[m.C]);
+  std::vector<uint32_t> fill(leaves_of_offsets.begin(), leaves_of_offsets.end() - 1);
+  for (uint32_t c : m.pinned_leaf_clusters) {
+    const uint32_t branch = tree.member_cluster[a.cluster_pin_slot[c]];
+    leaves_of[fill[branch]++] = c;
+    weight[branch] += size(c);
+  }
+  std::vector<uint32_t> branches, branch_offsets(1, 0);  // the unpinned clusters and their memberships before each
+  for (uint32_t c = 0; c < m.C; ++c)
+    if (!pinned[c]) {
+      branches.push_back(c);
+      branch_offsets.push_back(branch_offsets.back() + size(c) + weight[c]);
+    }
+  std::vector<uint32_t> cluster_block(m.C, kNone);
+  m.block_cluster_offsets.assign(1, 0);
+  m.block_membership_offsets.assign(1, 0);
+  for (size_t b = 0; b < blocks; ++b) {
+    const auto [first, last] = balanced_range(branch_offsets, int(b), int(blocks));
+    std::vector<uint32_t> leaves;
+    for (size_t i = first; i < last; ++i) {
+      const uint32_t c = branches[i];
+      m.block_clusters.push_back(c);
+      leaves.insert(leaves.end(), leaves_of.begin() + leaves_of_offsets[c], leaves_of.begin() + leaves_of_offsets[c + 1]);
+    }
+    std::sort(leaves.begin(), leaves.end());
+    m.block_clusters.insert(m.block_clusters.end(), leaves.begin(), leaves.end());
+    for (uint32_t k = m.block_cluster_offsets.back(); k < m.block_clusters.size(); ++k)
+      cluster_block[m.block_clusters[k]] = static_cast<uint32_t>(b);
+    m.block_cluster_offsets.push_back(static_cast<uint32_t>(m.block_clusters.size()));
+    m.block_membership_offsets.push_back(m.block_membership_offsets.back() + branch_offsets[last] - branch_offsets[first]);
+  }
+  // Each vertex's block, B for the border; each cluster with a border vertex is summed last.
+  std::vector<uint32_t> vertex_block(m.V, static_cast<uint32_t>(blocks));
+  std::vector<uint8_t> border_cluster(m.C, 0);
+  for (size_t v = 0; v < m.V; ++v) {
+    const uint32_t begin = tree.vertex_cluster_offsets[v], end = tree.vertex_cluster_offsets[v + 1];
+    uint32_t block = begin < end ? cluster_block[tree.member_cluster[tree.vertex_memberships[begin]]] : kNone;
+    for (uint32_t s = begin + 1; s < end; ++s)
+      if (cluster_block[tree.member_cluster[tree.vertex_memberships[s]]] != block) block = kNone;
+    if (block != kNone) vertex_block[v] = block;
+    else
+      for (uint32_t s = begin; s < end; ++s) border_cluster[tree.member_cluster[tree.vertex_memberships[s]]] = 1;
+  }
+  std::vector<std::vector<VertexSegment>> segments(blocks + 1);
+  for (uint32_t v = 0; v < m.V; ++v) {
+    std::vector<VertexSegment>& list = segments[vertex_block[v]];
+    if (!list.empty() && list.back().end == v)
+      ++list.back().end;
+    else
+      list.push_back({v, v + 1});
+  }
+  std::vector<std::vector<uint32_t>> loads(blocks + 1);
+  for (uint32_t c = 0; c < m.C; ++c) loads[border_cluster[c] ? blocks : cluster_block[c]].push_back(c);
+  m.block_segment_offsets.assign(1, 0);
+  m.block_load_offsets.assign(1, 0);
+  for (size_t b = 0; b <= blocks; ++b) {
+    m.block_segments.insert(m.block_segments.end(), segments[b].begin(), segments[b].end());
+    m.block_segment_offsets.push_back(static_cast<uint32_t>(m.block_segments.size()));
+    m.block_load_clusters.insert(m.block_load_clusters.end(), loads[b].begin(), loads[b].end());
+    m.block_load_offsets.push_back(static_cast<uint32_t>(m.block_load_clusters.size()));
+  }
+}
+
 }  // namespace
 
 template <typename Real>
-SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const WindOptions& w, double dt, int n)
+SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const WindOptions& w, double dt, int n,
+                               size_t block_memberships)
     : tree(t), options(o), wind(w), frame_dt(dt), substeps(n), h(dt / n), V(t.vertex_count()), C(t.cluster_count()),
       M(t.membership_count()), L(t.leaf_count()), I(0), detach_enabled(o.leaf_detach_force > 0 && t.leaf_count() > 0),
       beam(o.global_matching), kick(beam && o.stiffness == StiffnessMode::kPhysical),
@@ -252,6 +335,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   a.vertex_flying.assign(V, 0);
   a.leaf_attached.assign(L, 1);
   sum_drag_areas(*this, a);
+  precompute_blocks(*this, block_memberships);
   // Spatial phases of the wind at the rest centres: the tree moves little against the length
   // scales of the eddies and gusts, so they are evaluated once (flying leaves use their centre).
   const size_t P = size_t(wind.phase_count());

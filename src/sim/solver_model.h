@@ -53,6 +53,11 @@ struct CorrectionRun {
   uint32_t begin, end, row;
 };
 
+// Vertices [begin, end): a run of consecutive vertices one pass takes as one range.
+struct VertexSegment {
+  uint32_t begin, end;
+};
+
 // What the leaves' attachment decides: the clusters' rest data for the members they keep,
 // and which vertices fly. With every leaf attached it is precomputed in the SolverModel;
 // detachment.cpp changes it when a leaf detaches, and rebuilds it from the model for a state
@@ -157,6 +162,24 @@ struct SolverModel {
   // its clusters' values, read from this table in order (not through each vertex's memberships,
   // a chain of dependent loads per run).
   std::vector<VertexRun> vertex_runs;
+  // --- the step in cache blocks (cache_blocks.cpp; docs/solver.md, "Cache blocks") ---
+  // B blocks of clusters of about the constructor's block_memberships memberships, each
+  // predicted, matched, corrected and loaded in turn while its data is in cache; empty (the
+  // separate passes of match_clusters and correct_and_predict) for block_memberships 0, a
+  // tree of fewer than two blocks, or leaves that detach (a detachment falls between a step's
+  // prediction and its match, which a block does at once).
+  // Block b's clusters are block_clusters[block_cluster_offsets[b], [b + 1]): consecutive
+  // branch clusters (and unpinned leaves), ascending, then the leaves pinned to them, ascending.
+  std::vector<uint32_t> block_cluster_offsets, block_clusters;
+  std::vector<uint32_t> block_membership_offsets;  // (B + 1) memberships before block b: threads take equal shares
+  // The vertices whose clusters are all block b's, as segments: block_segments[block_segment_offsets[b],
+  // [b + 1]); entry B: the border, vertices of clusters in two blocks (or in none), predicted
+  // before the blocks and corrected after them.
+  std::vector<uint32_t> block_segment_offsets;
+  std::vector<VertexSegment> block_segments;
+  // The clusters whose loads block b sums, those without a border vertex: block_load_clusters[
+  // block_load_offsets[b], [b + 1]); entry B: the others, summed after the border's correction.
+  std::vector<uint32_t> block_load_offsets, block_load_clusters;
   std::vector<uint32_t> vertex_island;     // (V) island id, kNone for anchored vertices
   // --- islands (I): clusters connected through shared non-anchored vertices ---
   std::vector<uint32_t> island_vertex_offsets;  // (I+1) CSR into island_vertices
@@ -165,7 +188,7 @@ struct SolverModel {
   Attachment<Real> all_attached;           // the rest data of the bake's start
 
   SolverModel(const TreeModel& tree, const HsmOptions& options, const WindOptions& wind, double frame_dt,
-              int substeps);
+              int substeps, size_t block_memberships = 0);
 };
 
 // Per-step buffers: written before they are read within a step (no allocation in the step).

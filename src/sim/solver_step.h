@@ -3,6 +3,8 @@
 // model, the attachment it derives from the state, the state and the step's scratch. Each is
 // defined in the file named after what it computes and instantiated for float and double.
 #include <cstdint>
+#include <span>
+#include <utility>
 
 #include "sim/solver_model.h"
 
@@ -31,6 +33,36 @@ enum class VertexPass {
 template <typename Real>
 bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep);
+// How a step's vertex passes run.
+struct VertexPassMode {
+  bool from_state;  // u and v loaded from the state: the prediction of a frame's first step
+  bool last;        // a frame's last step: the corrected u and v kept for the state, the runaway checked
+  bool any_asleep;  // islands asleep: each block of vertices gathered lane by lane
+};
+// The passes of correct_and_predict, called by each thread on its vertices [first, last),
+// in a parallel region or outside one. The step just matched => the vertices corrected and
+// the drag of the next step measured => the lowest vertex not finite and the lowest that
+// ran away, each kNone for none.
+template <typename Real>
+std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment,
+                                               SimState& state, StepScratch<Real>& scratch, VertexPassMode mode,
+                                               size_t first, size_t last);
+// Corrected vertices (corrected here first, unless the frame's last step kept them) =>
+// their goals (with the beam), after the chain's walk, and the next step's prediction => the
+// lowest vertex not finite, kNone for none.
+template <typename Real>
+uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last);
+// The corrected vertices [first, last) (prediction) => the state's positions and velocities,
+// in double; a vertex that does not move keeps its values.
+template <typename Real>
+void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                 bool any_asleep, size_t first, size_t last);
+// The lowest vertex found not finite, and the lowest that ran away (kNone: none) => the
+// SimulationError naming the first, else the second; nothing when both are kNone.
+template <typename Real>
+void throw_vertex_failure(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                          long long frame, int substep, uint32_t bad, uint32_t runaway);
 // State at time t => the prediction of the first step from its positions and velocities.
 template <typename Real>
 void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
@@ -48,6 +80,14 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
 template <typename Real>
 void deflect_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                        StepScratch<Real>& scratch);
+// The same in two parts, for a step that sums a cluster's loads as soon as its members are
+// corrected (cache_blocks.cpp): the loads of the listed clusters; and, called by every thread
+// of a parallel region once every cluster's loads are summed, the rest.
+template <typename Real>
+void sum_cluster_loads(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                       StepScratch<Real>& scratch, std::span<const uint32_t> clusters);
+template <typename Real>
+void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, StepScratch<Real>& scratch);
 // The deflected chain => vertices [begin, end)'s offsets from rest in it (prediction.goal).
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
@@ -63,12 +103,39 @@ template <typename Real>
 void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                     StepScratch<Real>& scratch, long long frame, int substep);
 
+// The listed clusters in order (a cache block's: branches, then the leaves pinned to them) =>
+// each awake one matched (an attached leaf about its shared vertex, its branch listed before
+// it) and its air for the next step => the lowest cluster whose fit is not finite, kNone for none.
+template <typename Real>
+uint32_t match_listed_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                               StepScratch<Real>& scratch, std::span<const uint32_t> clusters);
+// The lowest cluster whose fit is not finite => the SimulationError naming it.
+[[noreturn]] void throw_match_failure(long long frame, int substep, uint32_t cluster);
+
 // --- attached_leaves.cpp ---
 // Inside match_clusters' parallel region, after a barrier: the attached leaves, each fitted
 // about its shared vertex held at its branch's goal. Lowers `bad` to a failing cluster.
 template <typename Real>
 void match_attached_leaves(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                            StepScratch<Real>& scratch, uint32_t& bad);
+
+// Attached leaf c, once its branch is matched => its match about its shared vertex held at
+// the branch's goal; false when the fit is not finite.
+template <typename Real>
+bool match_attached_leaf(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                         StepScratch<Real>& scratch, uint32_t c);
+
+// --- cache_blocks.cpp ---
+// One step in the model's cache blocks (SolverModel::block_cluster_offsets), in place of
+// match_clusters and correct_and_predict: unless it is a frame's first step (`predict` false:
+// the frame before or predict_from_state predicted it), the step predicted from the one
+// before; then block by block its vertices matched, corrected and their clusters' loads
+// summed, the border's after the blocks, and the chain's walk; a frame's `last` step writes
+// the state and predicts the next frame's first. Returns whether an island was asleep. Throws
+// the SimulationError those two would have, in the substep they would have thrown it.
+template <typename Real>
+bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                    StepScratch<Real>& scratch, bool predict, bool last, long long frame, int substep);
 
 // --- detachment.cpp ---
 // state.leaf_attached => `attachment` built for exactly those flags (unchanged when they

@@ -5,40 +5,23 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <cstring>
 #include <vector>
 
 #include "grown_tree.h"
+#include "same_state.h"
 #include "sim/simulator.h"
 #include "sim/solver_model.h"
 
 namespace treeanim {
 namespace {
 
+using testing::expect_same_state;
 using testing::grown_tree;
+using testing::same_bytes;
 
 constexpr int kFrames = 72;
 constexpr double kFrameDt = 1.0 / 24;
 constexpr int kSubsteps = 3;
-
-// Bytes of an Eigen array or a vector, for bit-exact comparisons (NaN-safe, -0 != +0).
-template <typename T>
-bool same_bytes(const T& a, const T& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(*a.data()) * a.size()) == 0;
-}
-
-// Everything a bake hands out or carries on, bit for bit.
-void expect_same_state(const SimState& expected, const SimState& actual, int frame) {
-  SCOPED_TRACE("frame " + std::to_string(frame));
-  EXPECT_TRUE(same_bytes(expected.positions, actual.positions));
-  EXPECT_TRUE(same_bytes(expected.velocities, actual.velocities));
-  EXPECT_TRUE(same_bytes(expected.cluster_rotations, actual.cluster_rotations));
-  EXPECT_TRUE(same_bytes(expected.cluster_shift, actual.cluster_shift));
-  EXPECT_EQ(expected.leaf_attached, actual.leaf_attached);
-  EXPECT_EQ(expected.island_asleep, actual.island_asleep);
-  EXPECT_EQ(expected.time, actual.time);
-  EXPECT_EQ(expected.predicted, actual.predicted);
-}
 
 size_t detached_leaves(const SimState& state) {
   return static_cast<size_t>(std::count(state.leaf_attached.begin(), state.leaf_attached.end(), 0));

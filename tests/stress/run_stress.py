@@ -35,8 +35,9 @@ RUNAWAY_SIZES = 2.5
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
 
-def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300, isa=None):
-    """One `treeanim run` (isa: TREEANIM_ISA, the solver loops' instruction set) => (exit code, stderr, seconds)."""
+def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300, isa=None, blocks=None):
+    """One `treeanim run` (isa: TREEANIM_ISA, the solver loops' instruction set; blocks:
+    TREEANIM_BLOCKS, memberships per cache block of the step) => (exit code, stderr, seconds)."""
     args = [binary, "run", scene, "-o", out_dir, *(() if "--verbose" in extra else ("--quiet",)), *extra]
     for key, value in sets.items():
         args += ["--set", f"{key}={json.dumps(value)}"]
@@ -45,6 +46,8 @@ def treeanim(binary, scene, out_dir, sets, extra=(), threads=None, timeout=300, 
         env["OMP_NUM_THREADS"] = str(threads)
     if isa:
         env["TREEANIM_ISA"] = isa
+    if blocks is not None:
+        env["TREEANIM_BLOCKS"] = str(blocks)
     start = time.perf_counter()
     done = subprocess.run(args, env=env, capture_output=True, text=True, timeout=timeout)
     return done.returncode, done.stderr.strip(), time.perf_counter() - start
@@ -303,7 +306,8 @@ def run_determinism(binary):
     double and float, and 4 frames of configs/table1-13548.json (float, clusters of ~50
     members: the chain's eight-lane sums), each at 1, 2 and 4 threads with the portable solver
     loops and at 1 and 2 with each wider instruction set this CPU runs (TREEANIM_ISA,
-    docs/solver.md "Instruction sets")."""
+    docs/solver.md "Instruction sets"); table1-13548 also stepped in cache blocks of 1,024
+    memberships (TREEANIM_BLOCKS, docs/solver.md "Cache blocks") and without blocks."""
     demo_wind = {"wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
                  "hsm.leaf_detach_force": 0.3}
     texts = []
@@ -314,24 +318,26 @@ def run_determinism(binary):
         with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
             sets = {"time.frames": frames, "outputs": [{"format": "hdf5", "path": "out.h5"}],
                     "hsm.precision": precision, **extra_sets}
-            runs = [("portable", 1), ("portable", 2), ("portable", 4), ("avx2", 1), ("avx2", 2), ("avx512", 1),
-                    ("avx512", 2)]
-            for isa, threads in runs:
+            runs = [("portable", 1, None), ("portable", 2, None), ("portable", 4, None), ("avx2", 1, None),
+                    ("avx2", 2, None), ("avx512", 1, None), ("avx512", 2, None)]
+            if scene.startswith("table1"):
+                runs += [("avx2", 1, 1024), ("avx2", 2, 1024), ("portable", 2, 1024), ("avx2", 2, 0)]
+            for isa, threads, blocks in runs:
                 code, err, _ = treeanim(binary, os.path.join(ROOT, "configs", scene), tmp, sets,
-                                        extra=("--verbose",), threads=threads, isa=isa)
+                                        extra=("--verbose",), threads=threads, isa=isa, blocks=blocks)
                 if code != 0:
-                    return False, f"{scene} {precision}, {isa}, OMP_NUM_THREADS={threads}: exit {code}: {err}"
+                    return False, f"{scene} {precision}, {isa}, OMP_NUM_THREADS={threads}, blocks {blocks}: exit {code}: {err}"
                 ran = re.search(r"solver loops: (\w+)", err)
                 if not ran:
                     return False, f"no 'solver loops:' in the verbose log: {err}"
                 with h5py.File(os.path.join(tmp, "out.h5"), "r") as f:
-                    digests[(ran.group(1), threads)] = f["/frames/positions"][()].tobytes()
+                    digests[(ran.group(1), threads, blocks)] = f["/frames/positions"][()].tobytes()
         if len(set(digests.values())) != 1:
-            return False, f"DIFFERENT /frames/positions across {sorted(digests)} ({scene}, {precision})"
+            return False, f"DIFFERENT /frames/positions across {sorted(map(str, digests))} ({scene}, {precision})"
         texts.append(f"{scene} {precision} ({len(next(iter(digests.values())))} bytes)")
-    sets_run = sorted({isa for isa, _ in digests})
-    return True, f"identical /frames/positions for 1, 2, 4 threads and the loops in {', '.join(sets_run)}: " + \
-        ", ".join(texts)
+    sets_run = sorted({isa for isa, _, _ in digests})
+    return True, f"identical /frames/positions for 1, 2, 4 threads, the loops in {', '.join(sets_run)} and " + \
+        "cache blocks of 1,024 memberships or none: " + ", ".join(texts)
 
 
 def report(name, passed, text):
