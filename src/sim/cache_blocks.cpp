@@ -44,7 +44,7 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
   const size_t blocks = model.block_cluster_offsets.size() - 1;
   const std::vector<uint32_t>& segment_offsets = model.block_segment_offsets;
   const std::vector<VertexSegment>& segments = model.block_segments;
-  const std::span<const uint32_t> load_clusters(model.block_load_clusters);
+  const std::span<const uint32_t> block_clusters(model.block_clusters), load_clusters(model.block_load_clusters);
   StepFailures failures;
 #pragma omp parallel if (model.parallel)
   {
@@ -71,11 +71,10 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
     for (size_t b = first; b < stop; ++b) {
       if (predict)
         for (uint32_t i = segment_offsets[b]; i < segment_offsets[b + 1]; ++i) predict_segment(i);
-      const std::span<const uint32_t> clusters(model.block_clusters);
+      const uint32_t clusters_begin = model.block_cluster_offsets[b], clusters_end = model.block_cluster_offsets[b + 1];
       mine.cluster = std::min(mine.cluster, match_listed_clusters(model, attachment, state, scratch,
-                                                                  clusters.subspan(model.block_cluster_offsets[b],
-                                                                                   model.block_cluster_offsets[b + 1] -
-                                                                                       model.block_cluster_offsets[b])));
+                                                                  block_clusters.subspan(clusters_begin,
+                                                                                         clusters_end - clusters_begin)));
       for (uint32_t i = segment_offsets[b]; i < segment_offsets[b + 1]; ++i) correct_segment(i);
       if (model.beam)
         sum_cluster_loads(model, attachment, state, scratch,

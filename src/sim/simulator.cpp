@@ -123,8 +123,8 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
 }  // namespace
 
 // A block's vertex, membership and cluster data (about 400 bytes a membership in float, 6.5 MB)
-// stays in the cache between its passes, two threads' blocks at once in a 32 MiB L3: 8,192
-// and 32,768 measured within a few per cent of it (docs/solver.md, "Cache blocks").
+// stays in the cache between its passes, two threads' blocks at once in a 32 MiB L3
+// (docs/solver.md, "Cache blocks", which measured 8,192 and 32,768 too).
 constexpr size_t kBlockMemberships = 16384;
 
 size_t cache_block_memberships() {

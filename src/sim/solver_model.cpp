@@ -216,8 +216,7 @@ void precompute_islands(SolverModel<Real>& m) {
     if (m.vertex_island[v] != kNone) m.island_vertices[fill[m.vertex_island[v]]++] = static_cast<uint32_t>(v);
 }
 
-
-// Clusters => the step's cache blocks (SolverModel::block_cluster_offsets): the branch
+// Clusters => the step's cache blocks (SolverModel::block_cluster_offsets): the unpinned
 // clusters cut into runs of about `block_memberships` memberships with the leaves pinned to
 // them (a pinned leaf is matched after its branch), each vertex given to the block holding all
 // its clusters, or to the border.
