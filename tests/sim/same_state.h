@@ -12,7 +12,8 @@ namespace treeanim::testing {
 // Bytes of an Eigen array or a vector, for bit-exact comparisons (NaN-safe, -0 != +0).
 template <typename T>
 bool same_bytes(const T& a, const T& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(*a.data()) * a.size()) == 0;
+  // An empty array may have no storage: memcmp takes no null pointer, even for no bytes.
+  return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(*a.data()) * a.size()) == 0);
 }
 
 // Everything a bake hands out or carries on, bit for bit.
