@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "sim/solver_step.h"
 
@@ -47,8 +48,10 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
   const std::span<const uint32_t> block_clusters(model.block_clusters), load_clusters(model.block_load_clusters);
   StepPrediction<Real>& prediction = state.prediction<Real>();
   const size_t threads = model.parallel ? size_t(omp_get_max_threads()) : 1;
+  // Filled with NaN: a row read before the step wrote it would fail the bake, never pass unseen.
   if (scratch.block_goals.size() < threads)
-    scratch.block_goals.resize(threads, Eigen::Matrix<Real, Eigen::Dynamic, 4>(model.block_vertex_capacity, 4));
+    scratch.block_goals.resize(threads, Eigen::Matrix<Real, Eigen::Dynamic, 4>::Constant(
+                                            model.block_vertex_capacity, 4, std::numeric_limits<Real>::quiet_NaN()));
   StepFailures failures;
 #pragma omp parallel if (model.parallel)
   {
@@ -64,10 +67,11 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
       mine.runaway = std::min(mine.runaway, runaway);
     };
     // A block's segments keep the goals this step predicts in the thread's own rows, one after
-    // another; a frame's first step reads those the frame before predicted, in the prediction.
+    // another; a frame's first step reads those the frame before predicted, in the prediction,
+    // and without the beam every step reads the prediction's zeros.
     Eigen::Matrix<Real, Eigen::Dynamic, 4>& own = scratch.block_goals[omp_get_thread_num()];
     auto block_goals = [&](uint32_t i, size_t row) {
-      if (!predict) return prediction_goals(prediction, segments[i].begin);
+      if (!predict || !model.beam) return prediction_goals(prediction, segments[i].begin);
       return GoalRows<Real>{own.col(0).data() + row, own.col(1).data() + row, own.col(2).data() + row,
                             own.col(3).data() + row};
     };
