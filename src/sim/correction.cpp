@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
-#include <type_traits>
 
 #include "common/errors.h"
 #include "sim/kernel_isa.h"
@@ -172,18 +171,10 @@ uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>
     return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !mode.from_state, false,
                              mode.any_asleep, false, goals, write_goals,
                              [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                               // With the beam only a flying leaf feels the drag itself.
-                               const bool drag = !model.beam || std::any_of(in.flying, in.flying + n,
-                                                                            [](Real f) { return f != 0; });
-                               auto predict = [&](auto correct, auto with_drag) {
-                                 return predict_block<decltype(correct)::value, decltype(with_drag)::value>(
-                                     model, attachment, scratch, prediction, begin, n, in, kick, block);
-                               };
-                               if (mode.last)
-                                 return drag ? predict(std::false_type{}, std::true_type{})
-                                             : predict(std::false_type{}, std::false_type{});
-                               return drag ? predict(std::true_type{}, std::true_type{})
-                                           : predict(std::true_type{}, std::false_type{});
+                               return mode.last ? predict_block<false>(model, attachment, scratch, prediction, begin,
+                                                                       n, in, kick, block)
+                                                : predict_block<true>(model, attachment, scratch, prediction, begin,
+                                                                      n, in, kick, block);
                              });
   }).first;
 }

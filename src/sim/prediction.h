@@ -191,10 +191,8 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
 // uncorrected, corrected here first, as it would have) => their prediction for the next step,
 // in place, written for every lane (a still lane maps onto itself). `kick` is 1, or 1/2 when the
 // velocities are not staggered (a step from the state: leapfrog's first half kick). The
-// drag's square roots and divisions dominate the loop; without kDrag (no lane feels the drag
-// itself: with the beam, a block without a flying leaf) they are left out, since a share of 0
-// leaves v as it is. Returns block_flagged.
-template <bool kCorrect, bool kDrag, typename Real>
+// drag's square roots and divisions dominate the loop. Returns block_flagged.
+template <bool kCorrect, typename Real>
 inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
                           const VertexInputs<Real>& in, Real kick, VertexBlock<Real>& block) {
@@ -218,12 +216,14 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
                        prediction.velocity.col(2).data() + begin};
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
+    const uint32_t c = air_cluster[k];
     Real ux = offset[0][k], uy = offset[1][k], uz = offset[2][k];
     Real vx = velocity[0][k], vy = velocity[1][k], vz = velocity[2][k];
     if constexpr (kCorrect) {
       const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_step);
       ux = lane.ux, uy = lane.uy, uz = lane.uz, vx = lane.vx, vy = lane.vy, vz = lane.vz;
     }
+    const Real ax = air[0][c], ay = air[1][c], az = air[2][c];
     // A symmetric (Strang) splitting of the step's velocity change about the kick of the
     // corrected position: half the damping, half the drag, the kick (gravity on a flying leaf,
     // with the beam the global pull toward the goal on an attached vertex), half the drag,
@@ -232,22 +232,14 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     const Real half = in.half_damping[k], falling = in.flying[k];
     const Real pull_back = in.global[k] * inv_h * kicked, drag = in.drag[k] * std::max(direct, falling);
     vx *= half, vy *= half, vz *= half;
-    Real ax = 0, ay = 0, az = 0;
-    if constexpr (kDrag) {
-      const uint32_t c = air_cluster[k];
-      ax = air[0][c], ay = air[1][c], az = air[2][c];
-      const Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
-      vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
-    }
+    Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
     const Real shape = in.kicked[k] * inv_h;
     vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][k];
     vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][k];
     vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][k];
-    if constexpr (kDrag) {
-      const Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
-      vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
-    }
-    vx *= half, vy *= half, vz *= half;
+    share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    vx = (vx + (ax - vx) * share) * half, vy = (vy + (ay - vy) * share) * half, vz = (vz + (az - vz) * share) * half;
     Real px = ux + step * vx, py = uy + step * vy, pz = uz + step * vz;
     // With per_step stiffness, Eq. 8 as the paper writes it: the global rate moves the
     // predicted position toward its goal, a projection that no wind or step can overshoot.
