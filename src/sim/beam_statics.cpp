@@ -313,16 +313,22 @@ inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Re
   back += ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15];
 }
 
-// Vertex v's sums over its clusters and share = 1 / their number => its goal, the mean, and
-// its damping compliance, never below 0, in row k of `out`.
+// Where the goal writes go: per vertex its goal (prediction.goal) and damping compliance.
 template <typename Real>
-inline void store_goal(const GoalRows<Real>& out, size_t k, Real ox, Real oy, Real oz, Real back, Real share) {
-  out.x[k] = ox * share, out.y[k] = oy * share, out.z[k] = oz * share;
-  out.compliance[k] = std::max(back * share, Real(0));
+struct GoalRows {
+  Real *x, *y, *z, *compliance;
+};
+
+// Vertex v's sums over its clusters and share = 1 / their number => its goal, the mean, and
+// its damping compliance, never below 0.
+template <typename Real>
+inline void store_goal(const GoalRows<Real>& out, size_t v, Real ox, Real oy, Real oz, Real back, Real share) {
+  out.x[v] = ox * share, out.y[v] = oy * share, out.z[v] = oz * share;
+  out.compliance[v] = std::max(back * share, Real(0));
 }
 
-// Vertices [v, stop) of `run`, which holds N clusters => their goals and damping compliances
-// in `out` (at vertex v), each the vertex loop's sum over its memberships in order, the lanes vectorised. A mean over
+// Vertices [v, stop) of `run`, which holds N clusters => their goals and damping compliances,
+// each the vertex loop's sum over its memberships in order, the lanes vectorised. A mean over
 // one takes the share 1 as a constant.
 template <int N, typename Real>
 void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachment, const StepScratch<Real>& scratch,
@@ -342,7 +348,7 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
   for (size_t u = v; u < stop; ++u) {
     Real ox = 0, oy = 0, oz = 0, back = 0;
     for (int j = 0; j < N; ++j) add_deflected(k[j], ax[j][u], ay[j][u], az[j][u], ox, oy, oz, back);
-    store_goal(out, u - v, ox, oy, oz, back, N == 1 ? Real(1) : inv_count[u]);
+    store_goal(out, u, ox, oy, oz, back, N == 1 ? Real(1) : inv_count[u]);
   }
 }
 
@@ -350,7 +356,8 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
 
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, GoalRows<Real> out, size_t begin, size_t end) {
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end) {
   const TreeModel& tree = model.tree;
   // 4. Per vertex: the mean over its clusters of their deflected poses, as an offset from rest;
   // and the mean of sum_j C_j S_j . (x0 - j_j), the goal's move back per m/s of the vertex when
@@ -362,6 +369,8 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
   const uint32_t* member_cluster = model.tree.member_cluster.data();
   const uint8_t* active = attachment.member_active.data();
+  const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
+                              prediction.goal.col(2).data(), prediction.damping_compliance.data()};
   const std::vector<VertexRun>& runs = model.vertex_runs;
   with_kernel_isa([&] {
     auto run = std::upper_bound(runs.begin(), runs.end(), begin,
@@ -370,10 +379,10 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
       if (run != runs.end() && run->begin <= v) {
         const size_t stop = std::min<size_t>(run->end, end);
         switch (run->count) {
-          case 1: write_run<1>(model, attachment, scratch, out.shifted(v - begin), *run, v, stop); break;
-          case 2: write_run<2>(model, attachment, scratch, out.shifted(v - begin), *run, v, stop); break;
-          case 3: write_run<3>(model, attachment, scratch, out.shifted(v - begin), *run, v, stop); break;
-          default: write_run<kMaxRunClusters>(model, attachment, scratch, out.shifted(v - begin), *run, v, stop); break;
+          case 1: write_run<1>(model, attachment, scratch, out, *run, v, stop); break;
+          case 2: write_run<2>(model, attachment, scratch, out, *run, v, stop); break;
+          case 3: write_run<3>(model, attachment, scratch, out, *run, v, stop); break;
+          default: write_run<kMaxRunClusters>(model, attachment, scratch, out, *run, v, stop); break;
         }
         if (stop == run->end) ++run;
         v = stop;
@@ -386,7 +395,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
         add_deflected(&scratch.cluster_pose(0, member_cluster[slot]), arm_x[slot], arm_y[slot], arm_z[slot], ox, oy,
                       oz, back);
       }
-      store_goal(out, v - begin, ox, oy, oz, back, attachment.vertex_inv_count[v]);
+      store_goal(out, v, ox, oy, oz, back, attachment.vertex_inv_count[v]);
       ++v;
     }
   });
@@ -400,7 +409,7 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
                                   StepScratch<Real>&, std::span<const uint32_t>);                                   \
   template void walk_bar_chain(const SolverModel<Real>&, const Attachment<Real>&, StepScratch<Real>&);             \
   template void write_static_offsets(const SolverModel<Real>&, const Attachment<Real>&, const StepScratch<Real>&, \
-                                     GoalRows<Real>, size_t, size_t);
+                                     StepPrediction<Real>&, size_t, size_t);
 TREEANIM_BEAM_STATICS(float)
 TREEANIM_BEAM_STATICS(double)
 #undef TREEANIM_BEAM_STATICS

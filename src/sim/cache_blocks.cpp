@@ -6,7 +6,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <limits>
 
 #include "sim/solver_step.h"
 
@@ -46,40 +45,24 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
   const std::vector<uint32_t>& segment_offsets = model.block_segment_offsets;
   const std::vector<VertexSegment>& segments = model.block_segments;
   const std::span<const uint32_t> block_clusters(model.block_clusters), load_clusters(model.block_load_clusters);
-  StepPrediction<Real>& prediction = state.prediction<Real>();
-  const size_t threads = model.parallel ? size_t(omp_get_max_threads()) : 1;
-  // Filled with NaN: a row read before the step wrote it would fail the bake, never pass unseen.
-  if (scratch.block_goals.size() < threads)
-    scratch.block_goals.resize(threads, Eigen::Matrix<Real, Eigen::Dynamic, 4>::Constant(
-                                            model.block_vertex_capacity, 4, std::numeric_limits<Real>::quiet_NaN()));
   StepFailures failures;
 #pragma omp parallel if (model.parallel)
   {
     StepFailures mine;
-    auto predict_segment = [&](uint32_t i, GoalRows<Real> goals) {
+    auto predict_segment = [&](uint32_t i) {
       mine.prediction = std::min(mine.prediction, predict_vertices(model, attachment, state, scratch, previous,
-                                                                   segments[i].begin, segments[i].end, goals));
+                                                                   segments[i].begin, segments[i].end));
     };
-    auto correct_segment = [&](uint32_t i, GoalRows<Real> goals) {
+    auto correct_segment = [&](uint32_t i) {
       const auto [bad, runaway] =
-          correct_vertices(model, attachment, state, scratch, mode, segments[i].begin, segments[i].end, goals);
+          correct_vertices(model, attachment, state, scratch, mode, segments[i].begin, segments[i].end);
       mine.vertex = std::min(mine.vertex, bad);
       mine.runaway = std::min(mine.runaway, runaway);
-    };
-    // A block's segments keep the goals this step predicts in the thread's own rows, one after
-    // another; a frame's first step reads those the frame before predicted, in the prediction,
-    // and without the beam every step reads the prediction's zeros.
-    Eigen::Matrix<Real, Eigen::Dynamic, 4>& own = scratch.block_goals[omp_get_thread_num()];
-    auto block_goals = [&](uint32_t i, size_t row) {
-      if (!predict || !model.beam) return prediction_goals(prediction, segments[i].begin);
-      return GoalRows<Real>{own.col(0).data() + row, own.col(1).data() + row, own.col(2).data() + row,
-                            own.col(3).data() + row};
     };
     // 1. The border's vertices, before any block matches them.
     if (predict) {
 #pragma omp for schedule(static)
-      for (uint32_t i = segment_offsets[blocks]; i < segment_offsets[blocks + 1]; ++i)
-        predict_segment(i, prediction_goals(prediction, segments[i].begin));
+      for (uint32_t i = segment_offsets[blocks]; i < segment_offsets[blocks + 1]; ++i) predict_segment(i);
     }
     // 2. This thread's blocks: each block's vertices predicted, its clusters matched (branches,
     // then the leaves pinned to them) with the next step's air, its vertices corrected and the
@@ -87,14 +70,12 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
     const auto [first, stop] = balanced_range(model.block_membership_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t b = first; b < stop; ++b) {
       if (predict)
-        for (uint32_t i = segment_offsets[b], row = 0; i < segment_offsets[b + 1]; row += segments[i].end - segments[i].begin, ++i)
-          predict_segment(i, block_goals(i, row));
+        for (uint32_t i = segment_offsets[b]; i < segment_offsets[b + 1]; ++i) predict_segment(i);
       const uint32_t clusters_begin = model.block_cluster_offsets[b], clusters_end = model.block_cluster_offsets[b + 1];
       mine.cluster = std::min(mine.cluster, match_listed_clusters(model, attachment, state, scratch,
                                                                   block_clusters.subspan(clusters_begin,
                                                                                          clusters_end - clusters_begin)));
-      for (uint32_t i = segment_offsets[b], row = 0; i < segment_offsets[b + 1]; row += segments[i].end - segments[i].begin, ++i)
-        correct_segment(i, block_goals(i, row));
+      for (uint32_t i = segment_offsets[b]; i < segment_offsets[b + 1]; ++i) correct_segment(i);
       if (model.beam)
         sum_cluster_loads(model, attachment, state, scratch,
                           load_clusters.subspan(model.block_load_offsets[b],
@@ -103,8 +84,7 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
 #pragma omp barrier
     // 3. The border once every block is matched, then the loads of the clusters it belongs to.
 #pragma omp for schedule(static)
-    for (uint32_t i = segment_offsets[blocks]; i < segment_offsets[blocks + 1]; ++i)
-      correct_segment(i, prediction_goals(prediction, segments[i].begin));
+    for (uint32_t i = segment_offsets[blocks]; i < segment_offsets[blocks + 1]; ++i) correct_segment(i);
     if (model.beam) {
 #pragma omp for schedule(static)
       for (uint32_t i = model.block_load_offsets[blocks]; i < model.block_load_offsets[blocks + 1]; ++i)
@@ -121,8 +101,7 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
       if (last) write_state(model, attachment, state, any_asleep, vertex_first, vertex_stop);
       if (model.beam) walk_bar_chain(model, attachment, scratch);
       if (last) {
-        const uint32_t bad = predict_vertices(model, attachment, state, scratch, mode, vertex_first, vertex_stop,
-                                              prediction_goals(prediction, vertex_first));
+        const uint32_t bad = predict_vertices(model, attachment, state, scratch, mode, vertex_first, vertex_stop);
         if (bad != kNone) {
 #pragma omp critical(treeanim_block_failure)
           failures.next_prediction = std::min(failures.next_prediction, bad);

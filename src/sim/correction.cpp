@@ -82,9 +82,9 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
   }
 }
 
-// One kernel over this thread's vertices [first, last), in blocks, their goals in `goals` =>
-// the lowest vertex whose values are not finite and (`check_runaway`) the lowest attached one
-// farther than the runaway limit. `before` runs on each block's range first.
+// One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
+// values are not finite and (`check_runaway`) the lowest attached one farther than the
+// runaway limit. `before` runs on each block's range first.
 // Without sleeping islands every vertex reads its mean correction from its own row (anchors:
 // a zero row, with factors that keep them still), which the first pass of a step averages for
 // the shared vertices (`first_pass`); otherwise, and when a frame starts from the state, each block is
@@ -93,8 +93,7 @@ template <typename Real, typename Before, typename Kernel>
 std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                                                 SimState& state, StepScratch<Real>& scratch, size_t first,
                                                 size_t last, bool load_state, bool with_pull, bool first_pass,
-                                                bool any_asleep, bool check_runaway, GoalRows<Real> goals,
-                                                Before before, Kernel kernel) {
+                                                bool any_asleep, bool check_runaway, Before before, Kernel kernel) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   uint32_t bad = kNone, runaway = kNone;
   const bool direct = !load_state && !any_asleep;
@@ -109,17 +108,15 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     if (direct) {
       in = {{corrections[0] + begin, corrections[1] + begin, corrections[2] + begin},
             model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
-            attachment.vertex_global.data() + begin, block.flying, {}, nullptr, nullptr};
+            attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
       std::fill(block.moving, block.moving + n, uint8_t(1));
       std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);
     } else {
       gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
       in = {{block.pull[0], block.pull[1], block.pull[2]}, block.drag, block.half_damping,
-            block.global, block.flying, {}, nullptr, nullptr};
+            block.global, block.flying, {}, nullptr};
     }
-    const GoalRows<Real> block_goals = goals.shifted(begin - first);
-    in.goal[0] = block_goals.x, in.goal[1] = block_goals.y, in.goal[2] = block_goals.z;
-    in.compliance = block_goals.compliance;
+    for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
     std::copy_n(model.vertex_shape_kick.data() + begin, n, block.kicked);
     in.kicked = block.kicked;
     if (!kernel(begin, n, in, block)) continue;
@@ -141,13 +138,13 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
 template <typename Real>
 std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                                                SimState& state, StepScratch<Real>& scratch, VertexPassMode mode,
-                                               size_t first, size_t last, GoalRows<Real> goals) {
+                                               size_t first, size_t last) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   auto nothing = [](size_t, size_t) {};
   return with_kernel_isa([&] {
     return for_vertex_blocks(
         model, attachment, state, scratch, first, last, mode.from_state, !mode.from_state, true, mode.any_asleep,
-        mode.last, goals, nothing, [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+        mode.last, nothing, [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
           if (model.store_drag_force)
             return mode.last ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
                              : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
@@ -159,17 +156,16 @@ std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, c
 
 template <typename Real>
 uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last,
-                          GoalRows<Real> goals) {
+                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   // The state's velocities are taken at its time: the first kick from them is half a step's.
   const Real kick = mode.from_state ? Real(0.5) : Real(1);
-  auto write_goals = [&](size_t begin, size_t stop) {
-    if (model.beam) write_static_offsets(model, attachment, scratch, goals.shifted(begin - first), begin, stop);
+  auto goals = [&](size_t begin, size_t stop) {
+    if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
   };
   return with_kernel_isa([&] {
     return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !mode.from_state, false,
-                             mode.any_asleep, false, goals, write_goals,
+                             mode.any_asleep, false, goals,
                              [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
                                return mode.last ? predict_block<false>(model, attachment, scratch, prediction, begin,
                                                                        n, in, kick, block)
@@ -227,8 +223,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
     const auto [first, last] =
         balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
     // 4. Correct the matched step (or load the state), and measure the drag of the next one.
-    const GoalRows<Real> goals = prediction_goals(state.prediction<Real>(), first);
-    const auto [my_bad, my_runaway] = correct_vertices(model, attachment, state, scratch, mode, first, last, goals);
+    const auto [my_bad, my_runaway] = correct_vertices(model, attachment, state, scratch, mode, first, last);
     if (my_bad != kNone || my_runaway != kNone) {
 #pragma omp critical(treeanim_correction_failure)
       bad = std::min(bad, my_bad), runaway = std::min(runaway, my_runaway);
@@ -238,7 +233,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
       if (mode.last) write_state(model, attachment, state, any_asleep, first, last);
       // 1. The static deflection under that drag, and the prediction of the next step.
       if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
-      const uint32_t my_bad_prediction = predict_vertices(model, attachment, state, scratch, mode, first, last, goals);
+      const uint32_t my_bad_prediction = predict_vertices(model, attachment, state, scratch, mode, first, last);
       if (my_bad_prediction != kNone) {
 #pragma omp critical(treeanim_correction_failure)
         bad_prediction = std::min(bad_prediction, my_bad_prediction);
@@ -276,9 +271,9 @@ template void predict_from_state(const SolverModel<double>&, const Attachment<do
 #define TREEANIM_VERTEX_PASSES(Real)                                                                             \
   template std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>&, const Attachment<Real>&,    \
                                                           SimState&, StepScratch<Real>&, VertexPassMode, size_t, \
-                                                          size_t, GoalRows<Real>);                               \
+                                                          size_t);                                               \
   template uint32_t predict_vertices(const SolverModel<Real>&, const Attachment<Real>&, SimState&,              \
-                                     StepScratch<Real>&, VertexPassMode, size_t, size_t, GoalRows<Real>);       \
+                                     StepScratch<Real>&, VertexPassMode, size_t, size_t);                       \
   template void write_state(const SolverModel<Real>&, const Attachment<Real>&, SimState&, bool, size_t, size_t); \
   template void throw_vertex_failure(const SolverModel<Real>&, const Attachment<Real>&, const SimState&,         \
                                      long long, int, uint32_t, uint32_t);

@@ -27,7 +27,6 @@ struct VertexInputs {
   const Real *drag, *half_damping, *global;
   const Real* flying;   // 1 on a flying leaf, else 0
   const Real* goal[3];  // m: the offset from rest the global term pulls toward
-  const Real* compliance;  // s: the damping compliance of that goal (StepPrediction)
   const Real* kicked;   // 1: the mean correction is a kick of the next step (a branch with the beam), 0: a projection now
 };
 
@@ -116,7 +115,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
       force[i] = prediction.drag_force.col(i).data() + begin;
       damped[i] = prediction.damping_offset.col(i).data() + begin;
     }
-  const Real* compliance = in.compliance;
+  const Real* compliance = prediction.damping_compliance.data() + begin;
   Real* drag_damping = scratch.vertex_drag_damping.data() + begin;
   const double* rotation = scratch.cluster_rotation_matrix.data();
   const uint32_t* air_cluster = attachment.vertex_air_cluster.data() + begin;

@@ -295,12 +295,6 @@ void precompute_blocks(SolverModel<Real>& m, size_t block_memberships) {
     m.block_load_clusters.insert(m.block_load_clusters.end(), loads[b].begin(), loads[b].end());
     m.block_load_offsets.push_back(static_cast<uint32_t>(m.block_load_clusters.size()));
   }
-  for (size_t b = 0; b < blocks; ++b) {
-    uint32_t rows = 0;
-    for (uint32_t i = m.block_segment_offsets[b]; i < m.block_segment_offsets[b + 1]; ++i)
-      rows += m.block_segments[i].end - m.block_segments[i].begin;
-    m.block_vertex_capacity = std::max(m.block_vertex_capacity, rows);
-  }
 }
 
 }  // namespace

@@ -177,7 +177,6 @@ struct SolverModel {
   // before the blocks and corrected after them.
   std::vector<uint32_t> block_segment_offsets;
   std::vector<VertexSegment> block_segments;
-  uint32_t block_vertex_capacity = 0;      // the most vertices one block holds (its rows in StepScratch::block_goals)
   // The clusters whose loads block b sums, those without a border vertex: block_load_clusters[
   // block_load_offsets[b], [b + 1]); entry B: the others, summed after the border's correction.
   std::vector<uint32_t> block_load_offsets, block_load_clusters;
@@ -218,11 +217,6 @@ struct StepScratch {
   Eigen::Matrix3Xd cluster_damping_path;
   std::vector<double> cluster_damping_lever;  // (C) s, the same joints' sum of compliance C_j S_j . (j_c - j_j)
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
-  // Per thread (block_vertex_capacity x 4): the goals (x, y, z) and damping compliances of the
-  // cache block it steps, its segments' rows one after another: they stay in the thread's cache
-  // from the block's prediction to its correction, where prediction.goal would be fetched from
-  // and written back to memory. Sized by the first step in blocks.
-  std::vector<Eigen::Matrix<Real, Eigen::Dynamic, 4>> block_goals;
   AirSample air;                           // the wind at the time being sampled
 
   explicit StepScratch(const SolverModel<Real>& model);

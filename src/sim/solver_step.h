@@ -33,19 +33,6 @@ enum class VertexPass {
 template <typename Real>
 bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep);
-// Where a range of vertices keeps its goals and damping compliances, each pointer at the
-// range's first vertex: the prediction's rows (prediction_goals), or a cache block's own rows
-// (StepScratch::block_goals), which stay in the cache between its prediction and correction.
-template <typename Real>
-struct GoalRows {
-  Real *x, *y, *z, *compliance;
-  GoalRows shifted(size_t n) const { return {x + n, y + n, z + n, compliance + n}; }
-};
-template <typename Real>
-GoalRows<Real> prediction_goals(StepPrediction<Real>& prediction, size_t first) {
-  return {prediction.goal.col(0).data() + first, prediction.goal.col(1).data() + first,
-          prediction.goal.col(2).data() + first, prediction.damping_compliance.data() + first};
-}
 // How a step's vertex passes run.
 struct VertexPassMode {
   bool from_state;  // u and v loaded from the state: the prediction of a frame's first step
@@ -55,18 +42,17 @@ struct VertexPassMode {
 // The passes of correct_and_predict, called by each thread on its vertices [first, last),
 // in a parallel region or outside one. The step just matched => the vertices corrected and
 // the drag of the next step measured => the lowest vertex not finite and the lowest that
-// ran away, each kNone for none. `goals`: where the step's prediction left the range's goals.
+// ran away, each kNone for none.
 template <typename Real>
 std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                                                SimState& state, StepScratch<Real>& scratch, VertexPassMode mode,
-                                               size_t first, size_t last, GoalRows<Real> goals);
+                                               size_t first, size_t last);
 // Corrected vertices (corrected here first, unless the frame's last step kept them) =>
 // their goals (with the beam), after the chain's walk, and the next step's prediction => the
-// lowest vertex not finite, kNone for none. The goals are written to `goals`.
+// lowest vertex not finite, kNone for none.
 template <typename Real>
 uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last,
-                          GoalRows<Real> goals);
+                          StepScratch<Real>& scratch, VertexPassMode mode, size_t first, size_t last);
 // The corrected vertices [first, last) (prediction) => the state's positions and velocities,
 // in double; a vertex that does not move keeps its values.
 template <typename Real>
@@ -102,11 +88,11 @@ void sum_cluster_loads(const SolverModel<Real>& model, const Attachment<Real>& a
                        StepScratch<Real>& scratch, std::span<const uint32_t> clusters);
 template <typename Real>
 void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& attachment, StepScratch<Real>& scratch);
-// The deflected chain => vertices [begin, end)'s offsets from rest in it and their damping
-// compliances, in `out` (at vertex begin).
+// The deflected chain => vertices [begin, end)'s offsets from rest in it (prediction.goal).
 template <typename Real>
 void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                          const StepScratch<Real>& scratch, GoalRows<Real> out, size_t begin, size_t end);
+                          const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin,
+                          size_t end);
 
 // --- shape_matching.cpp ---
 // Predicted positions => rotations, shifts and per-membership corrections of every awake
