@@ -15,10 +15,20 @@ add_test(NAME usd_clients_bake
 set_tests_properties(usd_clients_bake PROPERTIES LABELS "usd;clients" FIXTURES_SETUP usd_bake TIMEOUT 120)
 
 find_program(TREEANIM_USD_NODE node)  # not TREEANIM_NODE, which io_clients.cmake clears without the validator
+# A Node that guesses a module's syntax (20.19 and newer) would hide a module Node 18 reads as
+# CommonJS: where it can, the readers run with the guess off, as bookworm's Node 18 runs them.
+set(usd_node_options "")
+if(TREEANIM_USD_NODE)
+  execute_process(COMMAND ${TREEANIM_USD_NODE} --no-experimental-detect-module -e 0 RESULT_VARIABLE no_detect
+                  OUTPUT_QUIET ERROR_QUIET)
+  if(no_detect EQUAL 0)
+    set(usd_node_options --no-experimental-detect-module)
+  endif()
+endif()
 foreach(reader three tinyusdz)
   if(TREEANIM_USD_NODE AND EXISTS ${usd_clients}/node_modules/${reader})
     add_test(NAME usd_clients_${reader}
-             COMMAND sh -c "'${TREEANIM_USD_NODE}' '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/frames' --points '${usd_bake_dir}/tree.usda' --skinned '${usd_bake_dir}/skinned.usda' --forest '${usd_bake_dir}/forest' && exec '${TREEANIM_USD_NODE}' '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/step3' --points '${usd_bake_dir}/step3.usda' --skinned '${usd_bake_dir}/step3-skinned.usda'"
+             COMMAND sh -c "'${TREEANIM_USD_NODE}' ${usd_node_options} '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/frames' --points '${usd_bake_dir}/tree.usda' --skinned '${usd_bake_dir}/skinned.usda' --forest '${usd_bake_dir}/forest' && exec '${TREEANIM_USD_NODE}' ${usd_node_options} '${usd_clients}/check_usd_${reader}.mjs' --bake '${usd_bake_dir}/step3' --points '${usd_bake_dir}/step3.usda' --skinned '${usd_bake_dir}/step3-skinned.usda'"
              WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   else()  # a missing reader fails with the reason instead of silently passing
     add_test(NAME usd_clients_${reader}
