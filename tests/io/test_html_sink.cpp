@@ -376,13 +376,62 @@ TEST_F(HtmlSink, ForestPageThinsFramesToFit) {
   }
   // A limit of 0.6 MiB, rounded as every limit of whole MiB prints.
   EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: 1 frame in 2 of the trees' pages kept, the others interpolated.");
+  // Only pages written for another limit can leave no room for the first tree.
   try {
     forest_page(trees, "forest", 1000);
     FAIL() << "accepted";
   } catch (const OutputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("forest.html: the 2 trees' meshes and two frames each take 1 MiB, above the "
-                                          "page's limit of 0 MiB (max_mib)", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()), "forest.html: tree a's mesh and two frames alone take 1 MiB, above the page's "
+                                     "limit of 0 MiB (max_mib): its page was not written for this limit");
   }
+}
+
+// Trees in the forest page at `limit`, or 0 when it refuses.
+size_t trees_shown(const std::vector<ForestPageTree>& trees, size_t limit) {
+  try {
+    return preview_page_data(forest_page(trees, "forest", limit), "forest.html")["trees"].size();
+  } catch (const OutputError&) {
+    return 0;
+  }
+}
+
+TEST_F(HtmlSink, ForestPageLeavesOutTreesThatDoNotFitWithTwoFramesEach) {
+  const auto trees = two_tree_pages(dir_);
+  // The smallest limit that shows both trees, and one byte less.
+  size_t one = 0, both = forest_page(trees, "forest", 64 << 20).size();
+  while (both - one > 1) {
+    const size_t mid = one + (both - one) / 2;
+    (trees_shown(trees, mid) == 2 ? both : one) = mid;
+  }
+  nlohmann::json data = preview_page_data(forest_page(trees, "forest", both), "forest.html");
+  for (const nlohmann::json& tree : data["trees"]) EXPECT_EQ(tree["frames"]["sample"], (std::vector<int>{0, 4}));
+  EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: 1 frame in 4 of the trees' pages kept, the others interpolated.");
+  const std::string text = forest_page(trees, "forest", one);
+  EXPECT_LE(text.size(), one);
+  data = preview_page_data(text, "forest.html");
+  ASSERT_EQ(data["trees"].size(), 1u);
+  EXPECT_EQ(data["trees"][0]["position"], (std::vector<double>{1, 0, 2})) << "the first tree";
+  EXPECT_EQ(data["trees"][0]["frames"]["sample"], (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: the first 1 of 2 trees shown, the others left out.");
+  EXPECT_EQ(data["plot"]["max_displacement"], page_data(dir_ / "b.html")["plot"]["max_displacement"])
+      << "the plots still cover every tree";
+}
+
+// A tree's page at its limit leaves room for the forest page of that tree alone, placed with
+// the longest numbers and named longer than the tree's page, its note quoted.
+TEST_F(HtmlSink, ForestPageOfATreePageAtItsLimitFits) {
+  const TreeModel m = sized_model(2000, 3000);
+  test::bake({page_output("t.html", 1)}, dir_, m, small_info(1000, 0));
+  const std::vector<ForestPageTree> trees = {
+      {"a-tree-id-of-sixty-four-characters-which-is-the-longest-allowed.", dir_ / "t.html",
+       Eigen::Vector3d(-9876.123456789012, 0.1234567890123456, -1234.567890123456), -123.45678901234567}};
+  const std::string text = forest_page(trees, "forest", 1 << 20);
+  EXPECT_LE(text.size(), size_t(1 << 20));
+  const nlohmann::json data = preview_page_data(text, "forest.html");
+  ASSERT_EQ(data["trees"].size(), 1u);
+  EXPECT_EQ(data["trees"][0]["frames"], page_data(dir_ / "t.html")["trees"][0]["frames"]) << "nothing thinned";
+  EXPECT_NE(data["reduced"].get<std::string>().find("1 of 1 tree pages were reduced; tree a-tree-id"),
+            std::string::npos) << data["reduced"];
 }
 
 TEST_F(HtmlSink, ForestPageNamesAPageThatIsNotOne) {
