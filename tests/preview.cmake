@@ -54,6 +54,18 @@ for shard in 0/3 1/3 2/3; do \"$t\" run '${preview_forest_scene}' -o \"$d\" --qu
 test ! -e \"$d/forest.html\" && \"$t\" farm gather '${preview_forest_scene}' -o \"$d\" && cmp \"$d/forest.html\" '${preview_out}/forest/forest.html'")
 set_tests_properties(preview.forest_gather PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 120)
 
+# Pages at their size limit (tests/clients/preview_sweep.sh): the golden tree over 2 to 1,000
+# frames, the demo and the paper's two largest trees under limits near what each needs; every
+# page at most its max_mib; table1-38772's under 4 MiB opened in the browser.
+set(preview_sweep_out ${CMAKE_BINARY_DIR}/preview_sweep)
+separate_arguments(preview_sweep_colors UNIX_COMMAND "${preview_scene_colors}")
+add_test(NAME preview.sweep
+  COMMAND sh tests/clients/preview_sweep.sh $<TARGET_FILE:treeanim> ${preview_sweep_out} ${preview_sweep_colors}
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(preview.sweep PROPERTIES LABELS preview FIXTURES_SETUP preview_sweep_pages TIMEOUT 600)
+preview_page_test(sweep_table1_38772 ${preview_sweep_out}/table1-38772-24/p4.html --reduced yes)
+set_tests_properties(preview.sweep_table1_38772 PROPERTIES FIXTURES_REQUIRED preview_sweep_pages)
+
 # preview.NAME: the preview forest baked into DIR under max_mib 2 with one more `--set SET`; the
 # bake must succeed and forest.html fit 2 MiB and say NOTE (a grep pattern).
 function(preview_forest_fit_test name dir set note)
