@@ -26,9 +26,13 @@ set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP previ
 
 find_program(TREEANIM_NODE node)
 set(preview_client ${CMAKE_SOURCE_DIR}/tests/clients/node/preview_page.js)
+# A page of preview.bake's (a path under its folder) or any other (an absolute path).
 function(preview_page_test name page)
+  if(NOT IS_ABSOLUTE ${page})
+    set(page ${preview_out}/${page})
+  endif()
   if(TREEANIM_NODE AND EXISTS ${CMAKE_SOURCE_DIR}/tests/clients/node/node_modules/playwright-core AND EXISTS /usr/bin/chromium)
-    add_test(NAME preview.${name} COMMAND ${TREEANIM_NODE} ${preview_client} check ${preview_out}/${page} ${preview_colors} ${ARGN})
+    add_test(NAME preview.${name} COMMAND ${TREEANIM_NODE} ${preview_client} check ${page} ${preview_colors} ${ARGN})
   else()
     add_test(NAME preview.${name}
              COMMAND sh -c "echo 'preview.${name}: node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
@@ -50,12 +54,40 @@ for shard in 0/3 1/3 2/3; do \"$t\" run '${preview_forest_scene}' -o \"$d\" --qu
 test ! -e \"$d/forest.html\" && \"$t\" farm gather '${preview_forest_scene}' -o \"$d\" && cmp \"$d/forest.html\" '${preview_out}/forest/forest.html'")
 set_tests_properties(preview.forest_gather PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 120)
 
-# A forest whose pages together pass max_mib: forest.html thins every tree's frames alike and says so.
-add_test(NAME preview.forest_thinned
-  COMMAND sh -c "d='${preview_out}/forest-thinned' && rm -rf \"$d\" && \
-'$<TARGET_FILE:treeanim>' run '${preview_forest_scene}' -o \"$d\" --quiet --set time.frames=600 \
-  --set 'outputs=[{\"format\":\"html\",\"path\":\"trees/{tree}.html\",\"max_mib\":2}]' && \
-test $(wc -c < \"$d/forest.html\") -le 2097152 && \
-grep -o 'Reduced to fit 2 MiB: 1 frame in [0-9]* of the trees. pages kept, the others interpolated. 3 of 3 tree pages were reduced' \"$d/forest.html\""
+# Pages at their size limit (tests/clients/preview_sweep.sh): the golden tree over 2 to 1,000
+# frames, the demo and the paper's two largest trees under limits near what each needs; every
+# page at most its max_mib; table1-38772's under 4 MiB opened in the browser.
+set(preview_sweep_out ${CMAKE_BINARY_DIR}/preview_sweep)
+separate_arguments(preview_sweep_colors UNIX_COMMAND "${preview_scene_colors}")
+add_test(NAME preview.sweep
+  COMMAND sh tests/clients/preview_sweep.sh $<TARGET_FILE:treeanim> ${preview_sweep_out} ${preview_sweep_colors}
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(preview.forest_thinned PROPERTIES LABELS preview TIMEOUT 300)
+set_tests_properties(preview.sweep PROPERTIES LABELS preview FIXTURES_SETUP preview_sweep_pages TIMEOUT 600)
+preview_page_test(sweep_table1_38772 ${preview_sweep_out}/table1-38772-24/p4.html --reduced yes)
+set_tests_properties(preview.sweep_table1_38772 PROPERTIES FIXTURES_REQUIRED preview_sweep_pages)
+
+# preview.NAME: the preview forest baked into DIR under max_mib 2 with one more `--set SET`; the
+# bake must succeed and forest.html fit 2 MiB and say NOTE (a grep pattern).
+function(preview_forest_fit_test name dir set note)
+  add_test(NAME preview.${name}
+    COMMAND sh -c "d='${dir}' && rm -rf \"$d\" && \
+'$<TARGET_FILE:treeanim>' run '${preview_forest_scene}' -o \"$d\" --quiet --set ${set} \
+  --set 'outputs=[{\"format\":\"html\",\"path\":\"trees/{tree}.html\",\"max_mib\":2}]' && \
+test $(wc -c < \"$d/forest.html\") -le 2097152 && grep -o '${note}' \"$d/forest.html\""
+    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(preview.${name} PROPERTIES LABELS preview TIMEOUT 300)
+endfunction()
+
+# A forest whose pages together pass max_mib: forest.html thins every tree's frames alike and says so.
+preview_forest_fit_test(forest_thinned ${preview_out}/forest-thinned time.frames=600
+  "Reduced to fit 2 MiB: 1 frame in [0-9]* of the trees. pages kept, the others interpolated. 3 of 3 tree pages were reduced")
+
+# A forest whose trees do not all fit forest.html even with two frames each (broadleaves of 9,293
+# vertices under 2 MiB): the bake succeeds, the page shows the first two trees and says so.
+set(preview_left_out ${CMAKE_BINARY_DIR}/preview_forest_left_out)
+preview_forest_fit_test(forest_left_out ${preview_left_out} lsystem.iterations=8
+  "Reduced to fit 2 MiB: the first 2 of 3 trees shown, the others left out")
+set_tests_properties(preview.forest_left_out PROPERTIES FIXTURES_SETUP preview_forest_left_out)
+preview_page_test(forest_left_out_page ${preview_left_out}/forest.html --trees 2)
+# Two trees of 9,293 vertices, each drawn alone: slower than the other pages in software GL.
+set_tests_properties(preview.forest_left_out_page PROPERTIES FIXTURES_REQUIRED preview_forest_left_out TIMEOUT 600)

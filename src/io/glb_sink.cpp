@@ -349,6 +349,11 @@ class GlbSink final : public FrameSink {
     }
     content_.placeholder = false;
     std::string json = render_json(content_);
+    // Every number was reserved at its longest, so the JSON fits its room; were it longer, padding
+    // it to the room would cut it and leave a broken file under the final name.
+    if (json.size() > reserved_json_)
+      throw OutputError(path_.string() + ": the animated GLB's JSON came to " + std::to_string(json.size()) +
+                        " bytes, above the " + std::to_string(reserved_json_) + " reserved for it");
     json.resize(reserved_json_, ' ');
     file_->seek(0);
     file_->write_u32_le(kGlbMagic);

@@ -19,9 +19,12 @@ struct ForestPageTree {
 
 // trees (at least one), name, size limit => the page's text: every tree's mesh and kept frames,
 // the wind plotted at the first tree, the displacements over all trees. Frames the limit has no
-// room for are thinned alike in every tree (every k-th and the last kept), and the page says so.
-// A tree's scale is grown into its mesh, so nothing scales. Throws OutputError naming a page that
-// cannot be read or a forest whose meshes and two frames each do not fit.
+// room for are thinned alike in every tree (every k-th and the last kept); when the trees do not
+// fit even with two frames each, the first ones that do are shown and the others left out; the
+// page says what it reduced. A tree's page leaves room for a forest page of that tree alone, so a
+// forest page is never refused for its size. A tree's scale is grown into its mesh, so nothing
+// scales. Reads each page twice (its sizes, then the trees shown), holding one at a time besides
+// the page it composes. Throws OutputError naming a page that cannot be read or plots other frames.
 std::string forest_page(const std::vector<ForestPageTree>& trees, const std::string& name, size_t max_page_bytes);
 
 // Writes forest_page() to `path` (named after its stem) atomically. Throws OutputError naming the path.

@@ -1,16 +1,14 @@
 #include "io/output_estimate.h"
 
-#include <algorithm>
-
 #include "io/output_formats.h"
 
 namespace treeanim {
 
 double estimated_output_bytes(const OutputOptions& output, size_t vertices, size_t triangles, size_t clusters,
                               long long frames) {
+  if (output.format->output_bytes) return output.format->output_bytes(output, vertices, triangles, clusters, frames);
   const double written = double((frames + output.frame_step - 1) / output.frame_step);
-  const double bytes = written * output.format->frame_bytes(output, vertices, triangles, clusters);
-  return output.format->limit_bytes ? std::min(bytes, output.format->limit_bytes(output)) : bytes;
+  return written * output.format->frame_bytes(output, vertices, triangles, clusters);
 }
 
 }  // namespace treeanim

@@ -2,7 +2,8 @@
 // What an output will take on disk, estimated before baking (treeanim farm plan): the bytes of
 // its per-frame data, uncompressed, from the mesh size and the frames it writes. Compression,
 // headers and the rest mesh are left out: an upper bound for the frames, within a few percent
-// for plain HDF5, PC2 and MDD.
+// for plain HDF5, PC2 and MDD. A format that plans its whole size before simulating (the
+// preview page, under its limit) gives that plan instead: an upper bound of all it writes.
 #include <cstddef>
 
 #include "io/output_options.h"

@@ -13,6 +13,10 @@ namespace treeanim {
 SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
     make_skinned_glb_sink, make_usd_sink, make_html_sink;
 
+// The preview page's bytes at most, as its sink plans them (src/io/html_sink.cpp).
+double html_output_bytes(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters,
+                         long long frames);
+
 namespace {
 
 using Type = OutputKey::Type;
@@ -139,7 +143,7 @@ const std::vector<OutputFormatRow> kFormats = {
      .make = make_html_sink,
      // float32 positions in base64, reduced to fit the page's limit
      .frame_bytes = [](const OutputOptions&, size_t vertices, size_t, size_t) { return vector_bytes(vertices) * 4.0 / 3.0; },
-     .limit_bytes = [](const OutputOptions& o) { return double(o.max_page_bytes); }},
+     .output_bytes = html_output_bytes},
 };
 
 }  // namespace

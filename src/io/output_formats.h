@@ -44,8 +44,11 @@ struct OutputFormatRow {
   SinkFactory* make = nullptr;  // the format's sink
   // options, mesh size => bytes of one written frame's data, uncompressed (io/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
-  // options => the most bytes the output takes whatever the frames (a page that reduces its frames to fit); none: null
-  double (*limit_bytes)(const OutputOptions& options) = nullptr;
+  // options, mesh size, frames of the bake => an upper bound of the whole output's bytes, for a
+  // format that plans its size before simulating (a page that reduces its frames to fit its
+  // limit); none: null, and the estimate is the frames' bytes (io/output_estimate.h)
+  double (*output_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters,
+                         long long frames) = nullptr;
 };
 
 // Every format, in the order messages and docs/outputs.md list them.

@@ -25,14 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Bytes of the file, bounded from above before simulating (a GLB states its length in 32 bits).
-uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frames) {
-  const uint64_t n = model.vertex_count(), t = model.triangle_count(), j = joints;
-  constexpr uint64_t kJsonPerJoint = 1024, kJsonFixed = 4096;  // generous: nodes, samplers, channels, accessors
-  return kJsonFixed + kJsonPerJoint * j + 12 * t + n * (12 + 12 + 8 + 8 + 16 + 12) + 64 * j + 4 * frames +
-         28 * frames * j + 8 * (2 * j + 16);
-}
-
 class SkinnedGlbSink final : public FrameSink {
  public:
   SkinnedGlbSink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
@@ -191,6 +183,16 @@ class SkinnedGlbSink final : public FrameSink {
 };
 
 }  // namespace
+
+uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frames) {
+  const uint64_t n = model.vertex_count(), t = model.triangle_count(), j = joints;
+  constexpr uint64_t kJsonPerJoint = 1024, kJsonFixed = 4096;  // generous: nodes, samplers, channels, accessors
+  // A frame's RMS error in the extras: a double at its longest and a comma.
+  constexpr uint64_t kJsonPerFrame = 25;
+  const uint64_t keys = frames + 1;  // a loop's closing key
+  return kJsonFixed + kJsonPerJoint * j + kJsonPerFrame * frames + 12 * t + n * (12 + 12 + 8 + 8 + 16 + 12) + 64 * j +
+         4 * keys + 28 * keys * j + 8 * (2 * j + 16);
+}
 
 std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const fs::path& path,
                                                  const TreeModel& model, const BakeInfo& info) {

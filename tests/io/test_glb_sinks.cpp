@@ -175,5 +175,41 @@ TEST_F(GlbSinks, SequenceKeepsVerticesAndSplitsFacesByMaterial) {
   }
 }
 
+// The 4 GiB checks decide before simulating, so their bounds must hold for whatever is written:
+// every frame count across the digit counts of the JSON's numbers and target names (frames from
+// 9995 on cross into five digits), with and without normals, vertex colours and a loop's closing key.
+TEST_F(GlbSinks, AnimatedGlbNeverPassesItsSizeBound) {
+  const TreeModel m = small_model();
+  for (long long frames : {1, 2, 9, 10, 11, 99, 100, 101, 999, 1000, 1001}) {
+    for (bool normals : {false, true}) {
+      for (bool loop : {false, true}) {
+        BakeInfo info = frames % 2 ? coloured_info(frames, 9995) : small_info(frames, 9995);
+        info.loop = loop;
+        info.loop_end_time = double(9995 + frames) / 24.0;
+        OutputOptions options = test::output("glb", "anim.glb");
+        options.normals = normals;
+        test::bake({options}, dir_, m, info);
+        const uint64_t bytes = std::filesystem::file_size(dir_ / "anim.glb");
+        EXPECT_LE(bytes, animated_glb_bytes(m, info, 1, normals)) << frames << " " << normals << " " << loop;
+        EXPECT_EQ(parse_glb(dir_ / "anim.glb").json["meshes"][0]["extras"]["targetNames"].size(), size_t(frames));
+      }
+    }
+  }
+}
+
+TEST_F(GlbSinks, SkinnedGlbNeverPassesItsSizeBound) {
+  const TreeModel m = small_model();
+  for (long long frames : {1, 10, 100, 1000, 3000}) {
+    for (bool loop : {false, true}) {
+      BakeInfo info = coloured_info(frames, 0);
+      info.loop = loop;
+      info.loop_end_time = double(frames) / 24.0;
+      test::bake({test::output("skinned_glb", "skin.glb")}, dir_, m, info);
+      EXPECT_LE(std::filesystem::file_size(dir_ / "skin.glb"), skinned_glb_bytes(m, m.cluster_count(), uint64_t(frames)))
+          << frames << " " << loop;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace treeanim

@@ -12,6 +12,7 @@
 #include "io/html_forest.h"
 #include "io/preview_page.h"
 #include "io/text_output.h"
+#include "io/output_estimate.h"
 #include "io/output_options.h"
 #include "io_test_support.h"
 
@@ -131,6 +132,180 @@ TEST_F(HtmlSink, LargeBakeIsReducedToFit) {
   EXPECT_NE(note.find("; 1 frame in "), std::string::npos) << note;
 }
 
+// A model of `vertices` vertices and `triangles` triangles (every third one leaf): what sizes a
+// page, without the grower.
+TreeModel sized_model(size_t vertices, size_t triangles) {
+  TreeModel m = small_model();
+  m.rest_positions = Eigen::Matrix3Xd::Random(3, Eigen::Index(vertices));
+  m.vertex_leaf.assign(vertices, -1);
+  m.vertex_anchored.assign(vertices, 0);
+  m.triangles.resize(3 * triangles);
+  for (size_t i = 0; i < m.triangles.size(); ++i) m.triangles[i] = uint32_t(i % vertices);
+  m.triangle_material.resize(triangles);
+  for (size_t t = 0; t < triangles; ++t) m.triangle_material[t] = t % 3 == 2 ? kMaterialLeaf : kMaterialBark;
+  return m;
+}
+
+// Vertices and triangles of the trees the page is swept over (`treeanim info`, 2026-11-28).
+struct TreeSize {
+  const char* name;
+  size_t vertices, triangles;
+};
+constexpr TreeSize kDemo{"demo", 9797, 11772}, kTable38772{"table1-38772", 38578, 71158},
+    kTable211812{"table1-211812", 211864, 404284};
+
+// The html output `name` of at most `mib` MiB.
+OutputOptions page_output(const std::string& name, size_t mib) {
+  OutputOptions options = test::output("html", name);
+  options.max_page_bytes = mib << 20;
+  return options;
+}
+
+TEST(PagePlan, TakesTheFirstEncodingThatFitsAndTheSmallestStride) {
+  PreviewPageShape shape;
+  shape.vertices = 1000;
+  shape.triangles = 1500;
+  shape.frame_number_chars = 4;
+  shape.skeleton = {700000, 700040};
+  const size_t limit = 4 << 20;
+  size_t last_stride = 1;
+  for (size_t frames : {0, 1, 2, 3, 10, 100, 190, 200, 300, 400, 1000, 2000, 5000}) {
+    shape.frames = frames;
+    const PreviewPagePlan plan = plan_preview_page(shape, limit);
+    ASSERT_TRUE(plan.fits) << frames;
+    EXPECT_LE(plan.bytes, double(limit)) << frames;
+    EXPECT_EQ(plan.bytes, preview_page_bytes(shape, plan.quantized, plan.stride));
+    if (plan.quantized) {
+      EXPECT_GT(preview_page_bytes(shape, false, 1), double(limit)) << "float32 fits: " << frames;
+    }
+    if (plan.stride > 1) {
+      EXPECT_GT(preview_page_bytes(shape, true, plan.stride - 1), double(limit)) << frames;
+    }
+    EXPECT_GE(plan.stride, last_stride) << "more frames never keep a finer stride";
+    last_stride = plan.stride;
+  }
+  // Two frames as int16 are the least a page keeps.
+  shape.frames = 2;
+  const double fewest = preview_page_bytes(shape, true, 1);
+  EXPECT_FALSE(plan_preview_page(shape, size_t(fewest) - 1).fits);
+  EXPECT_TRUE(plan_preview_page(shape, size_t(fewest)).fits);
+  shape.frames = 1000;
+  EXPECT_EQ(plan_preview_page(shape, size_t(fewest) - 1).bytes, preview_page_bytes(shape, true, 999));
+}
+
+TEST(PagePlan, KeptFramesAreEveryStrideThAndTheLast) {
+  EXPECT_EQ(kept_frames(0, 3), std::vector<size_t>{});
+  EXPECT_EQ(kept_frames(1, 3), std::vector<size_t>{0});
+  EXPECT_EQ(kept_frames(7, 3), (std::vector<size_t>{0, 3, 6}));
+  EXPECT_EQ(kept_frames(8, 3), (std::vector<size_t>{0, 3, 6, 7}));
+  for (size_t count = 0; count < 60; ++count)
+    for (size_t stride = 1; stride < 62; ++stride)
+      ASSERT_EQ(kept_frame_count(count, stride), kept_frames(count, stride).size()) << count << " " << stride;
+}
+
+TEST(PagePlan, FurtherStrideDropsEnoughFrames) {
+  // 25 kept frames of 100 characters: 250 characters too many drop 3 frames at least.
+  const size_t k = further_stride(25, 100, 250);
+  EXPECT_GE(25 - kept_frame_count(25, k), 3u);
+  EXPECT_LT(25 - kept_frame_count(25, k - 1), 3u);
+  EXPECT_EQ(further_stride(25, 100, 2300), 24u) << "down to the first and the last";
+  EXPECT_EQ(further_stride(25, 100, 2301), 0u) << "not even those";
+  EXPECT_EQ(further_stride(2, 100, 1), 0u);
+}
+
+// Every frame count from 2 to 1,000 of the demo and the two largest trees of the paper's Table 1
+// at 64 MiB: each plan fits, keeps the most it can, and a page of every tree is written at the
+// counts where its plan changes (the largest page of the sweep is printed).
+TEST_F(HtmlSink, PlanSweepOfTheTablesTreesAt64MiB) {
+  const OutputOptions options = page_output("page.html", 64);
+  double largest = 0;
+  std::string largest_at;
+  for (const TreeSize& tree : {kDemo, kTable38772, kTable211812}) {
+    const TreeModel m = sized_model(tree.vertices, tree.triangles);
+    PreviewPagePlan last;
+    std::vector<long long> changes;
+    for (long long frames = 2; frames <= 1000; ++frames) {
+      const PreviewPageShape shape = html_page_shape(options, m, small_info(frames, 0));
+      const PreviewPagePlan plan = plan_preview_page(shape, options.max_page_bytes);
+      ASSERT_TRUE(plan.fits) << tree.name << " " << frames;
+      ASSERT_LE(plan.bytes, double(options.max_page_bytes)) << tree.name << " " << frames;
+      if (plan.stride > 1) {
+        ASSERT_GT(preview_page_bytes(shape, true, plan.stride - 1), double(options.max_page_bytes));
+      }
+      if (plan.bytes > largest) {
+        largest = plan.bytes;
+        largest_at = std::string(tree.name) + ", " + std::to_string(frames) + " frames";
+      }
+      if (frames > 2 && (plan.quantized != last.quantized || plan.stride != last.stride)) changes.push_back(frames);
+      last = plan;
+    }
+    EXPECT_FALSE(changes.empty()) << tree.name << ": the sweep passes no limit";
+    std::printf("%s: the plan changes at frames", tree.name);
+    for (long long f : changes) std::printf(" %lld", f);
+    std::printf("\n");
+  }
+  std::printf("largest planned page of the sweep: %.0f bytes (%s), limit %zu\n", largest, largest_at.c_str(),
+              options.max_page_bytes);
+}
+
+// Pages written at the limit: each within its plan, within its limit, and near it when thinned
+// (it keeps the most frames that fit). Small trees and small limits, so the writes are quick.
+TEST_F(HtmlSink, PagesStayWithinTheirPlan) {
+  struct Case {
+    size_t vertices, triangles;
+    long long frames;
+    size_t mib;
+  };
+  const std::vector<Case> cases = {{300, 400, 1, 1},      {300, 400, 2, 1},      {300, 400, 3, 1},
+                                   {300, 400, 40, 1},     {300, 400, 90, 1},     {300, 400, 200, 1},
+                                   {300, 400, 1000, 1},   {2000, 3000, 2, 1},    {2000, 3000, 5, 1},
+                                   {2000, 3000, 14, 2},   {2000, 3000, 60, 2},   {2000, 3000, 61, 2},
+                                   {2000, 3000, 300, 2},  {2000, 3000, 1000, 2}, {9797, 11772, 2, 2},
+                                   {9797, 11772, 9, 2},   {9797, 11772, 1000, 2}};
+  for (const Case& c : cases) {
+    const TreeModel m = sized_model(c.vertices, c.triangles);
+    const OutputOptions options = page_output("page.html", c.mib);
+    const BakeInfo info = small_info(c.frames, 0);
+    const PreviewPagePlan plan = plan_preview_page(html_page_shape(options, m, info), options.max_page_bytes);
+    ASSERT_TRUE(plan.fits);
+    test::bake({options}, dir_, m, info);
+    const double bytes = double(std::filesystem::file_size(dir_ / "page.html"));
+    const std::string at = std::to_string(c.vertices) + " vertices, " + std::to_string(c.frames) + " frames";
+    EXPECT_LE(bytes, plan.bytes) << at;
+    EXPECT_LE(bytes, double(options.max_page_bytes)) << at;
+    EXPECT_LE(bytes, estimated_output_bytes(options, c.vertices, c.triangles, 7, c.frames)) << at;
+    // What the plan leaves unused: the plots' numbers below their longest, the note's room.
+    EXPECT_LT(plan.bytes - bytes, 150.0 * double(c.frames) + 2048) << at;
+    const nlohmann::json frames = page_data(dir_ / "page.html")["trees"][0]["frames"];
+    EXPECT_EQ(frames["encoding"], plan.quantized ? "int16" : "float32") << at;
+    EXPECT_EQ(frames["sample"].size(), kept_frame_count(size_t(c.frames), plan.stride)) << at;
+    if (plan.stride > 1) {  // the frames a finer stride keeps besides would not have fitted
+      const size_t more = kept_frame_count(size_t(c.frames), plan.stride - 1) - frames["sample"].size();
+      EXPECT_GT(bytes + double(more * base64_chars(6 * c.vertices)) + 150.0 * double(c.frames) + 2048,
+                double(options.max_page_bytes)) << at;
+    }
+  }
+}
+
+// The page of the bake that overran its limit in the field (table1-211812, 96 frames, 67.5 MB at
+// 64 MiB), the largest page of the sweep above (table1-38772, 417 frames, planned within 3.5 kB
+// of 64 MiB) and the demo's largest float32 page: each written, within its plan and 64 MiB.
+TEST_F(HtmlSink, PagesOfTheTablesTreesFit64MiB) {
+  const OutputOptions options = page_output("page.html", 64);
+  for (const auto& [tree, frames] :
+       {std::pair{kTable211812, 96LL}, std::pair{kTable38772, 417LL}, std::pair{kDemo, 421LL}}) {
+    const TreeModel m = sized_model(tree.vertices, tree.triangles);
+    const BakeInfo info = small_info(frames, 0);
+    const PreviewPagePlan plan = plan_preview_page(html_page_shape(options, m, info), options.max_page_bytes);
+    test::bake({options}, dir_, m, info);
+    const double bytes = double(std::filesystem::file_size(dir_ / "page.html"));
+    EXPECT_LE(bytes, plan.bytes) << tree.name << " " << frames;
+    EXPECT_LE(bytes, double(64 << 20)) << tree.name << " " << frames;
+    std::printf("%s, %lld frames: %.0f bytes (%s, stride %zu), limit %zu\n", tree.name, frames, bytes,
+                plan.quantized ? "int16" : "float32", plan.stride, options.max_page_bytes);
+  }
+}
+
 TEST_F(HtmlSink, PageTooSmallForTheTreeIsRefused) {
   TreeModel m = small_model();
   m.rest_positions = Eigen::Matrix3Xd::Random(3, 200000);
@@ -143,7 +318,7 @@ TEST_F(HtmlSink, PageTooSmallForTheTreeIsRefused) {
     FAIL() << "accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "/outputs/0/max_mib: the page needs 7 MiB at least for this tree (viewer, mesh and two frames)");
+              "/outputs/0/max_mib: the page needs 8 MiB at least for this tree (viewer, mesh and two frames)");
   }
 }
 
@@ -201,13 +376,62 @@ TEST_F(HtmlSink, ForestPageThinsFramesToFit) {
   }
   // A limit of 0.6 MiB, rounded as every limit of whole MiB prints.
   EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: 1 frame in 2 of the trees' pages kept, the others interpolated.");
+  // Only pages written for another limit can leave no room for the first tree.
   try {
     forest_page(trees, "forest", 1000);
     FAIL() << "accepted";
   } catch (const OutputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("forest.html: the 2 trees' meshes and two frames each take 1 MiB, above the "
-                                          "page's limit of 0 MiB (max_mib)", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()), "forest.html: tree a's mesh and two frames alone take 1 MiB, above the page's "
+                                     "limit of 0 MiB (max_mib): its page was not written for this limit");
   }
+}
+
+// Trees in the forest page at `limit`, or 0 when it refuses.
+size_t trees_shown(const std::vector<ForestPageTree>& trees, size_t limit) {
+  try {
+    return preview_page_data(forest_page(trees, "forest", limit), "forest.html")["trees"].size();
+  } catch (const OutputError&) {
+    return 0;
+  }
+}
+
+TEST_F(HtmlSink, ForestPageLeavesOutTreesThatDoNotFitWithTwoFramesEach) {
+  const auto trees = two_tree_pages(dir_);
+  // The smallest limit that shows both trees, and one byte less.
+  size_t one = 0, both = forest_page(trees, "forest", 64 << 20).size();
+  while (both - one > 1) {
+    const size_t mid = one + (both - one) / 2;
+    (trees_shown(trees, mid) == 2 ? both : one) = mid;
+  }
+  nlohmann::json data = preview_page_data(forest_page(trees, "forest", both), "forest.html");
+  for (const nlohmann::json& tree : data["trees"]) EXPECT_EQ(tree["frames"]["sample"], (std::vector<int>{0, 4}));
+  EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: 1 frame in 4 of the trees' pages kept, the others interpolated.");
+  const std::string text = forest_page(trees, "forest", one);
+  EXPECT_LE(text.size(), one);
+  data = preview_page_data(text, "forest.html");
+  ASSERT_EQ(data["trees"].size(), 1u);
+  EXPECT_EQ(data["trees"][0]["position"], (std::vector<double>{1, 0, 2})) << "the first tree";
+  EXPECT_EQ(data["trees"][0]["frames"]["sample"], (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(data["reduced"], "Reduced to fit 1 MiB: the first 1 of 2 trees shown, the others left out.");
+  EXPECT_EQ(data["plot"]["max_displacement"], page_data(dir_ / "b.html")["plot"]["max_displacement"])
+      << "the plots still cover every tree";
+}
+
+// A tree's page at its limit leaves room for the forest page of that tree alone, placed with
+// the longest numbers and named longer than the tree's page, its note quoted.
+TEST_F(HtmlSink, ForestPageOfATreePageAtItsLimitFits) {
+  const TreeModel m = sized_model(2000, 3000);
+  test::bake({page_output("t.html", 1)}, dir_, m, small_info(1000, 0));
+  const std::vector<ForestPageTree> trees = {
+      {"a-tree-id-of-sixty-four-characters-which-is-the-longest-allowed.", dir_ / "t.html",
+       Eigen::Vector3d(-9876.123456789012, 0.1234567890123456, -1234.567890123456), -123.45678901234567}};
+  const std::string text = forest_page(trees, "forest", 1 << 20);
+  EXPECT_LE(text.size(), size_t(1 << 20));
+  const nlohmann::json data = preview_page_data(text, "forest.html");
+  ASSERT_EQ(data["trees"].size(), 1u);
+  EXPECT_EQ(data["trees"][0]["frames"], page_data(dir_ / "t.html")["trees"][0]["frames"]) << "nothing thinned";
+  EXPECT_NE(data["reduced"].get<std::string>().find("1 of 1 tree pages were reduced; tree a-tree-id"),
+            std::string::npos) << data["reduced"];
 }
 
 TEST_F(HtmlSink, ForestPageNamesAPageThatIsNotOne) {

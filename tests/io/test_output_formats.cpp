@@ -84,6 +84,14 @@ TEST(OutputFormats, SizeEstimatesPerFormat) {
   EXPECT_EQ(bytes("usd", plain), 4 * 36 * 100);
   EXPECT_EQ(bytes("usd", with_normals), 4 * (36 + 38) * 100);
   EXPECT_EQ(bytes("usd", [](OutputOptions& o) { o.skinned = true; }), 4 * 96 * 7);
+  // The page's whole size as its sink plans it (the viewer, about 0.6 MB, included), at most its limit.
+  const double page = bytes("html", [](OutputOptions& o) { o.max_page_bytes = 2 << 20; });
+  EXPECT_GT(page, 4 * 1600 + 500000);
+  EXPECT_LT(page, 2 << 20);
+  OutputOptions big;
+  big.format = find_output_format("html");
+  big.max_page_bytes = 2 << 20;
+  EXPECT_EQ(estimated_output_bytes(big, 100000, 200000, 7, 1000), double(2 << 20)) << "reduced to fit";
 }
 
 }  // namespace
