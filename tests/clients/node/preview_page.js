@@ -53,11 +53,14 @@ async function pixels(browser, pngs) {
     const canvas = new OffscreenCanvas(image.width, image.height);
     const g = canvas.getContext('2d');
     g.drawImage(image, 0, 0);
-    return { width: image.width, height: image.height,
-             data: Array.from(g.getImageData(0, 0, image.width, image.height).data) };
+    // base64 crosses to Node in a fraction of the time a JSON array of every byte takes
+    const bytes = g.getImageData(0, 0, image.width, image.height).data;
+    let text = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+    return { width: image.width, height: image.height, data: btoa(text) };
   })), pngs.map((p) => p.toString('base64')));
   await tab.close();
-  return out;
+  return out.map((image) => ({ ...image, data: Buffer.from(image.data, 'base64') }));
 }
 
 // PNG images => one PNG of them side by side.
