@@ -10,8 +10,8 @@
 #include "bake/signals.h"
 #include "common/errors.h"
 #include "common/seconds_since.h"
-#include "io/checkpoint.h"
-#include "io/free_space.h"
+#include "bake/checkpoint.h"
+#include "files/free_space.h"
 #include "sim/simulator.h"
 
 namespace treeanim {

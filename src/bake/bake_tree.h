@@ -14,7 +14,7 @@
 #include "bake/bake_plan.h"
 #include "bake/bake_start.h"
 #include "bake/loop_bake.h"
-#include "io/outputs.h"
+#include "formats/outputs.h"
 #include "scene/scene.h"
 #include "tree/tree_placement.h"
 

@@ -5,9 +5,9 @@
 #include <queue>
 
 #include "bake/prepare_tree.h"
-#include "io/checkpoint.h"
-#include "io/frame_journal.h"
-#include "io/output_estimate.h"
+#include "bake/checkpoint.h"
+#include "bake/frame_journal.h"
+#include "output/output_estimate.h"
 
 namespace treeanim {
 

@@ -4,8 +4,8 @@
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
-#include "io/output_estimate.h"
-#include "io/output_formats.h"
+#include "output/output_estimate.h"
+#include "output/output_formats.h"
 
 namespace treeanim {
 

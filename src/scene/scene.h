@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/output_options.h"
+#include "output/output_options.h"
 #include "lsystem/lsystem_options.h"
 #include "scene/forest.h"
 #include "scene/scene_reader.h"

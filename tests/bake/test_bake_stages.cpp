@@ -7,7 +7,7 @@
 
 #include "bake/bake_tree.h"
 #include "bake/prepare_tree.h"
-#include "io/checkpoint.h"
+#include "bake/checkpoint.h"
 #include "sim/simulator.h"
 #include "temp_folder_test.h"
 
