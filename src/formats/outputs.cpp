@@ -14,12 +14,13 @@
 #include <unordered_set>
 
 #include "common/errors.h"
-#include "formats/frame_sink.h"
-#include "output/output_estimate.h"
-#include "output/output_formats.h"
 #include "files/output_lock.h"
 #include "files/staged_files.h"
+#include "formats/frame_sink.h"
+#include "formats/sink_factories.h"
 #include "formats/vertex_normals.h"
+#include "output/output_estimate.h"
+#include "output/output_formats.h"
 
 namespace treeanim {
 
@@ -165,7 +166,9 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     : impl_(std::make_unique<Impl>(model)) {
   for (const OutputOptions& options : outputs) {
     auto worker = std::make_unique<Worker>();
-    worker->sink = options.format->make(options, resolve(options.path, out_dir), model, info);
+    SinkFactory* const make = find_sink_factory(options.format->name);
+    if (!make) throw std::logic_error(std::string("OutputSet: no sink writes format ") + options.format->name);
+    worker->sink = make(options, resolve(options.path, out_dir), model, info);
     worker->selection = {info.frame_start, info.frame_count, options.frame_step};
     const auto summary = worker->sink->summary_paths();
     worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();

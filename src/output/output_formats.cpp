@@ -1,17 +1,11 @@
-// The table of output formats (io/output_formats.h). A new format: its sink's file, which
-// defines make_<format>_sink, and a row here (and its entry in docs/outputs.md, which a test
-// compares with the table).
+// The table of output formats (output/output_formats.h). A new format: its sink's file
+// (formats/<format>_sink.cpp), a row here and its sink's line in formats/sink_factories.cpp (and
+// its entries in docs/outputs.md and docs/design.md, which tests compare with the table).
 #include "output/output_formats.h"
 
 #include <algorithm>
 
-#include "formats/frame_sink.h"
-
 namespace treeanim {
-
-// Each format's sink, defined in its own file (src/io/<format>_sink.cpp).
-SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
-    make_skinned_glb_sink, make_usd_sink, make_html_sink;
 
 namespace {
 
@@ -75,7 +69,6 @@ const std::vector<OutputFormatRow> kFormats = {
                .store = [](OutputOptions& o, double v) { o.quantize = v; }},
               kNormalsKey},
      .leaf_flags = true,
-     .make = make_hdf5_sink,
      // quantized: int16 displacements
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        const double vectors = vector_bytes(vertices);
@@ -83,21 +76,19 @@ const std::vector<OutputFormatRow> kFormats = {
      }},
     {.name = "obj",
      .keys = {kNormalsKey},
-     .make = make_obj_sink,
      // text: "v x y z" lines of ~32 characters, faces of ~24
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
        return 32.0 * double(vertices) + (o.normals ? 36.0 * double(vertices) : 0) + 24.0 * double(triangles);
      }},
     {.name = "gltf",
      .keys = {kSmoothNormalsKey},
-     .make = make_gltf_sink,
      // a file per frame: positions, triangles
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
        return vector_bytes(vertices) + normal_bytes(o, vertices) + 12.0 * double(triangles);
      }},
-    {.name = "glb", .keys = {kSmoothNormalsKey}, .make = make_glb_sink, .frame_bytes = vector_frame_bytes},
-    {.name = "pc2", .make = make_pc2_sink, .frame_bytes = vector_frame_bytes},
-    {.name = "mdd", .make = make_mdd_sink, .frame_bytes = vector_frame_bytes},
+    {.name = "glb", .keys = {kSmoothNormalsKey}, .frame_bytes = vector_frame_bytes},
+    {.name = "pc2", .frame_bytes = vector_frame_bytes},
+    {.name = "mdd", .frame_bytes = vector_frame_bytes},
     {.name = "vat",
      .keys = {{.name = "texture_width",
                .type = Type::kInteger,
@@ -109,14 +100,12 @@ const std::vector<OutputFormatRow> kFormats = {
                .choices = {"float", "half"},
                .store = [](OutputOptions& o, double v) { o.vat_half = v == 1; }}},
      .always_normals = true,  // the normals texture
-     .make = make_vat_sink,
      // offsets and normals, RGBA texels
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        return (o.vat_half ? 8.0 : 16.0) * 2.0 * double(vertices);
      }},
     {.name = "skinned_glb",
      .keys = {kMaxJointsKey},
-     .make = make_skinned_glb_sink,
      .frame_bytes = skinned_frame_bytes},
     {.name = "usd",
      .keys = {kNormalsKey,
@@ -124,7 +113,6 @@ const std::vector<OutputFormatRow> kFormats = {
                .type = Type::kBoolean,
                .store = [](OutputOptions& o, double v) { o.skinned = v != 0; }},
               kMaxJointsKey},
-     .make = make_usd_sink,
      // text: ~36 characters a point, ~38 a normal; skinned: ~96 a joint's translation and rotation
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t clusters) {
        return o.skinned ? 96.0 * joint_count(o, clusters) : (36.0 + (o.normals ? 38.0 : 0.0)) * double(vertices);
@@ -136,7 +124,6 @@ const std::vector<OutputFormatRow> kFormats = {
                .lo = 2,
                .hi = 64,
                .store = [](OutputOptions& o, double v) { o.max_page_bytes = size_t(v) << 20; }}},
-     .make = make_html_sink,
      // float32 positions in base64, reduced to fit the page's limit
      .frame_bytes = [](const OutputOptions&, size_t vertices, size_t, size_t) { return vector_bytes(vertices) * 4.0 / 3.0; },
      .limit_bytes = [](const OutputOptions& o) { return double(o.max_page_bytes); }},

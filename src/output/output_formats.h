@@ -1,27 +1,18 @@
 #pragma once
-// The output formats as one table (src/io/output_formats.cpp), a row per format: its name, the
-// scene keys it takes with their defaults, its sink and its size estimate. The scene reader,
-// OutputSet, the farm's size estimates and the list in docs/outputs.md all read the rows, so a
-// new format is its sink's file and a row.
+// The output formats as one table (src/output/output_formats.cpp), a row per format: its name,
+// the scene keys it takes with their defaults, what it writes besides positions and its size
+// estimate. No dependencies, so that scene/ reads the keys without linking a writer; each row's
+// sink is made in formats/ (formats/sink_factories.h). The scene reader, OutputSet, the farm's
+// size estimates and the lists in docs/outputs.md and docs/design.md all read the rows.
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
-#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "output/output_options.h"
-#include "formats/outputs.h"
-#include "tree/tree_model.h"
 
 namespace treeanim {
-
-class FrameSink;
-
-// options, path resolved against the out folder, model, bake => a format's sink
-using SinkFactory = std::unique_ptr<FrameSink>(const OutputOptions& options, const std::filesystem::path& path,
-                                               const TreeModel& model, const BakeInfo& info);
 
 // A scene key that some formats take besides format, path and frame_step; scene/ reads it
 // (messages and ranges as docs/scene.md "outputs" gives them) and stores its value.
@@ -41,7 +32,6 @@ struct OutputFormatRow {
   std::vector<OutputKey> keys = {};  // in the order read, the order they take in the resolved scene
   bool always_normals = false;  // writes vertex normals without a `normals` key
   bool leaf_flags = false;      // writes FrameData::leaf_attached
-  SinkFactory* make = nullptr;  // the format's sink
   // options, mesh size => bytes of one written frame's data, uncompressed (io/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
   // options => the most bytes the output takes whatever the frames (a page that reduces its frames to fit); none: null

@@ -1,6 +1,6 @@
 #pragma once
 // Scene /outputs elements (docs/scene.md), read by scene/ (src/scene/output_section.h); the keys
-// each format takes are its row of the format table (src/io/output_formats.h).
+// each format takes are its row of the format table (src/output/output_formats.h).
 #include <cstddef>
 #include <filesystem>
 #include <string>

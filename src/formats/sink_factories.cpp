@@ -1,0 +1,35 @@
+// The sinks of the format table's rows (formats/sink_factories.h): a line per format.
+#include "formats/sink_factories.h"
+
+#include <utility>
+
+namespace treeanim {
+
+// Each format's sink, defined in its own file (src/formats/<format>_sink.cpp).
+SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
+    make_skinned_glb_sink, make_usd_sink, make_html_sink;
+
+namespace {
+
+const std::pair<std::string_view, SinkFactory*> kSinkFactories[] = {
+    {"hdf5", make_hdf5_sink},
+    {"obj", make_obj_sink},
+    {"gltf", make_gltf_sink},
+    {"glb", make_glb_sink},
+    {"pc2", make_pc2_sink},
+    {"mdd", make_mdd_sink},
+    {"vat", make_vat_sink},
+    {"skinned_glb", make_skinned_glb_sink},
+    {"usd", make_usd_sink},
+    {"html", make_html_sink},
+};
+
+}  // namespace
+
+SinkFactory* find_sink_factory(std::string_view format) {
+  for (const auto& [name, make] : kSinkFactories)
+    if (name == format) return make;
+  return nullptr;
+}
+
+}  // namespace treeanim
