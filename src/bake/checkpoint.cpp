@@ -6,12 +6,11 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cinttypes>
-#include <cstdio>
 #include <system_error>
 
 #include "common/errors.h"
 #include "formats/hdf5_support.h"
+#include "files/io_failure.h"
 #include "files/staged_files.h"
 
 namespace treeanim {
@@ -161,22 +160,6 @@ void read_prediction(const CheckpointFile& file, hid_t group, const StepPredicti
 }
 
 }  // namespace
-
-std::string scene_hash(const std::string& scene_json, const std::string& generator) {
-  uint64_t hash = 0xcbf29ce484222325ull;
-  auto mix = [&](const std::string& text) {
-    for (unsigned char c : text) {
-      hash ^= c;
-      hash *= 0x100000001b3ull;
-    }
-  };
-  mix(scene_json);
-  mix("\n");
-  mix(generator);
-  char text[32];
-  std::snprintf(text, sizeof text, "fnv1a64:%016" PRIx64, hash);
-  return text;
-}
 
 double estimated_checkpoint_bytes(size_t vertices, size_t clusters, size_t leaves) {
   constexpr double kVertexBytes = 8 * 3 * 8;  // 8 arrays of (V x 3) doubles

@@ -14,14 +14,10 @@ namespace treeanim {
 
 // What ties a checkpoint to its bake.
 struct CheckpointKey {
-  std::string scene_hash;  // scene_hash() of the resolved scene and the generator
+  std::string scene_hash;  // scene_hash() of the resolved scene and the generator (bake/scene_hash.h)
   std::string generator;   // "treeanim <version>"
   bool float_precision = false;  // hsm.precision: the precision of the stored prediction
 };
-
-// Resolved scene JSON text + generator => "fnv1a64:<16 hex digits>", FNV-1a (64 bit) of the
-// scene text, a newline and the generator.
-std::string scene_hash(const std::string& scene_json, const std::string& generator);
 
 // dir, frame => dir/checkpoint-<frame>.h5
 std::filesystem::path checkpoint_path(const std::filesystem::path& dir, long long frame);

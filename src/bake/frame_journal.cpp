@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/errors.h"
-#include "files/staged_files.h"
+#include "files/io_failure.h"
 
 namespace treeanim {
 

@@ -14,7 +14,7 @@ namespace treeanim {
 
 // What the records of a journal hold; a journal is reused only by the bake it was made for.
 struct JournalLayout {
-  std::string scene_hash;       // scene_hash() of the bake (io/checkpoint.h)
+  std::string scene_hash;       // scene_hash() of the bake (bake/scene_hash.h)
   long long first_frame = 0;    // the first frame written (time.start, or --frames START)
   uint64_t vertices = 0;        // V: positions (and velocities) per record
   uint64_t leaves = 0;          // L: leaf flags per record

@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "common/errors.h"
-#include "files/staged_files.h"
+#include "files/io_failure.h"
 
 namespace treeanim {
 

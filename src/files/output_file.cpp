@@ -4,7 +4,7 @@
 #include <bit>
 
 #include "common/errors.h"
-#include "files/staged_files.h"
+#include "files/io_failure.h"
 
 namespace treeanim {
 

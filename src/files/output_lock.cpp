@@ -8,7 +8,7 @@
 #include <string>
 
 #include "common/errors.h"
-#include "files/staged_files.h"
+#include "files/io_failure.h"
 
 namespace treeanim {
 

@@ -2,20 +2,15 @@
 
 #include <unistd.h>
 
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <system_error>
 
 #include "common/errors.h"
+#include "files/io_failure.h"
 
 namespace treeanim {
 
 namespace fs = std::filesystem;
-
-std::string io_failure(const fs::path& path, const std::string& what) {
-  return path.string() + ": " + what + ": " + std::strerror(errno);
-}
 
 fs::path temporary_path(const fs::path& target) {
   // Appended piece by piece: g++ 12 warns (-Wrestrict, a false positive) on "." + string.

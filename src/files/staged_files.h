@@ -63,7 +63,4 @@ class StagedFiles {
   std::vector<std::filesystem::path> temporaries_;  // same order as targets_
 };
 
-// "<path>: <what>: <strerror(errno)>" for OutputError messages.
-std::string io_failure(const std::filesystem::path& path, const std::string& what);
-
 }  // namespace treeanim

@@ -6,6 +6,7 @@
 
 #include "common/errors.h"
 #include "files/output_file.h"
+#include "files/io_failure.h"
 #include "files/staged_files.h"
 
 namespace treeanim {

@@ -23,7 +23,7 @@
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
-#include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 #include "files/output_file.h"
 #include "files/staged_files.h"
 #include "formats/vertex_normals.h"

@@ -5,8 +5,9 @@
 #include "common/errors.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
-#include "formats/obj_format.h"
-#include "files/staged_files.h"
+#include "formats/rest_positions_f32.h"
+#include "formats/sequence_pattern.h"
+#include "files/io_failure.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {

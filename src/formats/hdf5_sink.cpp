@@ -13,7 +13,7 @@
 #include "common/errors.h"
 #include "formats/frame_sink.h"
 #include "formats/hdf5_support.h"
-#include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 #include "files/staged_files.h"
 
 namespace treeanim {

@@ -23,11 +23,6 @@ void append_index(std::string& out, uint32_t value) {
 
 }  // namespace
 
-std::vector<float> rest_positions_f32(const TreeModel& model) {
-  const double* rest = model.rest_positions.data();
-  return std::vector<float>(rest, rest + 3 * model.vertex_count());
-}
-
 std::string obj_shared_lines(const TreeModel& model, const std::string& mtl_name, bool with_normals) {
   std::string out;
   out.reserve(24 * model.vertex_count() + 40 * model.triangle_count());

@@ -20,8 +20,6 @@ std::string obj_shared_lines(const TreeModel& model, const std::string& mtl_name
 // Blender's importer reads it), the PBR extension's Pr and Pm, and Ns for readers without it.
 void write_mtl_file(const std::filesystem::path& temporary, const std::filesystem::path& target,
                     std::string_view comment, const std::array<SurfaceMaterial, kMaterialCount>& materials);
-// TreeModel rest positions (double) => (V*3) float, as the sinks write them.
-std::vector<float> rest_positions_f32(const TreeModel& model);
 // Writes one OBJ: a comment line, "v" lines of `positions` (V*3 floats, shortest round-trip
 // text), "vn" lines of `normals` (V*3, or empty for none), then `shared`. Throws OutputError
 // naming `target`.

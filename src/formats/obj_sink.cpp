@@ -5,6 +5,8 @@
 #include "common/errors.h"
 #include "formats/frame_sink.h"
 #include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
+#include "formats/sequence_pattern.h"
 #include "files/staged_files.h"
 #include "formats/vertex_normals.h"
 

@@ -8,6 +8,7 @@
 #include "common/errors.h"
 #include "formats/frame_sink.h"
 #include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 #include "files/output_file.h"
 #include "files/staged_files.h"
 

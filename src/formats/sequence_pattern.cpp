@@ -1,7 +1,8 @@
+#include "formats/sequence_pattern.h"
+
 #include <cstdio>
 
 #include "common/errors.h"
-#include "formats/frame_sink.h"
 
 namespace treeanim {
 

@@ -12,10 +12,11 @@
 
 #include "common/errors.h"
 #include "formats/frame_sink.h"
-#include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 #include "files/output_file.h"
 #include "formats/skin_fit.h"
 #include "formats/skin_track.h"
+#include "files/io_failure.h"
 #include "files/staged_files.h"
 #include "formats/usd_text.h"
 #include "tree/surface_materials.h"

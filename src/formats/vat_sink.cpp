@@ -20,9 +20,9 @@
 #include "common/errors.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
-#include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 #include "files/output_file.h"
-#include "files/staged_files.h"
+#include "files/io_failure.h"
 #include "formats/vat_layout.h"
 #include "formats/vertex_normals.h"
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "formats/obj_format.h"
+#include "formats/rest_positions_f32.h"
 
 namespace treeanim {
 

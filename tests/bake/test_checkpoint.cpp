@@ -10,6 +10,7 @@
 
 #include "common/errors.h"
 #include "bake/checkpoint.h"
+#include "bake/scene_hash.h"
 #include "bake/frame_journal.h"
 #include "sim/simulator.h"
 #include "../sim/grown_tree.h"

@@ -3,7 +3,7 @@
 #include <cstring>
 
 #include "common/errors.h"
-#include "formats/frame_sink.h"
+#include "formats/sequence_pattern.h"
 #include "formats/vertex_normals.h"
 #include "formats_test_support.h"
 
