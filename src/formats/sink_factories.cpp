@@ -3,13 +3,22 @@
 
 #include <utility>
 
+#include "formats/frame_sink.h"
+
 namespace treeanim {
 
 // Each format's sink, defined in its own file (src/formats/<format>_sink.cpp).
 SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
-    make_skinned_glb_sink, make_usd_sink, make_html_sink;
+    make_skinned_glb_sink, make_usd_sink, make_skinned_usd_sink, make_html_sink;
 
 namespace {
+
+// A usd output's writer: the points per frame, or with "skinned" the UsdSkel layer, a writer of
+// its own as the skinned GLB is beside the GLB.
+std::unique_ptr<FrameSink> make_usd_form_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                              const TreeModel& model, const BakeInfo& info) {
+  return (options.skinned ? make_skinned_usd_sink : make_usd_sink)(options, path, model, info);
+}
 
 const std::pair<std::string_view, SinkFactory*> kSinkFactories[] = {
     {"hdf5", make_hdf5_sink},
@@ -20,7 +29,7 @@ const std::pair<std::string_view, SinkFactory*> kSinkFactories[] = {
     {"mdd", make_mdd_sink},
     {"vat", make_vat_sink},
     {"skinned_glb", make_skinned_glb_sink},
-    {"usd", make_usd_sink},
+    {"usd", make_usd_form_sink},
     {"html", make_html_sink},
 };
 
