@@ -1,7 +1,7 @@
 #pragma once
-// FrameSink (DESIGN.md): one output format. OutputSet calls begin() once, write() for every
-// selected frame in order (on the sink's own writer thread), then finish() and, once every
-// sink finished, commit(); or abort() at any point.
+// FrameSink (docs/design.md): one output format, made by its factory (formats/sink_factories.h).
+// OutputSet calls begin() once, write() for every selected frame in order (on the sink's own
+// writer thread), then finish() and, once every sink finished, commit(); or abort() at any point.
 // Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
 #include <filesystem>
 #include <functional>

@@ -5,7 +5,7 @@
 // nlohmann_json, streamed: the JSON chunk's room is reserved up front (its numbers at their
 // longest) and filled in by finish(), the frames go straight to the BIN chunk.
 //
-// The mesh is io/gltf_mesh.h's: one vertex set, a primitive per material, each primitive with
+// The mesh is formats/gltf_mesh.h's: one vertex set, a primitive per material, each primitive with
 // the same targets.
 //
 // BIN layout (every part a multiple of 4 bytes): indices u32 [T*3] grouped by material, rest

@@ -1,5 +1,5 @@
 // glTF sequence: one self-contained .glb per written frame ("<name>.%04d.glb"), the tree's mesh
-// (io/gltf_mesh.h: positions, UVs, normals unless turned off, materials) at that frame.
+// (formats/gltf_mesh.h: positions, UVs, normals unless turned off, materials) at that frame.
 #include <cstring>
 
 #include "common/errors.h"

@@ -1,6 +1,6 @@
 // The preview page (docs/outputs.md "Preview page"): one self-contained HTML file holding the
 // bake as JSON with base64 arrays and the three.js viewer bundled at build time
-// (src/io/preview/viewer.js, embedded as kPreviewViewerJs), so it opens from disk with no
+// (src/formats/preview/viewer.js, embedded as kPreviewViewerJs), so it opens from disk with no
 // network. A bake too large for kMaxPageBytes keeps fewer frames and quantized positions.
 #include <algorithm>
 #include <array>

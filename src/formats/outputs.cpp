@@ -105,7 +105,7 @@ struct OutputSet::Impl {
   std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
   bool leaf_flags = false;  // some output writes the leaves' attached flags
   bool done = false;  // finished or aborted
-  OutputLocks locks;  // one per output, held from the checks to the end (io/output_lock.h)
+  OutputLocks locks;  // one per output, held from the checks to the end (files/output_lock.h)
   MadeFolders folders;  // made for the outputs: removed, when empty, if the bake fails
 
   // A failed bake's locks dropped and the folders it made removed (a lock file would keep one).

@@ -1,7 +1,8 @@
 #pragma once
-// Stage entry point of io/: every output of a bake, written on a writer thread behind a
-// bounded queue so writing never stalls the solver. Each sink writes to a temporary name
-// beside its target and renames it when complete; abort() removes every temporary.
+// OutputSet, what the bake writes through: every output of a bake, each sink on its own
+// writer thread behind a bounded queue, so writing never stalls the solver. Each sink writes to
+// a temporary name beside its target and renames it when complete; abort() removes every
+// temporary.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -52,7 +53,7 @@ class OutputSet {
  public:
   // Resolves relative paths against out_dir (when not empty), checks every target (folder
   // exists or can be made, writable, format limits such as 4 GiB GLB) and locks each output
-  // against other bakes (io/output_lock.h) before simulation; finish() and abort() unlock. The
+  // against other bakes (files/output_lock.h) before simulation; finish() and abort() unlock. The
   // options are as the scene reader checked them. Throws InputError for a target no output may
   // write (a directory, one written twice, a GLB past 4 GiB), OutputError naming the path for
   // unwritable targets
@@ -64,7 +65,7 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
 
   bool wants_velocities() const;
-  // Opens temporaries, writes headers and the rest mesh; starts the writer thread.
+  // Opens temporaries, writes headers and the rest mesh; starts each sink's writer thread.
   void begin();
   // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.
   void push(FrameData frame);

@@ -1,6 +1,6 @@
 #pragma once
 // The preview page's frame (docs/outputs.md "Preview page"): the HTML around the embedded bake
-// and the bundled viewer. A tree's page (io/html_sink.cpp) and the forest's (io/html_forest.cpp)
+// and the bundled viewer. A tree's page (formats/html_sink.cpp) and the forest's (formats/html_forest.cpp)
 // are written by it, and the forest's reads the trees' pages back through it.
 #include <nlohmann/json.hpp>
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 // The keys of a skinned output (docs/outputs.md "Skinned glTF"): per written frame, each joint's
-// transform relative to its parent joint, fitted to the bake (io/skin_fit.h), and the error of
+// transform relative to its parent joint, fitted to the bake (formats/skin_fit.h), and the error of
 // the skinned mesh against the bake. The skinned GLB and the UsdSkel layer write the same keys.
 #include <Eigen/Geometry>
 #include <string>

@@ -1,6 +1,6 @@
 // Skinned glTF ("skinned_glb", docs/outputs.md "Skinned glTF"): the rest mesh bound to one joint
 // per cluster (or per limb, option max_joints), and per joint a translation and a rotation key
-// per written frame, fitted so that the skinned mesh follows the bake (io/skin_track.h). The RMS
+// per written frame, fitted so that the skinned mesh follows the bake (formats/skin_track.h). The RMS
 // and largest error of the skinned mesh against the bake, relative to the bake's RMS
 // displacement, go into the asset's extras ("skinning") and the run's summary. Written with tinygltf at the
 // end: the keys of every frame are kept until then (28 bytes per joint and frame).

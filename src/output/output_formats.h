@@ -32,7 +32,7 @@ struct OutputFormatRow {
   std::vector<OutputKey> keys = {};  // in the order read, the order they take in the resolved scene
   bool always_normals = false;  // writes vertex normals without a `normals` key
   bool leaf_flags = false;      // writes FrameData::leaf_attached
-  // options, mesh size => bytes of one written frame's data, uncompressed (io/output_estimate.h)
+  // options, mesh size => bytes of one written frame's data, uncompressed (output/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
   // options => the most bytes the output takes whatever the frames (a page that reduces its frames to fit); none: null
   double (*limit_bytes)(const OutputOptions& options) = nullptr;

@@ -1,5 +1,5 @@
 #pragma once
-// Hand-made TreeModel and frames for the io/ tests, so they need neither the grower nor the
+// Hand-made TreeModel and frames for the formats/ tests, so they need neither the grower nor the
 // solver: a branch quad (vertices 0-3, two triangles) and one leaf triangle hanging from
 // vertex 3 (vertices 3-5), one segment, two clusters.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // The HDF5 bake read back through the HDF5 C API: every dataset, shape, type and attribute of
-// DESIGN.md's layout, and the frames exactly as pushed.
+// docs/design.md's layout, and the frames exactly as pushed.
 #include <hdf5.h>
 
 #include <cmath>

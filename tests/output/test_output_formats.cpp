@@ -1,4 +1,5 @@
-// The table of output formats: well-formed rows, and docs/outputs.md lists exactly its formats.
+// The table of output formats: well-formed rows, and docs/outputs.md and docs/design.md list
+// exactly its formats.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -13,27 +14,27 @@
 namespace treeanim {
 namespace {
 
-// The format names of docs/outputs.md's list between "<!-- formats: begin -->" and
+// The format names of a doc's list between "<!-- formats: begin -->" and
 // "<!-- formats: end -->": the first `quoted` word of each "- " line.
-std::vector<std::string> documented_formats() {
-  std::ifstream in(std::filesystem::path(TREEANIM_SOURCE_DIR) / "docs" / "outputs.md");
-  EXPECT_TRUE(in);
+std::vector<std::string> documented_formats(const std::string& doc) {
+  std::ifstream in(std::filesystem::path(TREEANIM_SOURCE_DIR) / "docs" / doc);
+  EXPECT_TRUE(in) << doc;
   std::vector<std::string> names;
   bool inside = false;
   for (std::string line; std::getline(in, line);) {
     if (line == "<!-- formats: begin -->") inside = true;
     else if (line == "<!-- formats: end -->") inside = false;
     else if (inside && line.rfind("- `", 0) == 0) names.push_back(line.substr(3, line.find('`', 3) - 3));
-    else if (inside && !line.empty()) ADD_FAILURE() << "not a format line: " << line;
+    else if (inside && !line.empty()) ADD_FAILURE() << doc << ": not a format line: " << line;
   }
-  EXPECT_FALSE(inside) << "no \"<!-- formats: end -->\"";
+  EXPECT_FALSE(inside) << doc << ": no \"<!-- formats: end -->\"";
   return names;
 }
 
 TEST(OutputFormats, DocsListEveryFormatOfTheTableAndNothingElse) {
   std::vector<std::string> table;
   for (const OutputFormatRow& row : output_formats()) table.emplace_back(row.name);
-  EXPECT_EQ(documented_formats(), table);
+  for (const char* doc : {"outputs.md", "design.md"}) EXPECT_EQ(documented_formats(doc), table) << doc;
 }
 
 TEST(OutputFormats, RowsAreComplete) {

@@ -1,5 +1,5 @@
 // The html output's viewer (docs/outputs.md "Preview page"): reads the bake embedded in the
-// page (<script id="treeanim-bake" type="application/json">, written by src/io/html_sink.cpp)
+// page (<script id="treeanim-bake" type="application/json">, written by src/formats/html_sink.cpp)
 // and plays it with three.js. Bundled by esbuild at build time; the page needs no network.
 // page.html#t=SECONDS shows that time, stops, and sets document.title to "ready" once drawn;
 // &tree=K shows the K-th tree alone (from 0; none past the last), framed as the whole page.
