@@ -6,11 +6,11 @@
 #include <chrono>
 #include <csignal>
 
+#include "bake/checkpoint.h"
 #include "bake/prepare_tree.h"
 #include "bake/signals.h"
 #include "common/errors.h"
 #include "common/seconds_since.h"
-#include "bake/checkpoint.h"
 #include "files/free_space.h"
 #include "sim/simulator.h"
 

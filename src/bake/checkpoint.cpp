@@ -9,9 +9,9 @@
 #include <system_error>
 
 #include "common/errors.h"
-#include "formats/hdf5_support.h"
 #include "files/io_failure.h"
 #include "files/staged_files.h"
+#include "formats/hdf5_support.h"
 
 namespace treeanim {
 

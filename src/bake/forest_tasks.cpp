@@ -4,9 +4,9 @@
 #include <numeric>
 #include <queue>
 
-#include "bake/prepare_tree.h"
 #include "bake/checkpoint.h"
 #include "bake/frame_journal.h"
+#include "bake/prepare_tree.h"
 #include "output/output_estimate.h"
 
 namespace treeanim {

@@ -5,8 +5,8 @@
 #include <system_error>
 
 #include "common/errors.h"
-#include "files/output_file.h"
 #include "files/io_failure.h"
+#include "files/output_file.h"
 #include "files/staged_files.h"
 
 namespace treeanim {

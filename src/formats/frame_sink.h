@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "output/output_options.h"
-#include "formats/outputs.h"
 #include "files/staged_files.h"
+#include "formats/outputs.h"
+#include "output/output_options.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {

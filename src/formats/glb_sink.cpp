@@ -20,12 +20,12 @@
 #include <optional>
 
 #include "common/errors.h"
+#include "files/output_file.h"
+#include "files/staged_files.h"
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
-#include "files/output_file.h"
-#include "files/staged_files.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {

@@ -3,11 +3,11 @@
 #include <cstring>
 
 #include "common/errors.h"
+#include "files/io_failure.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/sequence_pattern.h"
-#include "files/io_failure.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "common/errors.h"
+#include "files/staged_files.h"
 #include "formats/frame_sink.h"
 #include "formats/hdf5_support.h"
 #include "formats/rest_positions_f32.h"
-#include "files/staged_files.h"
 
 namespace treeanim {
 

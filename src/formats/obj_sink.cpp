@@ -3,11 +3,11 @@
 // (Houdini's $F4, Blender's Mesh Sequence Cache) sees one topology; "<name>.rest.mtl" holds the
 // materials every file names.
 #include "common/errors.h"
+#include "files/staged_files.h"
 #include "formats/frame_sink.h"
 #include "formats/obj_format.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/sequence_pattern.h"
-#include "files/staged_files.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {

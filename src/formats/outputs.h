@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "output/output_options.h"
-#include "tree/surface_materials.h"
 #include "sim/sim_options.h"
-#include "tree/tree_placement.h"
+#include "tree/surface_materials.h"
 #include "tree/tree_model.h"
+#include "tree/tree_placement.h"
 
 namespace treeanim {
 

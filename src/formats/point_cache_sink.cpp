@@ -6,11 +6,11 @@
 #include <optional>
 
 #include "common/errors.h"
+#include "files/output_file.h"
+#include "files/staged_files.h"
 #include "formats/frame_sink.h"
 #include "formats/obj_format.h"
 #include "formats/rest_positions_f32.h"
-#include "files/output_file.h"
-#include "files/staged_files.h"
 
 namespace treeanim {
 

@@ -10,13 +10,13 @@
 #include <limits>
 
 #include "common/errors.h"
+#include "files/io_failure.h"
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/skin_fit.h"
 #include "formats/skin_track.h"
-#include "files/io_failure.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {

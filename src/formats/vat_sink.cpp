@@ -18,11 +18,11 @@
 #include <optional>
 
 #include "common/errors.h"
+#include "files/io_failure.h"
+#include "files/output_file.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
-#include "files/output_file.h"
-#include "files/io_failure.h"
 #include "formats/vat_layout.h"
 #include "formats/vertex_normals.h"
 

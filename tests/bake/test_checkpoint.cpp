@@ -8,10 +8,10 @@
 #include <cstring>
 #include <fstream>
 
-#include "common/errors.h"
 #include "bake/checkpoint.h"
-#include "bake/scene_hash.h"
 #include "bake/frame_journal.h"
+#include "bake/scene_hash.h"
+#include "common/errors.h"
 #include "sim/simulator.h"
 #include "../sim/grown_tree.h"
 

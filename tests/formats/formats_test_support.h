@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "output/output_formats.h"
 #include "formats/outputs.h"
+#include "output/output_formats.h"
 #include "tree/tree_model.h"
 
 namespace treeanim::test {
