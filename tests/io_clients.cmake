@@ -1,4 +1,4 @@
-# Real-client checks of io/'s outputs (docs/outputs.md, "Checks"): one end-to-end bake of
+# Real-client checks of the outputs (docs/outputs.md, "Checks"): one end-to-end bake of
 # tests/golden/small_tree.json with the CLI, then each format opened by the tool its users use.
 # Included by CMakeLists.txt inside TREEANIM_TESTS; labels "io;clients". The tools come from
 # scripts/setup: python3-h5py, hdf5-tools, blender (apt) and tests/clients/node (npm ci).

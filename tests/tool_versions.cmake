@@ -4,7 +4,7 @@
 file(STRINGS ${CMAKE_SOURCE_DIR}/scripts/minimum-versions oldest_node REGEX "^node ")
 string(REPLACE "node " "" oldest_node "${oldest_node}")
 find_program(TREEANIM_ENGINES_NODE node)
-set(npm_lock_files ${CMAKE_SOURCE_DIR}/src/io/preview/package-lock.json
+set(npm_lock_files ${CMAKE_SOURCE_DIR}/src/formats/preview/package-lock.json
     ${CMAKE_SOURCE_DIR}/tests/clients/node/package-lock.json ${CMAKE_SOURCE_DIR}/tests/clients/usd/package-lock.json)
 if(TREEANIM_ENGINES_NODE AND EXISTS ${CMAKE_SOURCE_DIR}/tests/clients/node/node_modules/semver)
   add_test(NAME npm.engines COMMAND ${TREEANIM_ENGINES_NODE} ${CMAKE_SOURCE_DIR}/tests/clients/node/check_engines.js

@@ -1,6 +1,6 @@
 #include "bake/bake_config.h"
 
-#include "io/checkpoint.h"
+#include "bake/scene_hash.h"
 #include "treeanim_version.h"
 
 namespace treeanim {

@@ -4,8 +4,8 @@
 #include <filesystem>
 
 #include "bake/bake_config.h"
-#include "io/checkpoint.h"
-#include "io/outputs.h"
+#include "bake/checkpoint.h"
+#include "formats/outputs.h"
 #include "scene/scene.h"
 
 namespace treeanim {

@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "bake/bake_plan.h"
-#include "io/frame_journal.h"
+#include "bake/frame_journal.h"
 #include "sim/simulator.h"
 
 namespace treeanim {

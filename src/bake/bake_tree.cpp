@@ -6,12 +6,12 @@
 #include <chrono>
 #include <csignal>
 
+#include "bake/checkpoint.h"
 #include "bake/prepare_tree.h"
 #include "bake/signals.h"
 #include "common/errors.h"
 #include "common/seconds_since.h"
-#include "io/checkpoint.h"
-#include "io/free_space.h"
+#include "files/free_space.h"
 #include "sim/simulator.h"
 
 namespace treeanim {

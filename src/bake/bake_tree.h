@@ -14,7 +14,7 @@
 #include "bake/bake_plan.h"
 #include "bake/bake_start.h"
 #include "bake/loop_bake.h"
-#include "io/outputs.h"
+#include "formats/outputs.h"
 #include "scene/scene.h"
 #include "tree/tree_placement.h"
 
@@ -65,7 +65,7 @@ JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool 
 
 // Room: the bytes that the outputs and, with checkpoints, the checkpoints and journal records
 // still to write from `start` will take, against the free space of each filesystem they go to
-// (io/free_space.h). Throws OutputError when some filesystem lacks room.
+// (files/free_space.h). Throws OutputError when some filesystem lacks room.
 void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
                 const BakeFrames& frames);
 

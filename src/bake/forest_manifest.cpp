@@ -4,10 +4,10 @@
 
 #include "common/json_text.h"
 #include "common/read_text_file.h"
-#include "io/html_forest.h"
-#include "io/output_formats.h"
-#include "io/text_output.h"
-#include "io/usd_forest.h"
+#include "files/text_output.h"
+#include "formats/html_forest.h"
+#include "formats/usd_forest.h"
+#include "output/output_formats.h"
 
 namespace treeanim {
 

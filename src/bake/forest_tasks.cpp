@@ -4,10 +4,10 @@
 #include <numeric>
 #include <queue>
 
+#include "bake/checkpoint.h"
+#include "bake/frame_journal.h"
 #include "bake/prepare_tree.h"
-#include "io/checkpoint.h"
-#include "io/frame_journal.h"
-#include "io/output_estimate.h"
+#include "formats/output_estimate.h"
 
 namespace treeanim {
 

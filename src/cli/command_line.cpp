@@ -1,5 +1,5 @@
 // The treeanim command line (CLI11): the subcommands' arguments, the dispatch to
-// cli/commands.h, and the error types of common/errors.h mapped to the exit codes of DESIGN.md.
+// cli/commands.h, and the error types of common/errors.h mapped to the exit codes of docs/design.md.
 #include "cli/command_line.h"
 
 #include <CLI/CLI.hpp>

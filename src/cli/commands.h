@@ -1,6 +1,7 @@
 #pragma once
 // The subcommands of the treeanim CLI. Each returns the process exit code; input, simulation
-// and output errors propagate as exceptions that main() maps to exit codes (DESIGN.md).
+// and output errors propagate as exceptions that run_command_line (cli/command_line.h) maps to
+// exit codes (docs/design.md).
 #include <filesystem>
 #include <optional>
 #include <string>

@@ -5,8 +5,8 @@
 #include "bake/forest_tasks.h"
 #include "cli/commands.h"
 #include "common/errors.h"
-#include "io/free_space.h"
-#include "io/text_output.h"
+#include "files/free_space.h"
+#include "files/text_output.h"
 
 namespace treeanim {
 

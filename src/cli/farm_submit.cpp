@@ -11,9 +11,9 @@
 #include "cli/run_program.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
-#include "io/free_space.h"
-#include "io/staged_files.h"
-#include "io/text_output.h"
+#include "files/free_space.h"
+#include "files/staged_files.h"
+#include "files/text_output.h"
 
 namespace treeanim {
 

@@ -4,8 +4,8 @@
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
-#include "io/output_estimate.h"
-#include "io/output_formats.h"
+#include "formats/output_estimate.h"
+#include "output/output_formats.h"
 
 namespace treeanim {
 
@@ -82,7 +82,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
               scene.time.frames, scene.time.substeps,
               summary["estimate"]["bytes_per_frame"].get<double>() / 1024.0,
               summary["estimate"]["bytes_positions_total"].get<double>() / (1024.0 * 1024.0));
-  for (const Json& output : outputs)  // io/output_estimate.h: the frames' data, uncompressed
+  for (const Json& output : outputs)  // formats/output_estimate.h: the frames' data, uncompressed
     std::printf("output %s (%s): about %.1f MiB of frames\n", output["path"].get<std::string>().c_str(),
                 output["format"].get<std::string>().c_str(), output["bytes"].get<double>() / (1024.0 * 1024.0));
   return 0;

@@ -1,6 +1,6 @@
 #pragma once
-// Error types shared by every stage. main() maps them to the exit codes of DESIGN.md:
-// InputError => 2, SimulationError => 3, OutputError => 4.
+// Error types shared by every stage. The command line (cli/command_line.cpp) maps them to the
+// exit codes of docs/design.md: InputError => 2, SimulationError => 3, OutputError => 4.
 #include <stdexcept>
 #include <string>
 

@@ -17,12 +17,6 @@ namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-uint64_t mix64(uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 struct Function {
   const char* name;
   Op op;
@@ -753,23 +747,6 @@ const DataFile& data_file(const ExprProgram& program, uint32_t instruction, doub
 }
 
 }  // namespace
-
-RandomStream RandomStream::keyed(uint64_t seed, uint64_t purpose, uint64_t step, uint64_t position) {
-  return {mix64(mix64(mix64(mix64(seed) ^ purpose) ^ step) ^ position)};
-}
-
-uint64_t RandomStream::next_u64() {
-  state += 0x9e3779b97f4a7c15ULL;
-  return mix64(state);
-}
-
-double RandomStream::uniform() { return static_cast<double>(next_u64() >> 11) * 0x1.0p-53; }
-
-double RandomStream::normal() {
-  const double u1 = 1.0 - uniform();  // (0, 1]: log is finite
-  const double u2 = uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
-}
 
 bool ExprProgram::is_constant(const Expr& expr, double* value) const {
   if (expr.end != expr.begin + 1 || code[expr.begin].op != Op::kConst) return false;

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/random.h"
 #include "lsystem/data_file.h"
 #include "lsystem/view_curve.h"
 
@@ -46,16 +47,6 @@ struct TextOrigin {
 struct GrammarError {
   SourcePos pos;
   std::string message;
-};
-
-// Counter-based random numbers (splitmix64): the draws of one module in one derivation step
-// depend only on (seed, purpose, step, position), never on thread count or evaluation order.
-struct RandomStream {
-  uint64_t state = 0;
-  static RandomStream keyed(uint64_t seed, uint64_t purpose, uint64_t step, uint64_t position);
-  uint64_t next_u64();
-  double uniform();  // [0, 1)
-  double normal();   // mean 0, standard deviation 1 (Box-Muller)
 };
 
 enum class Op : uint8_t {

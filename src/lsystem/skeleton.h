@@ -1,5 +1,5 @@
 #pragma once
-// Skeleton: what the turtle draws, as flat arrays (DESIGN.md). Produced by lsystem/,
+// Skeleton: what the turtle draws, as flat arrays (docs/design.md). Produced by lsystem/,
 // consumed by tree/. Scene units (the turtle's), Y up. Segments are stored parents first
 // (segment_parent[s] < s), one segment per drawn F/G module, never merged.
 #include <Eigen/Core>

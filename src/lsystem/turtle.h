@@ -1,5 +1,5 @@
 #pragma once
-// The 3D turtle (lpfg conventions, DESIGN.md): module string => Skeleton.
+// The 3D turtle (lpfg conventions, docs/design.md): module string => Skeleton.
 #include <Eigen/Core>
 #include <optional>
 #include <vector>

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "common/random.h"
+
 namespace treeanim {
 
 namespace {
@@ -46,15 +48,6 @@ class GroundGrid {
 
 }  // namespace
 
-uint64_t splitmix64(uint64_t& state) {
-  uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
-double uniform01(uint64_t& state) { return static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53; }
-
 std::optional<std::pair<size_t, size_t>> closer_than(const std::vector<Eigen::Vector2d>& points, double spacing) {
   GroundGrid grid(spacing);
   for (size_t i = 0; i < points.size(); ++i) {
@@ -69,14 +62,14 @@ std::vector<Eigen::Vector2d> scatter_points(uint64_t seed, size_t count, const S
                                             long long attempts, const std::vector<Eigen::Vector2d>& fixed) {
   GroundGrid grid(spacing);
   for (const Eigen::Vector2d& p : fixed) grid.add(p);
-  uint64_t state = seed ^ 0x7363617474657200ull;  // "scatter": this purpose's stream
+  RandomStream random{seed ^ 0x7363617474657200ull};  // "scatter": this purpose's stream
   const Eigen::Vector2d extent = area.max - area.min;
   std::vector<Eigen::Vector2d> placed;
   placed.reserve(count);
   while (placed.size() < count) {
     bool fitted = false;
     for (long long dart = 0; dart < attempts && !fitted; ++dart) {
-      const double u = uniform01(state), v = uniform01(state);
+      const double u = random.uniform(), v = random.uniform();
       const Eigen::Vector2d p(area.min.x() + u * extent.x(), area.min.y() + v * extent.y());
       if (grid.near(p, nullptr)) continue;
       grid.add(p);

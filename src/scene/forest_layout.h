@@ -9,12 +9,6 @@
 
 namespace treeanim {
 
-// splitmix64 step: a counter-based generator whose streams are keyed by plain integers, so a
-// tree's draws depend on (seed, index) only, never on the trees drawn before it.
-uint64_t splitmix64(uint64_t& state);
-// state => a double uniform in [0, 1) (53 random bits).
-double uniform01(uint64_t& state);
-
 // The first pair (in index order of the later point) closer than `spacing`, or none.
 std::optional<std::pair<size_t, size_t>> closer_than(const std::vector<Eigen::Vector2d>& points, double spacing);
 

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "common/errors.h"
+#include "common/random.h"
 #include "scene/forest.h"
 #include "scene/forest_layout.h"
 #include "scene/lsystem_section.h"
@@ -113,9 +114,9 @@ ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, con
   tree.position = element.vector3("position", Eigen::Vector3d::Zero(), kGround);
   tree.rotation = element.number("rotation", 0, kTurn);
   tree.scale = element.number("scale", 1, kTreeScale);
-  uint64_t state = scene_seed ^ 0x7472656573656564ull ^ (uint64_t(index) << 20);  // "treeseed", by index
+  RandomStream random{scene_seed ^ 0x7472656573656564ull ^ (uint64_t(index) << 20)};  // "treeseed", by index
   tree.seed = static_cast<uint64_t>(
-      element.integer("seed", static_cast<long long>(splitmix64(state) & kSeedMask), 0, 1LL << 53));
+      element.integer("seed", static_cast<long long>(random.next_u64() & kSeedMask), 0, 1LL << 53));
   return tree;
 }
 
@@ -153,17 +154,17 @@ void scatter_trees(SceneObject scatter, long long count, Forest& forest, uint64_
     ForestTree tree;
     tree.pointer = scatter.pointer();
     tree.id = padded_id(first + k, total);
-    uint64_t state = (seed * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k) + 0x5ca77e4ull);  // the tree's stream
-    double pick = uniform01(state) * total_weight;
+    RandomStream random{(seed * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k) + 0x5ca77e4ull)};  // the tree's stream
+    double pick = random.uniform() * total_weight;
     tree.variant = 0;
     while (tree.variant + 1 < forest.variants.size() &&
            (pick >= forest.variants[tree.variant].weight || forest.variants[tree.variant].weight == 0)) {
       pick -= forest.variants[tree.variant].weight;
       ++tree.variant;
     }
-    tree.rotation = rotation[0] + uniform01(state) * (rotation[1] - rotation[0]);
-    tree.scale = scale[0] + uniform01(state) * (scale[1] - scale[0]);
-    tree.seed = splitmix64(state) & kSeedMask;
+    tree.rotation = rotation[0] + random.uniform() * (rotation[1] - rotation[0]);
+    tree.scale = scale[0] + random.uniform() * (scale[1] - scale[0]);
+    tree.seed = random.next_u64() & kSeedMask;
     tree.position = Eigen::Vector3d(points[k].x(), 0, points[k].y());
     forest.trees.push_back(std::move(tree));
   }

@@ -4,7 +4,7 @@
 #include <optional>
 #include <vector>
 
-#include "io/output_formats.h"
+#include "output/output_formats.h"
 
 namespace treeanim {
 

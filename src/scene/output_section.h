@@ -1,7 +1,7 @@
 #pragma once
-// Scene /outputs elements (docs/scene.md) => the io stage's options; the keys a format takes
-// are its row of the format table (io/output_formats.h).
-#include "io/output_options.h"
+// Scene /outputs elements (docs/scene.md) => the output options; the keys a format takes are
+// its row of the format table (output/output_formats.h).
+#include "output/output_options.h"
 #include "scene/scene_reader.h"
 
 namespace treeanim {

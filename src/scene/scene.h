@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "io/output_options.h"
 #include "lsystem/lsystem_options.h"
+#include "output/output_options.h"
 #include "scene/forest.h"
 #include "scene/scene_reader.h"
 #include "sim/sim_options.h"

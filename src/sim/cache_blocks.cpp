@@ -35,12 +35,12 @@ struct StepFailures {
 
 template <typename Real>
 bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                    StepScratch<Real>& scratch, bool predict, bool last, long long frame, int substep) {
+                    StepScratch<Real>& scratch, BlockStep step, long long frame, int substep) {
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
   // This step's prediction follows a step that was not a frame's last (which would have
   // predicted it); this step's own passes may be the last.
-  const VertexPassMode previous = {false, false, any_asleep}, mode = {false, last, any_asleep};
+  const VertexPassMode previous = {.any_asleep = any_asleep}, mode = {.last = step.last, .any_asleep = any_asleep};
   const size_t blocks = model.block_cluster_offsets.size() - 1;
   const std::vector<uint32_t>& segment_offsets = model.block_segment_offsets;
   const std::vector<VertexSegment>& segments = model.block_segments;
@@ -60,7 +60,7 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
       mine.runaway = std::min(mine.runaway, runaway);
     };
     // 1. The border's vertices, before any block matches them.
-    if (predict) {
+    if (step.predict) {
 #pragma omp for schedule(static)
       for (uint32_t i = segment_offsets[blocks]; i < segment_offsets[blocks + 1]; ++i) predict_segment(i);
     }
@@ -69,7 +69,7 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
     // loads of its clusters without a border vertex summed.
     const auto [first, stop] = balanced_range(model.block_membership_offsets, omp_get_thread_num(), omp_get_num_threads());
     for (size_t b = first; b < stop; ++b) {
-      if (predict)
+      if (step.predict)
         for (uint32_t i = segment_offsets[b]; i < segment_offsets[b + 1]; ++i) predict_segment(i);
       const uint32_t clusters_begin = model.block_cluster_offsets[b], clusters_end = model.block_cluster_offsets[b + 1];
       mine.cluster = std::min(mine.cluster, match_listed_clusters(model, attachment, state, scratch,
@@ -98,9 +98,9 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
     if (!failures.any()) {
       const auto [vertex_first, vertex_stop] =
           balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-      if (last) write_state(model, attachment, state, any_asleep, vertex_first, vertex_stop);
+      if (step.last) write_state(model, attachment, state, any_asleep, vertex_first, vertex_stop);
       if (model.beam) walk_bar_chain(model, attachment, scratch);
-      if (last) {
+      if (step.last) {
         const uint32_t bad = predict_vertices(model, attachment, state, scratch, mode, vertex_first, vertex_stop);
         if (bad != kNone) {
 #pragma omp critical(treeanim_block_failure)
@@ -119,8 +119,8 @@ bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& atta
 }
 
 template bool step_in_blocks(const SolverModel<float>&, const Attachment<float>&, SimState&, StepScratch<float>&,
-                             bool, bool, long long, int);
+                             BlockStep, long long, int);
 template bool step_in_blocks(const SolverModel<double>&, const Attachment<double>&, SimState&, StepScratch<double>&,
-                             bool, bool, long long, int);
+                             BlockStep, long long, int);
 
 }  // namespace treeanim

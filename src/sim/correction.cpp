@@ -48,30 +48,40 @@ void average_shared_pulls(const SolverModel<Real>& model, const Attachment<Real>
   }
 }
 
+// How a vertex pass reads and checks its blocks.
+struct BlockPass {
+  bool load_state = false;     // u = x - x0 and v loaded from the state first (kFromState)
+  bool with_pull = false;      // each vertex takes its mean correction
+  bool first_pass = false;     // the step's first pass: it averages the shared vertices' corrections
+  bool any_asleep = false;     // islands asleep: their vertices stand still
+  bool check_runaway = false;  // the attached vertices checked against the runaway limit
+};
+
 // Vertices [begin, begin + n) => block.moving (0: anchored, without an active cluster, or
 // asleep), their factors and, `with_pull`, block.pull, each vertex's mean correction;
-// kFromState first loads u = x - x0 and v from the state (anchors included: they hold where
+// `load_state` first loads u = x - x0 and v from the state (anchors included: they hold where
 // they are).
 template <typename Real>
 void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                  const StepScratch<Real>& scratch, bool load_state, bool with_pull, bool any_asleep, size_t begin,
-                  int n, VertexBlock<Real>& block) {
+                  const StepScratch<Real>& scratch, const BlockPass& pass, size_t begin, int n,
+                  VertexBlock<Real>& block) {
   const TreeModel& tree = model.tree;
   StepPrediction<Real>& prediction = state.prediction<Real>();
   for (int k = 0; k < n; ++k) {
     const size_t v = begin + k;
     const bool still = tree.vertex_anchored[v] || attachment.vertex_inv_count[v] == 0 ||
-                       (any_asleep && !attachment.vertex_flying[v] && state.island_asleep[model.vertex_island[v]]);
+                       (pass.any_asleep && !attachment.vertex_flying[v] &&
+                        state.island_asleep[model.vertex_island[v]]);
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
     block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
     block.flying[k] = still ? Real(0) : Real(attachment.vertex_flying[v]);
     Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
-    if (load_state) {
+    if (pass.load_state) {
       prediction.offset.row(v) = (state.positions.col(v) - tree.rest_positions.col(v)).transpose().template cast<Real>();
       prediction.velocity.row(v) = state.velocities.col(v).transpose().template cast<Real>();
-    } else if (with_pull && !still) {
+    } else if (pass.with_pull && !still) {
       const uint32_t* slots = tree.vertex_memberships.data() + tree.vertex_cluster_offsets[v];
       pull = mean_correction(scratch, tree.vertex_cluster_offsets[v + 1] - tree.vertex_cluster_offsets[v],
                              attachment.vertex_inv_count[v],
@@ -83,7 +93,7 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
 }
 
 // One kernel over this thread's vertices [first, last), in blocks => the lowest vertex whose
-// values are not finite and (`check_runaway`) the lowest attached one farther than the
+// values are not finite and (`pass.check_runaway`) the lowest attached one farther than the
 // runaway limit. `before` runs on each block's range first.
 // Without sleeping islands every vertex reads its mean correction from its own row (anchors:
 // a zero row, with factors that keep them still), which the first pass of a step averages for
@@ -92,12 +102,11 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
 template <typename Real, typename Before, typename Kernel>
 std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                                                 SimState& state, StepScratch<Real>& scratch, size_t first,
-                                                size_t last, bool load_state, bool with_pull, bool first_pass,
-                                                bool any_asleep, bool check_runaway, Before before, Kernel kernel) {
+                                                size_t last, const BlockPass& pass, Before before, Kernel kernel) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   uint32_t bad = kNone, runaway = kNone;
-  const bool direct = !load_state && !any_asleep;
-  if (direct && with_pull && first_pass) average_shared_pulls(model, attachment, scratch, first, last);
+  const bool direct = !pass.load_state && !pass.any_asleep;
+  if (direct && pass.with_pull && pass.first_pass) average_shared_pulls(model, attachment, scratch, first, last);
   const Real* corrections[3] = {scratch.member_correction.col(0).data(), scratch.member_correction.col(1).data(),
                                 scratch.member_correction.col(2).data()};
   VertexBlock<Real> block;
@@ -112,7 +121,7 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
       std::fill(block.moving, block.moving + n, uint8_t(1));
       std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);
     } else {
-      gather_block(model, attachment, state, scratch, load_state, with_pull, any_asleep, begin, n, block);
+      gather_block(model, attachment, state, scratch, pass, begin, n, block);
       in = {{block.pull[0], block.pull[1], block.pull[2]}, block.drag, block.half_damping,
             block.global, block.flying, {}, nullptr};
     }
@@ -125,7 +134,7 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
       if (!block.moving[k]) continue;
       const uint32_t v = static_cast<uint32_t>(begin + k);
       if (!prediction.offset.row(v).allFinite() || !prediction.velocity.row(v).allFinite()) bad = std::min(bad, v);
-      if (check_runaway && !attachment.vertex_flying[v] &&
+      if (pass.check_runaway && !attachment.vertex_flying[v] &&
           prediction.offset.row(v).template cast<double>().squaredNorm() > model.runaway_distance2)
         runaway = std::min(runaway, v);
     }
@@ -141,10 +150,15 @@ std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, c
                                                size_t first, size_t last) {
   StepPrediction<Real>& prediction = state.prediction<Real>();
   auto nothing = [](size_t, size_t) {};
+  const BlockPass pass = {.load_state = mode.from_state,
+                          .with_pull = !mode.from_state,
+                          .first_pass = true,
+                          .any_asleep = mode.any_asleep,
+                          .check_runaway = mode.last};
   return with_kernel_isa([&] {
     return for_vertex_blocks(
-        model, attachment, state, scratch, first, last, mode.from_state, !mode.from_state, true, mode.any_asleep,
-        mode.last, nothing, [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+        model, attachment, state, scratch, first, last, pass, nothing,
+        [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
           if (model.store_drag_force)
             return mode.last ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
                              : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
@@ -163,9 +177,9 @@ uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>
   auto goals = [&](size_t begin, size_t stop) {
     if (model.beam) write_static_offsets(model, attachment, scratch, prediction, begin, stop);
   };
+  const BlockPass pass = {.with_pull = !mode.from_state, .any_asleep = mode.any_asleep};
   return with_kernel_isa([&] {
-    return for_vertex_blocks(model, attachment, state, scratch, first, last, false, !mode.from_state, false,
-                             mode.any_asleep, false, goals,
+    return for_vertex_blocks(model, attachment, state, scratch, first, last, pass, goals,
                              [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
                                return mode.last ? predict_block<false>(model, attachment, scratch, prediction, begin,
                                                                        n, in, kick, block)
@@ -216,7 +230,9 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep) {
   const bool any_asleep = std::any_of(state.island_asleep.begin(), state.island_asleep.end(),
                                       [](uint8_t a) { return a != 0; });
-  const VertexPassMode mode = {pass == VertexPass::kFromState, pass == VertexPass::kLastStep, any_asleep};
+  const VertexPassMode mode = {.from_state = pass == VertexPass::kFromState,
+                               .last = pass == VertexPass::kLastStep,
+                               .any_asleep = any_asleep};
   uint32_t bad = kNone, runaway = kNone, bad_prediction = kNone;
 #pragma omp parallel if (model.parallel)
   {

@@ -1,5 +1,5 @@
 #pragma once
-// SimState: everything that changes during a bake (DESIGN.md; MuJoCo's mjData). Complete: a
+// SimState: everything that changes during a bake (docs/design.md; MuJoCo's mjData). Complete: a
 // state copied or loaded into a fresh Simulator of the same model and options continues
 // bit-identically (tests/sim/test_resume.cpp). The TreeModel it belongs to is read-only;
 // what a detachment changes in the clusters' rest data is a function of the model and

@@ -109,7 +109,8 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
                                                last ? VertexPass::kLastStep : VertexPass::kStep, frame, k);
       } else {
         // The same (1 of this step, 2, 3, 4), block by block while each is in cache.
-        skipped_sleepers = step_in_blocks(model, attachment, state, scratch, k > 0, last, frame, k);
+        skipped_sleepers =
+            step_in_blocks(model, attachment, state, scratch, {.predict = k > 0, .last = last}, frame, k);
       }
     }
     complete = !skipped_sleepers;

@@ -35,9 +35,9 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
                          StepScratch<Real>& scratch, VertexPass pass, long long frame, int substep);
 // How a step's vertex passes run.
 struct VertexPassMode {
-  bool from_state;  // u and v loaded from the state: the prediction of a frame's first step
-  bool last;        // a frame's last step: the corrected u and v kept for the state, the runaway checked
-  bool any_asleep;  // islands asleep: each block of vertices gathered lane by lane
+  bool from_state = false;  // u and v loaded from the state: the prediction of a frame's first step
+  bool last = false;        // a frame's last step: the corrected u and v kept for the state, the runaway checked
+  bool any_asleep = false;  // islands asleep: each block of vertices gathered lane by lane
 };
 // The passes of correct_and_predict, called by each thread on its vertices [first, last),
 // in a parallel region or outside one. The step just matched => the vertices corrected and
@@ -126,6 +126,11 @@ bool match_attached_leaf(const SolverModel<Real>& model, const Attachment<Real>&
                          StepScratch<Real>& scratch, uint32_t c);
 
 // --- cache_blocks.cpp ---
+// Where a step in blocks stands in its frame.
+struct BlockStep {
+  bool predict = false;  // predict the step from the one before (false for a frame's first step)
+  bool last = false;     // a frame's last step
+};
 // One step in the model's cache blocks (SolverModel::block_cluster_offsets), in place of
 // match_clusters and correct_and_predict: unless it is a frame's first step (`predict` false:
 // the frame before or predict_from_state predicted it), the step predicted from the one
@@ -135,7 +140,7 @@ bool match_attached_leaf(const SolverModel<Real>& model, const Attachment<Real>&
 // the SimulationError those two would have, in the substep they would have thrown it.
 template <typename Real>
 bool step_in_blocks(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                    StepScratch<Real>& scratch, bool predict, bool last, long long frame, int substep);
+                    StepScratch<Real>& scratch, BlockStep step, long long frame, int substep);
 
 // --- detachment.cpp ---
 // state.leaf_attached => `attachment` built for exactly those flags (unchanged when they

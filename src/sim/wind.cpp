@@ -4,19 +4,16 @@
 #include <cmath>
 
 #include <numbers>
-#include <random>
+
+#include "common/random.h"
 
 namespace treeanim {
 
 namespace {
 
-// A 64-bit generator's raw output => uniform in [0, 1). std::uniform_real_distribution is
-// implementation-defined, so it would make bakes differ between standard libraries.
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-Eigen::Vector3d random_unit(std::mt19937_64& rng) {
-  const double z = 2 * uniform01(rng) - 1;
-  const double phi = 2 * std::numbers::pi * uniform01(rng);
+Eigen::Vector3d random_unit(RandomSequence& rng) {
+  const double z = 2 * rng.uniform() - 1;
+  const double phi = 2 * std::numbers::pi * rng.uniform();
   const double s = std::sqrt(std::max(0.0, 1 - z * z));
   return {s * std::cos(phi), s * std::sin(phi), z};
 }
@@ -43,7 +40,7 @@ WindField::WindField(const WindOptions& options)
     key_advection[k] = key_advection[k - 1] +
                        0.5 * (keys.time[k] - keys.time[k - 1]) * (keys.wind[k - 1] + keys.wind[k]);
 
-  std::mt19937_64 rng(options.seed ^ 0x7475726275ull);  // "turbu": the turbulence stream
+  RandomSequence rng(options.seed ^ 0x7475726275ull);  // "turbu": the turbulence stream
   const int n = options.turbulence_modes;
   mode_turbulence = n;
   mode_wave.resize(3, n + kGustWaves);
@@ -56,13 +53,13 @@ WindField::WindField(const WindOptions& options)
   for (int m = 0; m < n; ++m) {
     const Eigen::Vector3d dir = random_unit(rng);
     // Wavelengths spread log-uniformly over [L/2, 2L] around the length scale L.
-    const double wavelength = options.turbulence_length * std::exp2(2 * uniform01(rng) - 1);
+    const double wavelength = options.turbulence_length * std::exp2(2 * rng.uniform() - 1);
     mode_wave.col(m) = dir * (2 * std::numbers::pi / wavelength);
     Eigen::Vector3d a = dir.cross(random_unit(rng));
     if (a.norm() < 1e-6) a = dir.unitOrthogonal();
     mode_amplitude.col(m) = a.normalized() * normalise;
-    mode_phase[m] = 2 * std::numbers::pi * uniform01(rng);
-    mode_omega[m] = 2 * std::numbers::pi * options.turbulence_frequency * (0.5 + uniform01(rng));
+    mode_phase[m] = 2 * std::numbers::pi * rng.uniform();
+    mode_omega[m] = 2 * std::numbers::pi * options.turbulence_frequency * (0.5 + rng.uniform());
   }
   // Gusts: three waves at incommensurate multiples of the gust rate, summed and normalised to
   // [-1, 1]; their fronts are tilted by up to 45 degrees about the up axis (gusts of finite width).
@@ -70,10 +67,10 @@ WindField::WindField(const WindOptions& options)
   double rates[kGustWaves], tilts[kGustWaves];
   for (int j = 0; j < kGustWaves; ++j) {
     rates[j] = 2 * std::numbers::pi * options.gust_frequency * ratios[j];
-    mode_phase[n + j] = 2 * std::numbers::pi * uniform01(rng);
+    mode_phase[n + j] = 2 * std::numbers::pi * rng.uniform();
     mode_omega[n + j] = 0;
   }
-  for (double& tilt : tilts) tilt = std::numbers::pi / 4 * (2 * uniform01(rng) - 1);
+  for (double& tilt : tilts) tilt = std::numbers::pi / 4 * (2 * rng.uniform() - 1);
   make_gust_waves(rates, tilts);
   if (loop_period > 0) make_periodic();
 }

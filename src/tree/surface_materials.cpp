@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lsystem/expression.h"
+#include "common/random.h"
 
 namespace treeanim {
 

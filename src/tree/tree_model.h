@@ -1,5 +1,5 @@
 #pragma once
-// TreeModel: the immutable, compiled tree (DESIGN.md; MuJoCo's mjModel). Built once by
+// TreeModel: the immutable, compiled tree (docs/design.md; MuJoCo's mjModel). Built once by
 // build_tree_model(), read-only afterwards; the solver and the sinks only read it.
 // SI units (m, kg), Y up. Index arrays are range-checked once by validate_tree_model().
 #include <Eigen/Core>

@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "bake/bake_tree.h"
+#include "bake/checkpoint.h"
 #include "bake/prepare_tree.h"
-#include "io/checkpoint.h"
 #include "sim/simulator.h"
 #include "temp_folder_test.h"
 

@@ -101,7 +101,7 @@ TEST_F(Cli, InfoJsonGivesExactSkeletonCounts) {
 }
 
 // Each output's estimate: 12 bytes a vertex and frame for the HDF5 positions, the USD text's
-// ~36 characters a point, ~96 a joint skinned (io/output_estimate.cpp).
+// ~36 characters a point, ~96 a joint skinned (output/output_formats.cpp).
 TEST_F(Cli, InfoEstimatesEachOutput) {
   const fs::path scene = write("line.json", kLine);
   const Result r = run("info --json " + scene.string() +

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Checks a treeanim HDF5 bake against the format_version 1 layout of DESIGN.md with h5py:
+"""Checks a treeanim HDF5 bake against the format_version 1 layout of docs/design.md with h5py:
 every root attribute, every dataset's shape, dtype and chunking, the index ranges, and,
 with --obj, that frame k of the bake equals the OBJ of frame k (bit for bit, float32);
 with --pc2, that the PC2 samples equal the bake's frames.

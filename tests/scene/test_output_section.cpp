@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
-#include "io/output_formats.h"
+#include "output/output_formats.h"
 #include "scene/output_section.h"
 #include "input_error_of.h"
 

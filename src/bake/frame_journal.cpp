@@ -1,0 +1,139 @@
+// Journal layout (little-endian, docs/checkpoint.md): a 64-byte header, magic "TAJOURN1",
+// u64 record bytes, i64 first frame, u64 V, u64 L, u8 velocities, padding, then the FNV-1a
+// scene hash as 24 bytes of text; then fixed-size records: i64 frame, f64 time,
+// f32 positions (V x 3), f32 velocities (V x 3, when recorded), u8 leaf flags (L).
+#include "bake/frame_journal.h"
+
+#include <unistd.h>
+
+#include <bit>
+#include <cstring>
+#include <vector>
+
+#include "common/errors.h"
+#include "files/io_failure.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the journal is written in host order");
+
+constexpr char kMagic[8] = {'T', 'A', 'J', 'O', 'U', 'R', 'N', '1'};
+constexpr size_t kHeaderBytes = 96;
+constexpr size_t kHashBytes = 32;
+
+std::vector<unsigned char> header_bytes(const JournalLayout& layout, uint64_t record_bytes) {
+  std::vector<unsigned char> header(kHeaderBytes, 0);
+  const int64_t first = layout.first_frame;
+  std::memcpy(&header[0], kMagic, 8);
+  std::memcpy(&header[8], &record_bytes, 8);
+  std::memcpy(&header[16], &first, 8);
+  std::memcpy(&header[24], &layout.vertices, 8);
+  std::memcpy(&header[32], &layout.leaves, 8);
+  header[40] = layout.velocities ? 1 : 0;
+  std::memcpy(&header[64], layout.scene_hash.data(), std::min(layout.scene_hash.size(), kHashBytes));
+  return header;
+}
+
+}  // namespace
+
+FrameJournal::FrameJournal(fs::path path, const JournalLayout& layout, std::FILE* file, long long records)
+    : path_(std::move(path)), layout_(layout), file_(file), records_(records) {}
+
+FrameJournal::FrameJournal(FrameJournal&& other) noexcept
+    : path_(std::move(other.path_)), layout_(other.layout_), file_(other.file_), records_(other.records_) {
+  other.file_ = nullptr;
+}
+
+FrameJournal& FrameJournal::operator=(FrameJournal&& other) noexcept {
+  std::swap(path_, other.path_);
+  std::swap(layout_, other.layout_);
+  std::swap(file_, other.file_);
+  std::swap(records_, other.records_);
+  return *this;
+}
+
+FrameJournal::~FrameJournal() {
+  if (file_) std::fclose(file_);
+}
+
+uint64_t journal_record_bytes(const JournalLayout& layout) {
+  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves;
+}
+
+FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {
+  std::error_code error;
+  fs::create_directories(path.parent_path(), error);
+  std::FILE* file = std::fopen(path.c_str(), "w+b");
+  if (!file) throw OutputError(io_failure(path, "cannot create the frame journal"));
+  FrameJournal journal(path, layout, file, 0);
+  const std::vector<unsigned char> header = header_bytes(layout, journal.record_bytes());
+  if (std::fwrite(header.data(), 1, header.size(), file) != header.size())
+    throw OutputError(io_failure(path, "cannot write the frame journal"));
+  return journal;
+}
+
+FrameJournal FrameJournal::open(const fs::path& path, const JournalLayout& layout) {
+  std::FILE* file = std::fopen(path.c_str(), "r+b");
+  if (!file) throw InputError(io_failure(path, "cannot open the frame journal"));
+  FrameJournal journal(path, layout, file, 0);
+  std::vector<unsigned char> header(kHeaderBytes);
+  if (std::fread(header.data(), 1, header.size(), file) != header.size() ||
+      header != header_bytes(layout, journal.record_bytes()))
+    throw InputError(path.string() + ": the frame journal is damaged or belongs to another bake (scene, frames or outputs)");
+  if (std::fseek(file, 0, SEEK_END) != 0) throw InputError(io_failure(path, "cannot read the frame journal"));
+  const long end = std::ftell(file);
+  journal.records_ = static_cast<long long>((uint64_t(end) - kHeaderBytes) / journal.record_bytes());
+  return journal;
+}
+
+FrameData FrameJournal::read(long long index) {
+  FrameData frame;
+  const size_t n = 3 * layout_.vertices;
+  frame.positions.resize(n);
+  if (layout_.velocities) frame.velocities.resize(n);
+  frame.leaf_attached.resize(layout_.leaves);
+  int64_t number = 0;
+  const bool ok =
+      index < records_ && std::fseek(file_, long(kHeaderBytes + uint64_t(index) * record_bytes()), SEEK_SET) == 0 &&
+      std::fread(&number, 8, 1, file_) == 1 && std::fread(&frame.time, 8, 1, file_) == 1 &&
+      std::fread(frame.positions.data(), 4, n, file_) == n &&
+      (!layout_.velocities || std::fread(frame.velocities.data(), 4, n, file_) == n) &&
+      std::fread(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves;
+  frame.frame = number;
+  if (!ok || number != layout_.first_frame + index)
+    throw InputError(path_.string() + ": record " + std::to_string(index) + " of the frame journal is damaged");
+  return frame;
+}
+
+void FrameJournal::truncate(long long count) {
+  const uint64_t bytes = kHeaderBytes + uint64_t(count) * record_bytes();
+  if (std::fflush(file_) != 0 || ::ftruncate(fileno(file_), off_t(bytes)) != 0 ||
+      std::fseek(file_, long(bytes), SEEK_SET) != 0)
+    throw OutputError(io_failure(path_, "cannot truncate the frame journal"));
+  records_ = count;
+}
+
+void FrameJournal::append(const FrameData& frame) {
+  const int64_t number = frame.frame;
+  const size_t n = 3 * layout_.vertices;
+  const bool ok = std::fseek(file_, 0, SEEK_END) == 0 && std::fwrite(&number, 8, 1, file_) == 1 &&
+                  std::fwrite(&frame.time, 8, 1, file_) == 1 && frame.positions.size() == n &&
+                  std::fwrite(frame.positions.data(), 4, n, file_) == n &&
+                  (!layout_.velocities || (frame.velocities.size() == n &&
+                                           std::fwrite(frame.velocities.data(), 4, n, file_) == n)) &&
+                  frame.leaf_attached.size() == layout_.leaves &&
+                  std::fwrite(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves;
+  if (!ok) throw OutputError(io_failure(path_, "cannot append to the frame journal"));
+  ++records_;
+}
+
+void FrameJournal::sync() {
+  if (std::fflush(file_) != 0 || ::fdatasync(fileno(file_)) != 0)
+    throw OutputError(io_failure(path_, "cannot flush the frame journal"));
+}
+
+}  // namespace treeanim

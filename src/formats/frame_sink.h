@@ -1,0 +1,53 @@
+#pragma once
+// FrameSink (docs/design.md): one output format, made by its factory (formats/sink_factories.h).
+// OutputSet calls begin() once, write() for every selected frame in order (on the sink's own
+// writer thread), then finish() and, once every sink finished, commit(); or abort() at any point.
+// Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "files/staged_files.h"
+#include "formats/outputs.h"
+#include "output/output_options.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+// Which frames of the bake an output writes: frame_start, then every step-th frame.
+struct FrameSelection {
+  long long start = 0;  // first frame index of the bake
+  long long count = 0;  // frames the bake pushes
+  long long step = 1;   // write every step-th of them
+  bool wants(long long frame) const { return (frame - start) % step == 0; }
+  long long written() const { return (count + step - 1) / step; }
+};
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // Calls `visit` with every file the sink will create, final names (checked and de-duplicated
+  // before simulating), one at a time: a long sequence needs no list of its names.
+  virtual void for_each_target(const std::function<void(const std::filesystem::path&)>& visit) const = 0;
+  // The files named in the run's summary (a sequence's first frame stands for the rest).
+  virtual std::vector<std::filesystem::path> summary_paths() const = 0;
+  // Opens the temporaries and writes what does not change over frames.
+  virtual void begin() = 0;
+  // Appends one selected frame. Throws OutputError naming the path.
+  virtual void write(const FrameData& frame) = 0;
+  // Completes and closes the temporaries.
+  virtual void finish() {}
+  // Renames every temporary to its final name.
+  void commit() { staged_.commit(); }
+  // A line for the run's summary after finish() ("" for none), e.g. a fit's error.
+  virtual std::string report() const { return ""; }
+  // Closes and removes every temporary. Never throws.
+  virtual void abort() noexcept { staged_.discard(); }
+
+ protected:
+  StagedFiles staged_;  // this sink's temporaries and their final names
+};
+
+}  // namespace treeanim

@@ -1,0 +1,297 @@
+// OutputSet: checks every target before the simulation, then runs each sink on its own
+// writer thread behind a bounded queue, so the bake takes about max(simulation, slowest sink).
+#include "formats/outputs.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/errors.h"
+#include "files/output_lock.h"
+#include "files/staged_files.h"
+#include "formats/frame_sink.h"
+#include "formats/sink_factories.h"
+#include "formats/vertex_normals.h"
+#include "formats/output_estimate.h"
+#include "output/output_formats.h"
+
+namespace treeanim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Nice increment of writer threads (Linux: per thread). When the solver's OpenMP threads
+// already use every core, a writer that preempts one of them stalls the whole team at its next
+// barrier; niced, the writer runs in the gaps and only takes a core when its queue is full
+// and the solver is waiting anyway.
+constexpr int kWriterNice = 5;
+
+// Frames a sink may lag behind the solver. Enough to absorb a slow frame (a compressed chunk,
+// a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
+constexpr size_t kQueueFrames = 8;
+
+// One sink, its thread and its queue of frames still to write.
+struct Worker {
+  std::unique_ptr<FrameSink> sink;
+  FrameSelection selection;
+  fs::path first_path;  // for messages about failures that do not name a path themselves
+  double estimated_bytes = 0;  // of the frames it will write (estimated_output_bytes)
+  std::thread thread;
+  std::mutex mutex;
+  std::condition_variable changed;  // queue, closing, stopping or error changed
+  std::deque<std::shared_ptr<const FrameData>> queue;
+  bool closing = false;              // no more frames will come: drain and return
+  bool stopping = false;             // abort: return without writing the rest
+  std::exception_ptr error;          // the sink's failure, rethrown by push() or finish()
+
+  // Writer thread: writes queued frames in order until closed, stopped or failed.
+  void run() {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWriterNice);  // best effort
+    for (;;) {
+      std::shared_ptr<const FrameData> frame;
+      {
+        std::unique_lock lock(mutex);
+        changed.wait(lock, [&] { return stopping || closing || !queue.empty(); });
+        if (stopping || queue.empty()) return;
+        frame = std::move(queue.front());
+        queue.pop_front();
+      }
+      changed.notify_all();
+      try {
+        sink->write(*frame);
+      } catch (...) {
+        fail(std::current_exception());
+        return;
+      }
+    }
+  }
+
+  // Records the first failure as an OutputError that names a path.
+  void fail(std::exception_ptr failure) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const OutputError&) {
+    } catch (const std::exception& e) {
+      failure = std::make_exception_ptr(OutputError(first_path.string() + ": " + e.what()));
+    }
+    {
+      std::lock_guard lock(mutex);
+      if (!error) error = failure;
+    }
+    changed.notify_all();
+  }
+
+  void rethrow_error() {
+    std::lock_guard lock(mutex);
+    if (error) std::rethrow_exception(error);
+  }
+};
+
+}  // namespace
+
+struct OutputSet::Impl {
+  const TreeModel& model;
+  std::vector<std::unique_ptr<Worker>> workers;
+  bool velocities = false;
+  bool normals = false;
+  std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
+  bool leaf_flags = false;  // some output writes the leaves' attached flags
+  bool done = false;  // finished or aborted
+  OutputLocks locks;  // one per output, held from the checks to the end (files/output_lock.h)
+  MadeFolders folders;  // made for the outputs: removed, when empty, if the bake fails
+
+  // A failed bake's locks dropped and the folders it made removed (a lock file would keep one).
+  void undo() noexcept {
+    locks.release();
+    folders.undo();
+  }
+
+  explicit Impl(const TreeModel& m) : model(m) {}
+};
+
+namespace {
+
+fs::path resolve(const fs::path& path, const fs::path& out_dir) {
+  return (path.is_relative() && !out_dir.empty() ? out_dir / path : path).lexically_normal();
+}
+
+// Every target is written by one output only, is absent or a regular file (after its symbolic
+// links), and every folder takes files. The first pass only looks (lstat), so a refused output
+// leaves nothing created; the second creates folders and probes them. A sequence has a target
+// per frame, so this runs on strings: path comparisons per component cost ~20 us a target, a
+// minute for a million-frame sequence.
+void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs,
+                   MadeFolders& made) {
+  const fs::path cwd = fs::current_path();
+  std::unordered_map<std::string, size_t> writer;  // absolute file written => output index
+  std::unordered_set<std::string> folders;         // absolute folders seen
+  std::vector<fs::path> probes;                    // the first file of each folder
+  for (size_t i = 0; i < workers.size(); ++i) {
+    workers[i]->sink->for_each_target([&](const fs::path& target) {
+      OutputTarget resolved;
+      try {
+        resolved = resolve_output_target(target);
+      } catch (const InputError& e) {
+        throw InputError(outputs[i].pointer + "/path: " + e.what());
+      }
+      const fs::path& file = resolved.file;
+      const std::string& kind = resolved.kind;
+      const std::string absolute = file.is_absolute() ? file.string() : (cwd / file).string();
+      const auto [it, inserted] = writer.emplace(absolute, i);
+      if (!inserted)
+        throw InputError(outputs[i].pointer + "/path: writes " + file.string() + ", which " +
+                         outputs[it->second].pointer + " writes too");
+      if (!kind.empty())
+        throw InputError(outputs[i].pointer + "/path: " + target.string() +
+                         (file == target ? " is " : " links to " + file.string() + ", ") + kind +
+                         ", left untouched; an output path must name a regular file or a new one");
+      if (folders.insert(absolute.substr(0, absolute.rfind('/'))).second) probes.push_back(file);
+    });
+  }
+  for (const fs::path& file : probes) check_writable_target(file, made);
+}
+
+}  // namespace
+
+OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, const TreeModel& model,
+                     const BakeInfo& info)
+    : impl_(std::make_unique<Impl>(model)) {
+  for (const OutputOptions& options : outputs) {
+    auto worker = std::make_unique<Worker>();
+    SinkFactory* const make = find_sink_factory(options.format->name);
+    if (!make) throw std::logic_error(std::string("OutputSet: no sink writes format ") + options.format->name);
+    worker->sink = make(options, resolve(options.path, out_dir), model, info);
+    worker->selection = {info.frame_start, info.frame_count, options.frame_step};
+    const auto summary = worker->sink->summary_paths();
+    worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();
+    worker->estimated_bytes = estimated_output_bytes(options, model.vertex_count(), model.triangle_count(),
+                                                     model.cluster_count(), info.frame_count);
+    impl_->velocities = impl_->velocities || options.velocities;
+    impl_->normals = impl_->normals || options.normals;
+    impl_->leaf_flags = impl_->leaf_flags || options.format->leaf_flags;
+    impl_->workers.push_back(std::move(worker));
+  }
+  try {
+    check_targets(impl_->workers, outputs, impl_->folders);
+    for (const OutputOptions& options : outputs) impl_->locks.lock(resolve(options.path, out_dir));
+  } catch (...) {
+    impl_->undo();
+    throw;
+  }
+  if (impl_->normals) impl_->rest_normals = rest_normals(model);
+}
+
+OutputSet::~OutputSet() {
+  if (!impl_->done) abort();
+}
+
+bool OutputSet::wants_velocities() const { return impl_->velocities; }
+
+void OutputSet::begin() {
+  try {
+    for (auto& worker : impl_->workers) worker->sink->begin();
+  } catch (...) {
+    abort();
+    throw;
+  }
+  for (auto& worker : impl_->workers) worker->thread = std::thread(&Worker::run, worker.get());
+}
+
+void OutputSet::push(FrameData frame) {
+  const size_t n = 3 * impl_->model.vertex_count();
+  if (frame.positions.size() != n || (impl_->velocities && frame.velocities.size() != n) ||
+      (impl_->leaf_flags && frame.leaf_attached.size() != impl_->model.leaf_count()))
+    throw std::logic_error("OutputSet::push: frame " + std::to_string(frame.frame) +
+                           " does not match the model (positions " + std::to_string(frame.positions.size()) +
+                           ", velocities " + std::to_string(frame.velocities.size()) + ", leaf flags " +
+                           std::to_string(frame.leaf_attached.size()) + ")");
+  // Once per frame for every output that carries them, on the caller's thread: the writers
+  // share the frame read-only.
+  if (impl_->normals) vertex_normals(impl_->model, frame.positions.data(), impl_->rest_normals, frame.normals);
+  const auto shared = std::make_shared<const FrameData>(std::move(frame));
+  for (auto& worker : impl_->workers) {
+    if (!worker->selection.wants(shared->frame)) continue;
+    {
+      std::unique_lock lock(worker->mutex);
+      worker->changed.wait(lock, [&] { return worker->error || worker->queue.size() < kQueueFrames; });
+      if (!worker->error) worker->queue.push_back(shared);
+    }
+    worker->changed.notify_all();
+    worker->rethrow_error();
+  }
+}
+
+void OutputSet::finish() {
+  try {
+    for (auto& worker : impl_->workers) {
+      {
+        std::lock_guard lock(worker->mutex);
+        worker->closing = true;
+      }
+      worker->changed.notify_all();
+    }
+    for (auto& worker : impl_->workers)
+      if (worker->thread.joinable()) worker->thread.join();
+    for (auto& worker : impl_->workers) worker->rethrow_error();
+    // Every file complete before any is renamed: a failure here still leaves no output.
+    for (auto& worker : impl_->workers) worker->sink->finish();
+    for (auto& worker : impl_->workers) worker->sink->commit();
+  } catch (...) {
+    abort();
+    throw;
+  }
+  impl_->locks.release();
+  impl_->done = true;
+}
+
+void OutputSet::abort() noexcept {
+  for (auto& worker : impl_->workers) {
+    {
+      std::lock_guard lock(worker->mutex);
+      worker->stopping = true;
+    }
+    worker->changed.notify_all();
+  }
+  for (auto& worker : impl_->workers) {
+    if (worker->thread.joinable()) worker->thread.join();
+    worker->sink->abort();
+  }
+  impl_->undo();
+  impl_->done = true;
+}
+
+std::vector<std::pair<fs::path, std::string>> OutputSet::reports() const {
+  std::vector<std::pair<fs::path, std::string>> reports;
+  for (const auto& worker : impl_->workers)
+    if (std::string line = worker->sink->report(); !line.empty()) reports.emplace_back(worker->first_path, line);
+  return reports;
+}
+
+std::vector<std::pair<fs::path, double>> OutputSet::estimated_bytes() const {
+  std::vector<std::pair<fs::path, double>> bytes;
+  for (const auto& worker : impl_->workers) bytes.emplace_back(worker->first_path, worker->estimated_bytes);
+  return bytes;
+}
+
+std::vector<fs::path> OutputSet::files(size_t k) const {
+  std::vector<fs::path> files;
+  impl_->workers.at(k)->sink->for_each_target([&](const fs::path& file) { files.push_back(file); });
+  return files;
+}
+
+std::vector<fs::path> OutputSet::final_paths() const {
+  std::vector<fs::path> paths;
+  for (const auto& worker : impl_->workers)
+    for (const fs::path& path : worker->sink->summary_paths()) paths.push_back(path);
+  return paths;
+}
+
+}  // namespace treeanim

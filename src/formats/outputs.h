@@ -1,0 +1,90 @@
+#pragma once
+// OutputSet, what the bake writes through: every output of a bake, each sink on its own
+// writer thread behind a bounded queue, so writing never stalls the solver. Each sink writes to
+// a temporary name beside its target and renames it when complete; abort() removes every
+// temporary.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "output/output_options.h"
+#include "sim/sim_options.h"
+#include "tree/surface_materials.h"
+#include "tree/tree_model.h"
+#include "tree/tree_placement.h"
+
+namespace treeanim {
+
+// What the sinks record about the bake besides the frames.
+struct BakeInfo {
+  std::string scene_json;      // resolved scene (defaults filled in)
+  std::string generator;       // "treeanim <version>"
+  double fps = 24;
+  long long frame_start = 0;   // first frame index written
+  long long frame_count = 0;   // frames the bake will hand to push()
+  int substeps = 1;
+  uint64_t seed = 0;
+  // A seamless loop of the whole bake (time.loop): the first frame comes again at
+  // loop_end_time (s), so animations add a closing key there.
+  bool loop = false;
+  double loop_end_time = 0;
+  // The mesh's look: materials by TriangleMaterial, and (V*3) linear colour factors per vertex
+  // (tree/surface_materials.h; empty: no vertex colours).
+  std::array<SurfaceMaterial, kMaterialCount> materials = surface_materials(TreeOptions{});
+  std::vector<float> vertex_colors;
+  WindOptions wind;            // the scene's wind (the html page plots it at the tree)
+  TreePlacement placement;     // where the tree stands in that wind; identity for a lone tree
+};
+
+// One simulated frame, converted to float for output.
+struct FrameData {
+  long long frame = 0;                 // absolute frame index
+  double time = 0;                     // s
+  std::vector<float> positions;        // (V*3) m
+  std::vector<float> velocities;       // (V*3) m/s; empty unless some output asked for them
+  std::vector<float> normals;          // (V*3) unit; filled by OutputSet::push when an output wants them
+  std::vector<uint8_t> leaf_attached;  // (L)
+};
+
+class OutputSet {
+ public:
+  // Resolves relative paths against out_dir (when not empty), checks every target (folder
+  // exists or can be made, writable, format limits such as 4 GiB GLB) and locks each output
+  // against other bakes (files/output_lock.h) before simulation; finish() and abort() unlock. The
+  // options are as the scene reader checked them. Throws InputError for a target no output may
+  // write (a directory, one written twice, a GLB past 4 GiB), OutputError naming the path for
+  // unwritable targets
+  // and for an output another bake holds.
+  OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
+            const TreeModel& model, const BakeInfo& info);
+  ~OutputSet();  // abort()s when finish() was not reached
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  bool wants_velocities() const;
+  // Opens temporaries, writes headers and the rest mesh; starts each sink's writer thread.
+  void begin();
+  // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.
+  void push(FrameData frame);
+  // Drains the queue, closes files, renames temporaries to their final names.
+  void finish();
+  // Stops the writer and removes every temporary. Never throws.
+  void abort() noexcept;
+  // Final paths (files, or the first file of a sequence pattern) for the summary line.
+  std::vector<std::filesystem::path> final_paths() const;
+  // Every file of output k, in the order of its sink (a sequence: each frame's file and the rest mesh).
+  std::vector<std::filesystem::path> files(size_t k) const;
+  // Each output's first file and the bytes of the frames it will write (estimated_output_bytes).
+  std::vector<std::pair<std::filesystem::path, double>> estimated_bytes() const;
+  // After finish(): what outputs have to say besides their paths (a fit's error), by output path.
+  std::vector<std::pair<std::filesystem::path, std::string>> reports() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace treeanim

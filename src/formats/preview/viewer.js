@@ -1,0 +1,289 @@
+// The html output's viewer (docs/outputs.md "Preview page"): reads the bake embedded in the
+// page (<script id="treeanim-bake" type="application/json">, written by src/formats/html_sink.cpp)
+// and plays it with three.js. Bundled by esbuild at build time; the page needs no network.
+// page.html#t=SECONDS shows that time, stops, and sets document.title to "ready" once drawn;
+// &tree=K shows the K-th tree alone (from 0; none past the last), framed as the whole page.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const bake = JSON.parse(document.getElementById('treeanim-bake').textContent);
+
+// base64 => the bytes as a typed array of `Type` (the page's arrays are little-endian).
+function decode(text, Type) {
+  const binary = atob(text);
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
+  return new Type(bytes.buffer);
+}
+
+const samples = bake.plot.time.length;  // every written frame has a sample in the plots
+const times = bake.plot.time;
+const duration = samples > 1 ? times[samples - 1] - times[0] : 0;
+
+// --- page layout ---
+const style = document.createElement('style');
+style.textContent = `
+  body { margin: 0; font: 13px system-ui, sans-serif; background: #f4f5f2; color: #222; }
+  #view { position: relative; width: 100%; height: 62vh; min-height: 320px; }
+  #view canvas { display: block; }
+  #bar { display: flex; gap: 10px; align-items: center; padding: 6px 10px; background: #e6e8e3; }
+  #bar input[type=range] { flex: 1; }
+  #clock { font-variant-numeric: tabular-nums; min-width: 15em; }
+  #note { padding: 4px 10px; color: #8a4b00; }
+  #plots { display: flex; flex-wrap: wrap; gap: 8px; padding: 8px 10px; }
+  #plots canvas { flex: 1 1 420px; height: 170px; min-width: 300px; background: #fff; border: 1px solid #ccd; }
+  #title { position: absolute; left: 10px; top: 8px; color: #334; text-shadow: 0 0 3px #fff; }`;
+document.head.appendChild(style);
+const app = document.createElement('div');  // before the data, which stays in the page
+app.innerHTML = `
+  <div id="view"><div id="title"></div></div>
+  <div id="bar">
+    <button id="play">Pause</button>
+    <label>speed <select id="speed">
+      <option value="0.1">0.1×</option><option value="0.25">0.25×</option><option value="0.5">0.5×</option>
+      <option value="1" selected>1×</option><option value="2">2×</option></select></label>
+    <input id="scrub" type="range" min="0" max="${Math.max(samples - 1, 0)}" step="1" value="0">
+    <span id="clock"></span>
+  </div>
+  <div id="note"></div>
+  <div id="plots"><canvas id="windplot"></canvas><canvas id="dispplot"></canvas></div>`;
+document.body.prepend(app);
+document.getElementById('title').textContent = bake.title;
+document.getElementById('note').textContent = bake.reduced;
+
+// --- scene ---
+const view = document.getElementById('view');
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+view.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xdfe8ef);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8c8c8c, 2.2));  // grey ground: shading keeps the hues
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(0.4, 1, 0.7);
+scene.add(sun);
+
+const srgb = (rgb) => new THREE.Color().setRGB(rgb[0], rgb[1], rgb[2], THREE.SRGBColorSpace);
+const materials = [
+  new THREE.MeshLambertMaterial({ color: srgb(bake.colors.bark) }),
+  new THREE.MeshLambertMaterial({ color: srgb(bake.colors.leaf), side: THREE.DoubleSide }),
+];
+
+// One tree: its mesh, placed as the bake places it, and its frames.
+function makeTree(tree) {
+  const rest = decode(tree.rest, Float32Array);
+  const geometry = new THREE.BufferGeometry();
+  const positions = new THREE.BufferAttribute(rest.slice(), 3);
+  positions.setUsage(THREE.DynamicDrawUsage);
+  geometry.setAttribute('position', positions);
+  geometry.setIndex(new THREE.BufferAttribute(decode(tree.triangles, Uint32Array), 1));
+  const barkIndices = 3 * tree.bark_triangles;
+  geometry.addGroup(0, barkIndices, 0);
+  geometry.addGroup(barkIndices, geometry.index.count - barkIndices, 1);
+  geometry.computeVertexNormals();
+  const mesh = new THREE.Mesh(geometry, materials);
+  mesh.position.fromArray(tree.position);
+  mesh.rotation.y = THREE.MathUtils.degToRad(tree.rotation);
+  scene.add(mesh);
+  const data = tree.frames.encoding === 'int16' ? decode(tree.frames.data, Int16Array)
+                                                 : decode(tree.frames.data, Float32Array);
+  const quantized = tree.frames.encoding === 'int16';
+  return { rest, mesh, positions, data, sample: tree.frames.sample, quantized,
+           step: quantized ? decode(tree.frames.step, Float32Array) : null };
+}
+const trees = bake.trees.map(makeTree);
+
+// Sample time t => the tree's positions, linear between the two kept frames around it.
+function pose(tree, t) {
+  const kept = tree.sample;
+  let hi = kept.findIndex((s) => times[s] >= t);
+  if (hi < 0) hi = kept.length - 1;
+  const lo = Math.max(hi - 1, 0);
+  const span = times[kept[hi]] - times[kept[lo]];
+  const w = span > 0 ? Math.min(Math.max((t - times[kept[lo]]) / span, 0), 1) : 1;
+  const n = tree.rest.length, out = tree.positions.array, d = tree.data;
+  const a = lo * n, b = hi * n;
+  for (let i = 0; i < n; ++i) {
+    const pa = d[a + i], pb = d[b + i];
+    const v = pa + (pb - pa) * w;
+    out[i] = tree.quantized ? tree.rest[i] + v * tree.step[(i / 3) | 0] : v;
+  }
+  tree.positions.needsUpdate = true;
+  tree.mesh.geometry.computeVertexNormals();
+}
+
+// Framing: the box of every tree at rest, from the front and a little above, its height
+// (or width, in a narrow view) filling nine tenths of the view.
+const box = new THREE.Box3();
+for (const tree of trees) {
+  tree.mesh.geometry.computeBoundingBox();
+  tree.mesh.updateMatrixWorld();
+  box.union(tree.mesh.geometry.boundingBox.clone().applyMatrix4(tree.mesh.matrixWorld));
+}
+const size = box.getSize(new THREE.Vector3());
+const center = box.getCenter(new THREE.Vector3());
+const radius = Math.max(size.length() / 2, 0.1);
+const camera = new THREE.PerspectiveCamera(35, 1, radius / 100, radius * 100);
+const viewDirection = new THREE.Vector3(0, 0.12, 1).normalize();
+function frame() {
+  const halfHeight = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
+  const reach = Math.max(size.y / 2, Math.max(size.x, size.z) / 2 / camera.aspect) / (0.9 * halfHeight);
+  camera.position.copy(center).addScaledVector(viewDirection, reach + Math.max(size.x, size.z) / 2);
+}
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.copy(center);
+
+// Ground grid: metre lines over the trees' footprint and two metres around it.
+const extent = Math.ceil(Math.max(size.x, size.z) / 2 + 2);
+const grid = new THREE.GridHelper(2 * extent, 2 * extent, 0x7d8a7a, 0xb4bdb1);
+grid.position.set(Math.round(center.x), box.min.y, Math.round(center.z));
+scene.add(grid);
+
+// Wind arrow: the air velocity at the probe point, from upwind, 1 m/s = 4 % of the trees' size.
+const probe = new THREE.Vector3().fromArray(bake.wind_probe);
+const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), probe, 1, 0x2060d0);
+scene.add(arrow);
+const arrowScale = 0.04 * Math.max(size.x, size.y, size.z);
+function placeArrow(sample) {
+  const w = new THREE.Vector3().fromArray(bake.plot.wind, 3 * sample);
+  const speed = w.length();
+  arrow.visible = speed > 1e-3;
+  if (!arrow.visible) return;
+  const length = speed * arrowScale;
+  const dir = w.clone().divideScalar(speed);
+  arrow.position.copy(probe).addScaledVector(dir, -length - 0.5 * Math.max(size.x, size.z));
+  arrow.setDirection(dir);
+  arrow.setLength(length, Math.min(0.3 * length, 0.1 * radius), Math.min(0.15 * length, 0.05 * radius));
+}
+
+// --- plots ---
+const plotStyles = { grid: '#e3e6ea', axis: '#667', text: '#334', cursor: '#d03030' };
+function drawPlot(canvas, title, unit, series, cursorTime) {
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  canvas.width = w * dpr;
+  canvas.height = h * dpr;
+  const g = canvas.getContext('2d');
+  g.scale(dpr, dpr);
+  const left = 48, right = 10, top = 22, bottom = 24;
+  let ymax = 0;
+  for (const s of series) for (const v of s.values) ymax = Math.max(ymax, v);
+  ymax = ymax > 0 ? ymax * 1.1 : 1;
+  const t0 = times[0], t1 = samples > 1 ? times[samples - 1] : t0 + 1;
+  const x = (t) => left + ((t - t0) / (t1 - t0)) * (w - left - right);
+  const y = (v) => h - bottom - (v / ymax) * (h - top - bottom);
+  g.font = '11px system-ui, sans-serif';
+  g.fillStyle = plotStyles.text;
+  g.fillText(`${title} (${unit})`, left, 14);
+  g.strokeStyle = plotStyles.grid;
+  for (let k = 0; k <= 4; ++k) {
+    const v = (ymax * k) / 4;
+    g.beginPath(); g.moveTo(left, y(v)); g.lineTo(w - right, y(v)); g.stroke();
+    g.fillText(v.toPrecision(2), 4, y(v) + 4);
+  }
+  for (let k = 0; k <= 5; ++k) {
+    const t = t0 + ((t1 - t0) * k) / 5;
+    g.fillText(`${t.toFixed(1)} s`, Math.min(x(t) - 12, w - 36), h - 8);
+  }
+  let legend = left + 180;
+  for (const s of series) {
+    g.strokeStyle = s.color;
+    g.lineWidth = 1.5;
+    g.beginPath();
+    s.values.forEach((v, i) => (i ? g.lineTo(x(times[i]), y(v)) : g.moveTo(x(times[i]), y(v))));
+    g.stroke();
+    g.fillStyle = s.color;
+    g.fillText(s.name, legend, 14);
+    legend += 90;
+  }
+  g.strokeStyle = plotStyles.cursor;
+  g.lineWidth = 1;
+  g.beginPath(); g.moveTo(x(cursorTime), top); g.lineTo(x(cursorTime), h - bottom); g.stroke();
+}
+const windSpeed = times.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
+const windTitle = trees.length > 1 ? 'wind speed at the first tree' : 'wind speed at the tree';
+function drawPlots(t) {
+  drawPlot(document.getElementById('windplot'), windTitle, 'm/s',
+           [{ name: 'speed', values: windSpeed, color: '#2060d0' }], t);
+  drawPlot(document.getElementById('dispplot'), 'displacement from rest', 'm',
+           [{ name: 'largest', values: bake.plot.max_displacement, color: '#c05a00' },
+            { name: 'RMS', values: bake.plot.rms_displacement, color: '#2a8a3a' }], t);
+}
+
+// --- playback ---
+const scrub = document.getElementById('scrub');
+const clock = document.getElementById('clock');
+const playButton = document.getElementById('play');
+const speedSelect = document.getElementById('speed');
+let playing = true;
+let time = times[0];
+let shown = null;
+let framed = false;  // the first size frames the camera; later ones keep the user's view
+
+function nearestSample(t) {
+  let best = 0;
+  for (let i = 1; i < samples; ++i) if (Math.abs(times[i] - t) < Math.abs(times[best] - t)) best = i;
+  return best;
+}
+
+function show(t) {
+  time = t;
+  const sample = nearestSample(t);
+  if (shown !== t) {
+    for (const tree of trees) pose(tree, t);
+    placeArrow(sample);
+    drawPlots(t);
+    shown = t;
+  }
+  scrub.value = String(sample);
+  clock.textContent = `frame ${bake.plot.frame[sample]} · t = ${t.toFixed(3)} s`;
+}
+
+function resize() {
+  const w = view.clientWidth, h = view.clientHeight;
+  renderer.setSize(w, h);
+  camera.aspect = w / h;
+  camera.updateProjectionMatrix();
+  if (!framed) frame();
+  framed = true;
+  shown = null;
+}
+window.addEventListener('resize', resize);
+
+playButton.addEventListener('click', () => {
+  playing = !playing;
+  playButton.textContent = playing ? 'Pause' : 'Play';
+});
+scrub.addEventListener('input', () => {
+  playing = false;
+  playButton.textContent = 'Play';
+  show(times[Number(scrub.value)]);
+});
+
+let last = null;
+function tick(now) {
+  if (playing && last !== null && duration > 0) {
+    const dt = ((now - last) / 1000) * Number(speedSelect.value);
+    show(times[0] + ((time - times[0] + dt) % duration));
+  }
+  last = now;
+  controls.update();
+  renderer.render(scene, camera);
+  requestAnimationFrame(tick);
+}
+
+// #t=SECONDS: that time, stopped; the title says "ready" once the frame is on the canvas.
+const requested = /(?:^#|&)t=([0-9.eE+-]+)/.exec(window.location.hash);
+const alone = /(?:^#|&)tree=([0-9]+)/.exec(window.location.hash);
+if (alone) trees.forEach((tree, k) => { tree.mesh.visible = k === Number(alone[1]); });
+resize();
+if (requested) {
+  playing = false;
+  playButton.textContent = 'Play';
+  show(Math.min(Math.max(Number(requested[1]), times[0]), times[samples - 1]));
+  renderer.render(scene, camera);
+  requestAnimationFrame(() => { document.title = 'ready'; });
+} else {
+  show(times[0]);
+}
+requestAnimationFrame(tick);

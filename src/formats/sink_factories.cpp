@@ -1,0 +1,60 @@
+// The sinks of the format table's rows (formats/sink_factories.h): a line per format.
+#include "formats/sink_factories.h"
+
+
+#include "formats/frame_sink.h"
+
+namespace treeanim {
+
+// Each format's sink, defined in its own file (src/formats/<format>_sink.cpp).
+SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
+    make_skinned_glb_sink, make_usd_sink, make_skinned_usd_sink, make_html_sink;
+PlannedBytes html_output_bytes;
+
+namespace {
+
+// A usd output's writer: the points per frame, or with "skinned" the UsdSkel layer, a writer of
+// its own as the skinned GLB is beside the GLB.
+std::unique_ptr<FrameSink> make_usd_form_sink(const OutputOptions& options, const std::filesystem::path& path,
+                                              const TreeModel& model, const BakeInfo& info) {
+  return (options.skinned ? make_skinned_usd_sink : make_usd_sink)(options, path, model, info);
+}
+
+struct SinkRow {
+  std::string_view format;
+  SinkFactory* make;
+  PlannedBytes* planned_bytes = nullptr;
+};
+
+const SinkRow kSinks[] = {
+    {"hdf5", make_hdf5_sink},
+    {"obj", make_obj_sink},
+    {"gltf", make_gltf_sink},
+    {"glb", make_glb_sink},
+    {"pc2", make_pc2_sink},
+    {"mdd", make_mdd_sink},
+    {"vat", make_vat_sink},
+    {"skinned_glb", make_skinned_glb_sink},
+    {"usd", make_usd_form_sink},
+    {"html", make_html_sink, html_output_bytes},
+};
+
+const SinkRow* find_sink(std::string_view format) {
+  for (const SinkRow& row : kSinks)
+    if (row.format == format) return &row;
+  return nullptr;
+}
+
+}  // namespace
+
+SinkFactory* find_sink_factory(std::string_view format) {
+  const SinkRow* row = find_sink(format);
+  return row ? row->make : nullptr;
+}
+
+PlannedBytes* find_planned_bytes(std::string_view format) {
+  const SinkRow* row = find_sink(format);
+  return row ? row->planned_bytes : nullptr;
+}
+
+}  // namespace treeanim

@@ -1,0 +1,33 @@
+#pragma once
+// The writers' half of the format table: each format's sink (formats/<format>_sink.cpp), by the
+// format's name. The other half, the scene keys and size estimates (output/output_formats.h), has
+// no dependencies, so that scene/ reads it without linking a writer.
+#include <filesystem>
+#include <memory>
+#include <string_view>
+
+#include "formats/outputs.h"
+#include "output/output_options.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+class FrameSink;
+
+// options, path resolved against the out folder, model, bake => a format's sink
+using SinkFactory = std::unique_ptr<FrameSink>(const OutputOptions& options, const std::filesystem::path& path,
+                                               const TreeModel& model, const BakeInfo& info);
+
+// options, mesh size (vertices, triangles, clusters), frames of the bake => an upper bound of all
+// the output writes, for a format that plans its size before simulating (a page that reduces its
+// frames to fit its limit)
+using PlannedBytes = double(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters,
+                            long long frames);
+
+// A format's name => its sink's factory; nullptr when no sink writes that format (a test checks
+// that every row of output_formats() has one).
+SinkFactory* find_sink_factory(std::string_view format);
+// A format's name => its sink's size plan; nullptr for a format whose size is its frames' bytes.
+PlannedBytes* find_planned_bytes(std::string_view format);
+
+}  // namespace treeanim

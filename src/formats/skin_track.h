@@ -1,0 +1,41 @@
+#pragma once
+// The keys of a skinned output (docs/outputs.md "Skinned glTF"): per written frame, each joint's
+// transform relative to its parent joint, fitted to the bake (formats/skin_fit.h), and the error of
+// the skinned mesh against the bake. The skinned GLB and the UsdSkel layer write the same keys.
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "formats/skin_fit.h"
+#include "tree/tree_model.h"
+
+namespace treeanim {
+
+struct SkinTrack {
+  std::vector<float> translations;        // (F*J*3) m, local to the parent joint
+  std::vector<float> rotations;           // (F*J*4) unit quaternions (x, y, z, w), each the short way from the last
+  std::vector<float> times;               // (F) s
+  std::vector<double> frame_rms_error;    // (F) m, RMS over the vertices of skinned - baked
+  double squared_error = 0;               // m^2, summed over frames and vertices
+  double largest_error = 0;               // m
+  double squared_displacement = 0;        // m^2, baked - rest, summed over frames and vertices
+  std::vector<RigidMotion> motions;       // (J) scratch: the last frame's fitted motions
+  std::vector<Eigen::Quaterniond> previous_rotation;  // (J) the last keys, for sign continuity
+};
+
+// One baked frame (V*3 float positions at `time` s) => its keys and errors appended to `track`.
+void add_skin_frame(const Skin& skin, const TreeModel& model, const float* positions, double time, SkinTrack& track);
+
+// How far the skinned mesh strays from the bake over every frame of a track.
+struct SkinError {
+  double rms_displacement = 0;  // m, RMS of baked - rest
+  double rms_error = 0;         // m, RMS of skinned - baked
+  double relative_rms = 0;      // rms_error / rms_displacement (0 without displacement)
+  double relative_max = 0;      // largest error / rms_displacement
+};
+SkinError skin_error(const SkinTrack& track, size_t vertex_count);
+
+// The run's summary line: "skinning error RMS 1.23 %, max 4.56 % of the RMS displacement, 12 joints".
+std::string skin_error_report(const SkinError& error, size_t joints);
+
+}  // namespace treeanim

@@ -1,0 +1,46 @@
+// The bytes each format's output will take, estimated before baking (formats/output_estimate.h).
+#include "formats/output_estimate.h"
+
+#include <gtest/gtest.h>
+
+#include "output/output_formats.h"
+
+namespace treeanim {
+namespace {
+
+TEST(OutputEstimate, SizeEstimatesPerFormat) {
+  // 100 vertices, 50 triangles, 7 clusters, 10 frames written every 3rd: 4 frames of 1200 bytes of vectors.
+  auto bytes = [](const char* format, auto&& set) {
+    OutputOptions o;
+    o.format = find_output_format(format);
+    o.frame_step = 3;
+    set(o);
+    return estimated_output_bytes(o, 100, 50, 7, 10);
+  };
+  auto plain = [](OutputOptions&) {};
+  auto with_normals = [](OutputOptions& o) { o.normals = true; };
+  EXPECT_EQ(bytes("hdf5", plain), 4800);
+  EXPECT_EQ(bytes("hdf5", [](OutputOptions& o) { o.quantize = 1e-3, o.velocities = o.normals = true; }), 12000);
+  EXPECT_EQ(bytes("obj", plain), 17600);
+  EXPECT_EQ(bytes("obj", with_normals), 32000);
+  EXPECT_EQ(bytes("gltf", plain), 7200);
+  for (const char* format : {"glb", "pc2", "mdd"}) EXPECT_EQ(bytes(format, with_normals), 9600) << format;
+  EXPECT_EQ(bytes("vat", plain), 12800);
+  EXPECT_EQ(bytes("vat", [](OutputOptions& o) { o.vat_half = true; }), 6400);
+  EXPECT_EQ(bytes("skinned_glb", plain), 4 * 28 * 7);  // a joint per cluster
+  EXPECT_EQ(bytes("skinned_glb", [](OutputOptions& o) { o.max_joints = 5; }), 4 * 28 * 5);
+  EXPECT_EQ(bytes("usd", plain), 4 * 36 * 100);
+  EXPECT_EQ(bytes("usd", with_normals), 4 * (36 + 38) * 100);
+  EXPECT_EQ(bytes("usd", [](OutputOptions& o) { o.skinned = true; }), 4 * 96 * 7);
+  // The page's whole size as its sink plans it (the viewer, about 0.6 MB, included), at most its limit.
+  const double page = bytes("html", [](OutputOptions& o) { o.max_page_bytes = 2 << 20; });
+  EXPECT_GT(page, 4 * 1600 + 500000);
+  EXPECT_LT(page, 2 << 20);
+  OutputOptions big;
+  big.format = find_output_format("html");
+  big.max_page_bytes = 2 << 20;
+  EXPECT_EQ(estimated_output_bytes(big, 100000, 200000, 7, 1000), double(2 << 20)) << "reduced to fit";
+}
+
+}  // namespace
+}  // namespace treeanim

@@ -1,0 +1,319 @@
+// OutputSet: targets checked before simulating, nothing left behind on abort or failure,
+// the GLB size limit refused early with the number of frames that would fit.
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+#include "common/errors.h"
+#include "formats/glb_size.h"
+#include "formats_test_support.h"
+
+namespace treeanim {
+namespace {
+
+using test::output;
+using test::small_frame;
+using test::small_info;
+using test::small_model;
+
+class OutputSetTest : public test::TempFolder {};
+
+std::vector<OutputOptions> every_format() {
+  std::vector<OutputOptions> outputs = {output("hdf5", "bake.h5"), output("obj", "obj/tree"),
+                                        output("gltf", "gltf/tree"), output("glb", "anim.glb"),
+                                        output("pc2", "tree.pc2")};
+  for (size_t i = 0; i < outputs.size(); ++i) outputs[i].pointer = "/outputs/" + std::to_string(i);
+  outputs[0].velocities = true;
+  return outputs;
+}
+
+TEST_F(OutputSetTest, AbortMidBakeLeavesNoFile) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info(5, 0);
+  OutputSet set(every_format(), dir_, m, info);
+  set.begin();
+  set.push(small_frame(m, 0));
+  set.push(small_frame(m, 1));
+  set.abort();
+  EXPECT_EQ(entries(), std::vector<std::string>{});  // the folders the checks made are gone too
+}
+
+TEST_F(OutputSetTest, DestructorWithoutFinishLeavesNoFile) {
+  const TreeModel m = small_model();
+  {
+    OutputSet set(every_format(), dir_, m, small_info(5, 0));
+    set.begin();
+    set.push(small_frame(m, 0));
+  }
+  EXPECT_EQ(entries(), std::vector<std::string>{});
+}
+
+TEST_F(OutputSetTest, AbortKeepsFoldersThatStoodBefore) {
+  const TreeModel m = small_model();
+  std::filesystem::create_directories(dir_ / "obj");
+  OutputSet set(every_format(), dir_, m, small_info(5, 0));
+  set.begin();
+  set.push(small_frame(m, 0));
+  set.abort();
+  EXPECT_EQ(entries(), std::vector<std::string>{"obj"});  // empty, yet not the bake's to remove
+}
+
+TEST_F(OutputSetTest, SecondSetOfTheSameOutputIsRefusedNamingTheHolder) {
+  const TreeModel m = small_model();
+  const std::vector<OutputOptions> outputs = {output("pc2", "tree.pc2")};
+  // A lock is per process, so the holder is a child that locks the output and waits.
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    OutputSet held(outputs, dir_, m, small_info(5, 0));
+    char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(1);
+    ::pause();
+    ::_exit(0);
+  }
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+  try {
+    OutputSet second(outputs, dir_, m, small_info(5, 0));
+    ADD_FAILURE() << "a second writer of the same output was let in";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "tree.pc2").string() + ": another bake is writing this output (process " +
+                                         std::to_string(child) + ", lock " + (dir_ / ".tree.pc2.lock").string() +
+                                         "); nothing was written: wait for it to end, or write elsewhere (-o)");
+  }
+  ::kill(child, SIGKILL);  // the kernel drops its lock: the output is free again
+  ::waitpid(child, nullptr, 0);
+  OutputSet third(outputs, dir_, m, small_info(5, 0));
+  third.abort();
+  EXPECT_EQ(entries(), std::vector<std::string>{});  // the dead holder's lock file removed with ours
+}
+
+TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {
+  const TreeModel m = small_model();
+  OutputSet set(every_format(), dir_, m, small_info(1, 0));
+  EXPECT_TRUE(set.wants_velocities());
+  set.begin();
+  set.push(small_frame(m, 0));
+  set.finish();
+  EXPECT_EQ(entries(), (std::vector<std::string>{"anim.glb", "bake.h5", "gltf", "gltf/tree.0000.glb", "obj",
+                                                 "obj/tree.0000.obj", "obj/tree.rest.mtl", "obj/tree.rest.obj",
+                                                 "tree.pc2", "tree.rest.mtl", "tree.rest.obj"}));
+  const auto paths = set.final_paths();
+  ASSERT_EQ(paths.size(), 7u);
+  EXPECT_EQ(paths[0], dir_ / "bake.h5");
+  EXPECT_EQ(paths[1], dir_ / "obj/tree.rest.obj");
+  EXPECT_EQ(paths[2], dir_ / "obj/tree.0000.obj");
+  EXPECT_EQ(paths[3], dir_ / "gltf/tree.0000.glb");
+}
+
+// The message of the error that refuses `outputs`, "input: " before a bad-input one.
+std::string output_error(const std::vector<OutputOptions>& outputs, const std::filesystem::path& dir,
+                         const TreeModel& m, const BakeInfo& info) {
+  try {
+    OutputSet set(outputs, dir, m, info);
+  } catch (const InputError& e) {
+    return std::string("input: ") + e.what();
+  } catch (const OutputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST_F(OutputSetTest, BadPathsAreFoundBeforeSimulating) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info();
+  test::bake({output("hdf5", "file")}, dir_, m, info);  // a file where a folder is wanted
+  const std::string in_file = output_error({output("obj", "file/obj/tree")}, dir_, m, info);
+  EXPECT_EQ(in_file.rfind((dir_ / "file/obj/tree.rest.obj").string() + ": cannot create the folder " +
+                              (dir_ / "file/obj").string(), 0), 0u) << in_file;
+  std::filesystem::create_directories(dir_ / "in_the_way.h5");
+  EXPECT_EQ(output_error({output("hdf5", "in_the_way.h5")}, dir_, m, info),
+            "input: /outputs/0/path: " + (dir_ / "in_the_way.h5").string() + " is a directory, left untouched; an "
+            "output path must name a regular file or a new one");
+  std::filesystem::create_directories(dir_ / "seq/tree.0003.obj");
+  EXPECT_EQ(output_error({output("obj", "seq/tree")}, dir_, m, info),
+            "input: /outputs/0/path: " + (dir_ / "seq/tree.0003.obj").string() + " is a directory, left untouched; "
+            "an output path must name a regular file or a new one");
+  // Not writable even for root: /proc takes no new files.
+  const std::string unwritable = output_error({output("hdf5", "/proc/bake.h5")}, dir_, m, info);
+  EXPECT_EQ(unwritable.rfind("/proc/bake.h5: cannot create a file in /proc: ", 0), 0u) << unwritable;
+}
+
+// What stands at a path, as lstat() sees it: type and device number, to tell "left as it was".
+std::pair<mode_t, dev_t> node_at(const std::filesystem::path& path) {
+  struct stat info {};
+  if (::lstat(path.c_str(), &info) != 0) return {0, 0};
+  return {info.st_mode, info.st_rdev};
+}
+
+// Every target of every format, with a device node (root only), a FIFO, a socket or a directory
+// standing at it: refused before anything is written, and the node left as it was. The check
+// looks with lstat(), so the FIFO is never opened (that would block).
+TEST_F(OutputSetTest, TargetsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info(3, 0);
+  const std::vector<std::pair<std::string, std::string>> targets = {
+      {"hdf5", "bake.h5"},           {"glb", "anim.glb"},           {"pc2", "tree.pc2"},
+      {"pc2", "tree.rest.obj"},      {"obj", "obj/tree.0001.obj"},  {"obj", "obj/tree.rest.obj"},
+      {"gltf", "gltf/tree.0002.glb"}, {"mdd", "tree.mdd"},            {"vat", "vat/tree.normals.exr"},
+      {"vat", "vat/tree.json"}};
+  const std::vector<std::pair<std::string, std::string>> paths = {
+      {"hdf5", "bake.h5"},   {"glb", "anim.glb"}, {"pc2", "tree.pc2"}, {"obj", "obj/tree"},
+      {"gltf", "gltf/tree"}, {"mdd", "tree.mdd"}, {"vat", "vat/tree"}};
+  for (const auto& [format, file] : targets) {
+    for (const std::string kind : {"character device", "FIFO", "socket", "directory"}) {
+      SCOPED_TRACE(format + " " + file + " " + kind);
+      std::filesystem::remove_all(dir_);
+      const std::filesystem::path at = dir_ / file;
+      std::filesystem::create_directories(at.parent_path());
+      int made = 0;
+      if (kind == "character device") {
+        if (::geteuid() != 0) continue;  // mknod needs root; CI runs as root
+        made = ::mknod(at.c_str(), S_IFCHR | 0600, makedev(1, 3));  // what /dev/null is
+      } else if (kind == "FIFO") {
+        made = ::mkfifo(at.c_str(), 0600);
+      } else if (kind == "socket") {
+        made = test::bind_unix_socket(at);
+      } else {
+        std::filesystem::create_directory(at);
+      }
+      ASSERT_EQ(made, 0) << std::strerror(errno);
+      const auto before = node_at(at);
+      const std::vector<std::string> entries_before = entries();
+      std::string path;
+      for (const auto& [f, p] : paths)
+        if (f == format) path = p;
+      EXPECT_EQ(output_error({output(format, path)}, dir_, m, info),
+                "input: /outputs/0/path: " + at.string() + " is a " + kind +
+                    ", left untouched; an output path must name a regular file or a new one");
+      EXPECT_EQ(node_at(at), before);
+      EXPECT_EQ(entries(), entries_before);  // no folder, no probe, no temporary
+    }
+  }
+}
+
+// A symbolic link at the target is followed, as cp and editors do: the file it names gets the
+// bake and the link stays. A dangling link creates its file; a loop and a link to a FIFO are refused.
+TEST_F(OutputSetTest, SymbolicLinksAreFollowedAndKept) {
+  namespace fs = std::filesystem;
+  const TreeModel m = small_model();
+  fs::create_directories(dir_ / "store");
+  { std::ofstream(dir_ / "store/old.h5") << "old"; }
+  fs::create_symlink("store/old.h5", dir_ / "bake.h5");
+  fs::create_symlink("store/new.pc2", dir_ / "tree.pc2");  // dangling
+  test::bake({output("hdf5", "bake.h5"), output("pc2", "tree.pc2")}, dir_, m, small_info(2, 0));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "bake.h5")));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "tree.pc2")));
+  EXPECT_EQ(test::read_file(dir_ / "store/old.h5").substr(1, 3), "HDF");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_ / "store/new.pc2")));
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_ / "tree.rest.obj")));  // named after the link
+
+  fs::create_symlink("loop-b.h5", dir_ / "loop-a.h5");
+  fs::create_symlink("loop-a.h5", dir_ / "loop-b.h5");
+  EXPECT_EQ(output_error({output("hdf5", "loop-a.h5")}, dir_, m, small_info()),
+            "input: /outputs/0/path: " + (dir_ / "loop-a.h5").string() +
+                ": a loop of symbolic links, or a chain of more than 40");
+  ASSERT_EQ(::mkfifo((dir_ / "store/pipe").c_str(), 0600), 0);
+  fs::create_symlink("store/pipe", dir_ / "piped.glb");
+  EXPECT_EQ(output_error({output("glb", "piped.glb")}, dir_, m, small_info()),
+            "input: /outputs/0/path: " + (dir_ / "piped.glb").string() + " links to " +
+                (dir_ / "store/pipe").string() + ", a FIFO, left untouched; an output path must name a regular "
+                "file or a new one");
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(dir_ / "store/pipe")));
+}
+
+// Two outputs that reach one file, one of them through a link, are refused like two equal paths.
+TEST_F(OutputSetTest, TwoOutputsCannotWriteOneFileThroughALink) {
+  const TreeModel m = small_model();
+  std::filesystem::create_symlink("a.h5", dir_ / "b.h5");
+  std::vector<OutputOptions> outputs{output("hdf5", "a.h5"), output("hdf5", "b.h5")};
+  outputs[1].pointer = "/outputs/1";
+  EXPECT_EQ(output_error(outputs, dir_, m, small_info()),
+            "input: /outputs/1/path: writes " + (dir_ / "a.h5").string() + ", which /outputs/0 writes too");
+}
+
+TEST_F(OutputSetTest, TwoOutputsCannotWriteOneFile) {
+  const TreeModel m = small_model();
+  std::vector<OutputOptions> outputs{output("obj", "tree"), output("pc2", "tree.pc2")};
+  outputs[1].pointer = "/outputs/1";
+  try {
+    OutputSet set(outputs, dir_, m, small_info());
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "/outputs/1/path: writes " + (dir_ / "tree.rest.obj").string() +
+                                         ", which /outputs/0 writes too");
+  }
+}
+
+TEST_F(OutputSetTest, FailedRenameRemovesEveryTemporary) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info(2, 0);
+  OutputSet set({output("hdf5", "a.h5"), output("obj", "b")}, dir_, m, info);
+  set.begin();
+  set.push(small_frame(m, 0));
+  set.push(small_frame(m, 1));
+  std::filesystem::create_directories(dir_ / "b.0001.obj/occupied");  // appears during the bake
+  try {
+    set.finish();
+    FAIL() << "finished";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind((dir_ / "b.0001.obj").string() + ": a directory appeared at the output "
+                                          "path during the bake", 0), 0u) << e.what();
+  }
+  // a.h5 and b.rest.obj, b.0000.obj were renamed before the failure: whole files. No temporary stays.
+  for (const std::string& name : entries()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;
+}
+
+TEST_F(OutputSetTest, WriterFailureSurfacesInPush) {
+  const TreeModel m = small_model();
+  OutputSet set({output("obj", "seq/tree")}, dir_, m, small_info(50, 0));
+  set.begin();
+  std::filesystem::remove_all(dir_ / "seq");  // the writer thread can no longer create files
+  try {
+    for (long long f = 0; f < 50; ++f) set.push(small_frame(m, f));
+    set.finish();
+    FAIL() << "no error";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find((dir_ / "seq/tree.0000.obj").string() + ": cannot create"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(OutputSetTest, GlbOverFourGibIsRefusedWithTheFramesThatFit) {
+  TreeModel m = small_model();
+  m.rest_positions = Eigen::Matrix3Xd::Zero(3, 100000);  // only the counts matter for the size
+  m.triangles.clear();
+  const BakeInfo info = small_info(4000, 0);
+  const std::string error = output_error({output("glb", "anim.glb")}, dir_, m, info);
+  char size[32];
+  std::snprintf(size, sizeof size, "%.2f GiB", double(animated_glb_bytes(m, info, 1)) / double(1ull << 30));
+  const std::string expected = (dir_ / "anim.glb").string() + ": the animated GLB would be " + size +
+                               " (100000 vertices x 4000 frames), over glTF's 4 GiB GLB limit; at most ";
+  ASSERT_EQ(error.rfind(expected, 0), 0u) << error;
+  const long long fits = std::stoll(error.substr(expected.size()));
+  BakeInfo shorter = info;
+  shorter.frame_count = fits;
+  EXPECT_LE(animated_glb_bytes(m, shorter, 1), kGlbMaxBytes);
+  shorter.frame_count = fits + 1;
+  EXPECT_GT(animated_glb_bytes(m, shorter, 1), kGlbMaxBytes);
+  EXPECT_TRUE(entries().empty());
+  // The largest bake a scene may ask for is refused as fast, without memory per frame.
+  BakeInfo longest = info;
+  longest.frame_count = 10000000;
+  EXPECT_NE(output_error({output("glb", "anim.glb")}, dir_, m, longest).find("at most " + std::to_string(fits)),
+            std::string::npos);
+  OutputOptions stepped = output("glb", "anim.glb", 2);  // half the frames fit
+  EXPECT_NO_THROW(OutputSet(std::vector<OutputOptions>{stepped}, dir_, m, info));
+}
+
+}  // namespace
+}  // namespace treeanim

@@ -1,0 +1,16 @@
+// The writers' half of the format table: a sink for every row, and none for another name.
+#include <gtest/gtest.h>
+
+#include "formats/sink_factories.h"
+#include "output/output_formats.h"
+
+namespace treeanim {
+namespace {
+
+TEST(SinkFactories, EveryFormatOfTheTableHasASink) {
+  for (const OutputFormatRow& row : output_formats()) EXPECT_NE(find_sink_factory(row.name), nullptr) << row.name;
+  EXPECT_EQ(find_sink_factory("hdf"), nullptr);
+}
+
+}  // namespace
+}  // namespace treeanim
