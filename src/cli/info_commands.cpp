@@ -5,6 +5,7 @@
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
 #include "formats/output_estimate.h"
+#include "formats/sink_factories.h"
 #include "output/output_formats.h"
 
 namespace treeanim {
@@ -82,9 +83,14 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
               scene.time.frames, scene.time.substeps,
               summary["estimate"]["bytes_per_frame"].get<double>() / 1024.0,
               summary["estimate"]["bytes_positions_total"].get<double>() / (1024.0 * 1024.0));
-  for (const Json& output : outputs)  // formats/output_estimate.h: the frames' data, uncompressed
-    std::printf("output %s (%s): about %.1f MiB of frames\n", output["path"].get<std::string>().c_str(),
-                output["format"].get<std::string>().c_str(), output["bytes"].get<double>() / (1024.0 * 1024.0));
+  for (const Json& output : outputs) {  // formats/output_estimate.h
+    const std::string path = output["path"].get<std::string>(), format = output["format"].get<std::string>();
+    const double mib = output["bytes"].get<double>() / (1024.0 * 1024.0);
+    if (find_planned_bytes(format))  // a format that plans its whole size before simulating
+      std::printf("output %s (%s): at most %.1f MiB in all, planned to fit its limit\n", path.c_str(), format.c_str(), mib);
+    else
+      std::printf("output %s (%s): about %.1f MiB of frames, uncompressed\n", path.c_str(), format.c_str(), mib);
+  }
   return 0;
 }
 
