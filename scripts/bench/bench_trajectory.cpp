@@ -9,6 +9,10 @@
 #include <vector>
 
 #include "bench_common.h"
+#include <optional>
+
+#include "sim/particle_model.h"
+#include "sim/sample_skin.h"
 #include "sim/simulator.h"
 
 using namespace treeanim;
@@ -33,15 +37,23 @@ int main(int argc, char** argv) {
     const Scene scene = load_scene(argv[1], overrides);
     if (frames < 0) frames = scene.time.frames;
     const TreeModel model = bench::scene_model(scene);
-    Simulator sim(model, scene.hsm, scene.wind, 1.0 / scene.time.fps, scene.time.substeps);
+    // hsm.particles "samples": the solver moves the samples, the mesh is placed from them.
+    const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
+    const std::optional<TreeModel> samples = sampled ? std::optional<TreeModel>(sample_tree_model(model)) : std::nullopt;
+    const std::optional<SampleSkin> skin = sampled ? std::optional<SampleSkin>(std::in_place, model, *samples) : std::nullopt;
+    ClusterFrames skin_frames;
+    SimState skinned;
+    Simulator sim(samples ? *samples : model, scene.hsm, scene.wind, 1.0 / scene.time.fps, scene.time.substeps);
     SimState state = sim.initial_state(0);
     std::FILE* file = std::fopen(out.c_str(), "wb");
     if (!file) throw std::runtime_error("cannot write " + out);
     for (long long f = 0; f < frames; ++f) {
       if (f > 0) sim.advance_frame(state, f);
       // Column-major 3 x V: each vertex's x, y, z in turn, as the rows of a V x 3 array.
-      const size_t n = static_cast<size_t>(state.positions.size());
-      if (std::fwrite(state.positions.data(), sizeof(double), n, file) != n) {
+      if (skin) skin->pose(state, false, skin_frames, skinned);
+      const Eigen::Matrix3Xd& positions = skin ? skinned.positions : state.positions;
+      const size_t n = static_cast<size_t>(positions.size());
+      if (std::fwrite(positions.data(), sizeof(double), n, file) != n) {
         std::fclose(file);
         throw std::runtime_error("cannot write " + out);
       }

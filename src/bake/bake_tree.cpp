@@ -12,6 +12,7 @@
 #include "common/errors.h"
 #include "common/seconds_since.h"
 #include "files/free_space.h"
+#include "sim/particle_model.h"
 #include "sim/simulator.h"
 
 namespace treeanim {
@@ -47,7 +48,18 @@ FrameData output_frame(const SimState& state, long long frame, bool with_velocit
 // The frame `start.state` holds, converted, journalled when the bake writes checkpoints, pushed.
 void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
                  const TreePlacement* placement) {
-  FrameData data = output_frame(start.state, frame, frames.outputs.wants_velocities(), placement);
+  const bool velocities = frames.outputs.wants_velocities();
+  if (frames.skin && frames.output_count == 0 && plan.checkpoints.every <= 0 && !frames.info.loop) {
+    // Nothing reads the mesh: no vertex is placed; the bounds are the samples'.
+    for (long s = 0; s < start.state.positions.cols(); ++s) {
+      const Eigen::Vector3d x = start.state.positions.col(s);
+      frames.bounds.extend(placement ? Eigen::Vector3d(placement->rotation.transpose() * (x - placement->translation))
+                                     : x);
+    }
+    return;
+  }
+  if (frames.skin) frames.skin->pose(start.state, velocities, frames.skin_frames, frames.skinned);
+  FrameData data = output_frame(frames.skin ? frames.skinned : start.state, frame, velocities, placement);
   if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
   if (plan.checkpoints.every > 0) start.journal->append(data);
   frames.push(std::move(data));
@@ -160,7 +172,13 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
   const std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
-  Simulator simulator(placed ? *placed : tree.model, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
+  const TreeModel& mesh = placed ? *placed : tree.model;
+  // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
+  const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
+  const std::optional<TreeModel> samples = sampled ? std::optional<TreeModel>(sample_tree_model(mesh)) : std::nullopt;
+  const std::optional<SampleSkin> skin = sampled ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
+  if (skin) frames.skin = &*skin;
+  Simulator simulator(samples ? *samples : mesh, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);

@@ -16,6 +16,7 @@
 #include "bake/loop_bake.h"
 #include "formats/outputs.h"
 #include "scene/scene.h"
+#include "sim/sample_skin.h"
 #include "tree/tree_placement.h"
 
 namespace treeanim {
@@ -31,6 +32,11 @@ struct BakeFrames {
 
   const BakeInfo info;
   const size_t output_count;
+  // hsm.particles "samples": the mesh placed from the simulated samples' clusters (null: the
+  // state is the mesh's), and its scratch.
+  const SampleSkin* skin = nullptr;
+  ClusterFrames skin_frames;
+  SimState skinned;
   OutputSet outputs;
   SeamMeter seam;              // a loop baked whole: every frame
   Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame
