@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "sim/rotation.h"
+#include "sim/solver_model.h"
 
 namespace treeanim {
 
@@ -68,7 +69,8 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
     frames.velocity.resize(3, C);
     frames.spin.resize(3, C);
   }
-#pragma omp parallel for schedule(static)
+  // On several threads from as many memberships as the solver's loops (kParallelMemberships).
+#pragma omp parallel for schedule(static) if (fit_samples_.size() >= kParallelMemberships)
   for (long c = 0; c < C; ++c) {
     // A = sum s (d - shift) q^T with d = u + q, u = x - x0: sum s u q^T + the rest moment
     // sum s q q^T - shift (sum s q)^T, s = w k; at rest exactly the symmetric rest moment.
@@ -135,7 +137,7 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
   out.positions.resize(3, V);
   if (velocities) out.velocities.resize(3, V);
   else out.velocities.resize(3, 0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (mesh_.membership_count() >= kParallelMemberships)
   for (long v = 0; v < V; ++v) {
     const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
     if (mesh_.vertex_anchored[v]) {  // fixed to the ground, as the solver holds it
