@@ -66,8 +66,10 @@ struct TreeBakeResult {
   Eigen::AlignedBox3d bounds;                             // m, world box of every written frame's vertices
 };
 
-// The journal of `plan` for a model whose outputs want velocities or not.
-JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities);
+// The journal of `plan` for a model whose outputs want velocities or not, and the clusters'
+// motions (a bake on samples for a skinned output of a joint per cluster) or not.
+JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities,
+                             bool cluster_motions = false);
 
 // Room: the bytes that the outputs and, with checkpoints, the checkpoints and journal records
 // still to write from `start` will take, against the free space of each filesystem they go to

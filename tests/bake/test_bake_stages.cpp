@@ -194,12 +194,14 @@ TEST_F(BakeStages, AResumedBakeWritesTheSameBytes) {
 }
 
 TEST_F(BakeStages, ASampledBakeResumedFromAnEarlierCheckpointWritesTheSameBytes) {
-  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"}])", R"(hsm.particles="samples")",
-                            "lsystem.axiom=\"FFF[+FF]FF\""});
+  // The skinned GLB's keys are the clusters' motions: the journal replays them too.
+  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"},
+                                        {"format": "skinned_glb", "path": "bake.glb"}])",
+                            R"(hsm.particles="samples")", "lsystem.axiom=\"FFF[+FF]FF\""});
   BakeConfig checkpointed = config();
   checkpointed.checkpoints.every = 2;
   ASSERT_EQ(bake_tree(line, checkpointed, nullptr, BakeLog{}).exit_code, 0);
-  const std::string whole = slurp(dir_ / "out" / "bake.pc2");
+  const std::string whole = slurp(dir_ / "out" / "bake.pc2"), skinned = slurp(dir_ / "out" / "bake.glb");
   ASSERT_FALSE(whole.empty());
   // From frame 12: frames 13 and 14 simulated again from the samples' checkpoint.
   fs::remove(checkpoint_path(dir_ / "checkpoints", 14));
@@ -207,6 +209,7 @@ TEST_F(BakeStages, ASampledBakeResumedFromAnEarlierCheckpointWritesTheSameBytes)
   const TreeBakeResult resumed = bake_tree(line, checkpointed, nullptr, BakeLog{});
   EXPECT_EQ(resumed.substeps, 2 * 2);
   EXPECT_EQ(slurp(dir_ / "out" / "bake.pc2"), whole);
+  EXPECT_EQ(slurp(dir_ / "out" / "bake.glb"), skinned);
   // The samples' state is what a checkpoint holds: smaller than the mesh's.
   BakeConfig vertices = config();
   vertices.checkpoints.every = 2;
