@@ -26,10 +26,13 @@ set(io_options_outputs "[{\"format\":\"hdf5\",\"path\":\"plain.h5\",\"normals\":
 {\"format\":\"glb\",\"path\":\"normals.glb\",\"normals\":true},{\"format\":\"mdd\",\"path\":\"tree.mdd\"},\
 {\"format\":\"vat\",\"path\":\"vat/tree\"},{\"format\":\"vat\",\"path\":\"vat_half/tree\",\"precision\":\"half\",\"texture_width\":100},\
 {\"format\":\"skinned_glb\",\"path\":\"skinned.glb\"},{\"format\":\"skinned_glb\",\"path\":\"skinned4.glb\",\"max_joints\":4}]")
-# And a seamless loop of the same tree (tests/clients/scenes/loop.json).
+# And a seamless loop of the same tree (tests/clients/scenes/loop.json); and the scene on samples
+# (hsm.particles "samples"), whose skinned GLB carries the solver's own cluster motions.
 set(io_loop_dir ${io_bake_dir}/loop)
+set(io_samples_dir ${io_bake_dir}/samples)
+set(io_samples_outputs "[{\"format\":\"hdf5\",\"path\":\"plain.h5\"},{\"format\":\"skinned_glb\",\"path\":\"skinned.glb\"}]")
 add_test(NAME io_clients_bake
-         COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}' && exec '$<TARGET_FILE:treeanim>' run '${io_clients}/scenes/loop.json' -o '${io_loop_dir}' --quiet"
+         COMMAND sh -c "rm -rf '${io_bake_dir}' && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_bake_dir}' --quiet && '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_options_dir}' --quiet --set 'outputs=${io_options_outputs}' && '$<TARGET_FILE:treeanim>' run '${io_clients}/scenes/loop.json' -o '${io_loop_dir}' --quiet && exec '$<TARGET_FILE:treeanim>' run '${io_scene}' -o '${io_samples_dir}' --quiet --set 'hsm.particles=\"samples\"' --set hsm.leaf_detach_force=0 --set 'outputs=${io_samples_outputs}'"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(io_clients_bake PROPERTIES LABELS "io;clients" FIXTURES_SETUP io_bake TIMEOUT 120)
 
@@ -63,7 +66,8 @@ io_client_test(io_clients_gltf_validator "${TREEANIM_NODE}" ${io_clients}/node/v
                ${io_bake_dir}/small_tree.glb ${io_bake_dir}/gltf/small_tree.0000.glb
                ${io_bake_dir}/gltf/small_tree.0006.glb ${io_options_dir}/normals.glb
                ${io_options_dir}/gltf/tree.0006.glb ${io_options_dir}/vat/tree.glb ${io_options_dir}/skinned.glb
-               ${io_options_dir}/skinned4.glb ${io_loop_dir}/loop.glb ${io_loop_dir}/skinned.glb)
+               ${io_options_dir}/skinned4.glb ${io_loop_dir}/loop.glb ${io_loop_dir}/skinned.glb
+               ${io_samples_dir}/skinned.glb)
 
 find_program(TREEANIM_BLENDER blender)
 io_client_test(io_clients_blender "${TREEANIM_BLENDER}" -b --factory-startup --python
@@ -83,6 +87,11 @@ io_client_test(io_clients_blender_vat "${TREEANIM_BLENDER}" -b --factory-startup
 io_client_test(io_clients_blender_skinned "${TREEANIM_BLENDER}" -b --factory-startup --python
                ${io_clients}/check_skinned.py -- ${io_options_dir}/plain.h5 ${io_options_dir}/skinned.glb
                ${io_options_dir}/skinned4.glb)
+# A bake on samples: its skinned GLB's keys are the solver's cluster motions, the mesh's own
+# placement, so the armature reproduces the bake to float rounding at every vertex that is not
+# anchored (--exact), with leaves detaching off (a skin's weights cannot let a leaf go).
+io_client_test(io_clients_blender_skinned_samples "${TREEANIM_BLENDER}" -b --factory-startup --python
+               ${io_clients}/check_skinned.py -- --exact ${io_samples_dir}/plain.h5 ${io_samples_dir}/skinned.glb)
 
 # A bad output path is refused before simulating, with exit code 4 and the path named.
 add_test(NAME io_cli_unwritable_output

@@ -1,6 +1,8 @@
 // Solver timing (not a test): scene file => grown tree => time per substep at the given
 // thread counts, peak memory, and the speed of a calm, settled half.
-//   bench_sim SCENE [--frames N] [--threads 1,2] [--precision float|double] [--calm-half]
+//   bench_sim SCENE [--frames N] [--threads 1,2] [--precision float|double] [--particles vertices|samples]
+//             [--calm-half]
+// With samples (hsm.particles) the counts and times are the samples' (docs/solver.md, "Particles").
 #include <omp.h>
 #include <sys/resource.h>
 
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "sim/particle_model.h"
 #include "sim/simulator.h"
 #include "sim/stiffness.h"
 
@@ -38,8 +41,9 @@ int main(int argc, char** argv) {
   std::vector<int> threads{1, 2};
   bool calm_half = false;
   std::string precision;  // empty: the scene's /hsm/precision
+  std::string particles;  // empty: the scene's /hsm/particles
   const bool parsed = bench::parse_arguments(
-      argc, argv, "[--frames N] [--threads 1,2] [--precision float|double] [--calm-half]", frames,
+      argc, argv, "[--frames N] [--threads 1,2] [--precision float|double] [--particles vertices|samples] [--calm-half]", frames,
       [&](const std::string& arg, int& i) {
         if (arg == "--threads" && i + 1 < argc) {
           threads.clear();
@@ -48,6 +52,9 @@ int main(int argc, char** argv) {
         } else if (arg == "--precision" && i + 1 < argc &&
                    (std::string(argv[i + 1]) == "float" || std::string(argv[i + 1]) == "double")) {
           precision = argv[++i];
+        } else if (arg == "--particles" && i + 1 < argc &&
+                   (std::string(argv[i + 1]) == "vertices" || std::string(argv[i + 1]) == "samples")) {
+          particles = argv[++i];
         } else if (arg == "--calm-half") {
           calm_half = true;
         } else {
@@ -59,7 +66,10 @@ int main(int argc, char** argv) {
   try {
     Scene scene = load_scene(argv[1], {});
     if (!precision.empty()) scene.hsm.precision = precision == "float" ? Precision::kFloat : Precision::kDouble;
-    const TreeModel model = bench::scene_model(scene);
+    if (!particles.empty())
+      scene.hsm.particles = particles == "samples" ? ParticleMode::kSamples : ParticleMode::kVertices;
+    const TreeModel model = scene.hsm.particles == ParticleMode::kSamples ? sample_tree_model(bench::scene_model(scene))
+                                                                          : bench::scene_model(scene);
     const double frame_dt = 1.0 / scene.time.fps;
     const int substeps = scene.time.substeps;
     const StepRates rates = compute_step_rates(model, scene.hsm, frame_dt / substeps);

@@ -12,6 +12,7 @@
 #include "common/errors.h"
 #include "common/seconds_since.h"
 #include "files/free_space.h"
+#include "sim/particle_model.h"
 #include "sim/simulator.h"
 
 namespace treeanim {
@@ -44,10 +45,45 @@ FrameData output_frame(const SimState& state, long long frame, bool with_velocit
   return data;
 }
 
+// Each cluster's frame (x = R (x0 - t0) + t0 + shift, where the tree stands) => the motion
+// x = R x0 + t in the tree's own frame, as floats (FrameData::cluster_motions).
+void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& rest_centres,
+                         const TreePlacement* placement, FrameData& data) {
+  const long C = frames.rotation.cols();
+  data.cluster_motions.resize(7 * size_t(C));
+  const TreePlacement identity;
+  const TreePlacement& p = placement ? *placement : identity;
+  for (long c = 0; c < C; ++c) {
+    const Eigen::Vector4d q = frames.rotation.col(c);
+    const Eigen::Quaterniond world(q[3], q[0], q[1], q[2]);
+    const Eigen::Matrix3d R = world.toRotationMatrix();
+    const Eigen::Vector3d t = rest_centres.col(c) + frames.shift.col(c) - R * rest_centres.col(c);
+    // Own frame: x = P^T (R (P x0 + p) + t - p) = (P^T R P) x0 + P^T (R p + t - p).
+    const Eigen::Quaterniond own = Eigen::Quaterniond(p.rotation.transpose()) * world * Eigen::Quaterniond(p.rotation);
+    const Eigen::Vector3d shift = p.rotation.transpose() * (R * p.translation + t - p.translation);
+    float* out = &data.cluster_motions[7 * size_t(c)];
+    for (int k = 0; k < 4; ++k) out[k] = float(own.coeffs()[k]);
+    for (int k = 0; k < 3; ++k) out[4 + k] = float(shift[k]);
+  }
+}
+
 // The frame `start.state` holds, converted, journalled when the bake writes checkpoints, pushed.
 void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
                  const TreePlacement* placement) {
-  FrameData data = output_frame(start.state, frame, frames.outputs.wants_velocities(), placement);
+  const bool velocities = frames.outputs.wants_velocities();
+  if (frames.skin && frames.output_count == 0 && plan.checkpoints.every <= 0 && !frames.info.loop) {
+    // Nothing reads the mesh: no vertex is placed; the bounds are the samples'.
+    for (long s = 0; s < start.state.positions.cols(); ++s) {
+      const Eigen::Vector3d x = start.state.positions.col(s);
+      frames.bounds.extend(placement ? Eigen::Vector3d(placement->rotation.transpose() * (x - placement->translation))
+                                     : x);
+    }
+    return;
+  }
+  if (frames.skin) frames.skin->pose(start.state, velocities, frames.skin_frames, frames.skinned);
+  FrameData data = output_frame(frames.skin ? frames.skinned : start.state, frame, velocities, placement);
+  if (frames.skin && frames.outputs.wants_cluster_motions())
+    add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
   if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
   if (plan.checkpoints.every > 0) start.journal->append(data);
   frames.push(std::move(data));
@@ -78,8 +114,9 @@ void BakeFrames::push(FrameData data) {
   outputs.push(std::move(data));
 }
 
-JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities) {
-  return {plan.key.scene_hash, plan.written.first, model.vertex_count(), model.leaf_count(), velocities};
+JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities, bool cluster_motions) {
+  return {plan.key.scene_hash, plan.written.first, model.vertex_count(), model.leaf_count(), velocities,
+          cluster_motions ? model.cluster_count() : 0};
 }
 
 void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
@@ -160,8 +197,15 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
   const std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
-  Simulator simulator(placed ? *placed : tree.model, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
-  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
+  const TreeModel& mesh = placed ? *placed : tree.model;
+  // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
+  const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
+  const std::optional<TreeModel> samples = sampled ? std::optional<TreeModel>(sample_tree_model(mesh)) : std::nullopt;
+  const std::optional<SampleSkin> skin = sampled ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
+  if (skin) frames.skin = &*skin;
+  Simulator simulator(samples ? *samples : mesh, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
+  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
+                                              frames.skin && frames.outputs.wants_cluster_motions());
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);
   if (config.space_check) check_room(plan, start, tree.model, layout, frames);

@@ -16,6 +16,7 @@
 #include "bake/loop_bake.h"
 #include "formats/outputs.h"
 #include "scene/scene.h"
+#include "sim/sample_skin.h"
 #include "tree/tree_placement.h"
 
 namespace treeanim {
@@ -31,6 +32,11 @@ struct BakeFrames {
 
   const BakeInfo info;
   const size_t output_count;
+  // hsm.particles "samples": the mesh placed from the simulated samples' clusters (null: the
+  // state is the mesh's), and its scratch.
+  const SampleSkin* skin = nullptr;
+  ClusterFrames skin_frames;
+  SimState skinned;
   OutputSet outputs;
   SeamMeter seam;              // a loop baked whole: every frame
   Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame
@@ -60,8 +66,10 @@ struct TreeBakeResult {
   Eigen::AlignedBox3d bounds;                             // m, world box of every written frame's vertices
 };
 
-// The journal of `plan` for a model whose outputs want velocities or not.
-JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities);
+// The journal of `plan` for a model whose outputs want velocities or not, and the clusters'
+// motions (a bake on samples for a skinned output of a joint per cluster) or not.
+JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities,
+                             bool cluster_motions = false);
 
 // Room: the bytes that the outputs and, with checkpoints, the checkpoints and journal records
 // still to write from `start` will take, against the free space of each filesystem they go to

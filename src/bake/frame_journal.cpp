@@ -1,7 +1,8 @@
 // Journal layout (little-endian, docs/checkpoint.md): a 64-byte header, magic "TAJOURN1",
-// u64 record bytes, i64 first frame, u64 V, u64 L, u8 velocities, padding, then the FNV-1a
-// scene hash as 24 bytes of text; then fixed-size records: i64 frame, f64 time,
-// f32 positions (V x 3), f32 velocities (V x 3, when recorded), u8 leaf flags (L).
+// u64 record bytes, i64 first frame, u64 V, u64 L, u8 velocities, padding, u64 motion clusters
+// C, padding, then the FNV-1a scene hash as 24 bytes of text; then fixed-size records: i64 frame,
+// f64 time, f32 positions (V x 3), f32 velocities (V x 3, when recorded), u8 leaf flags (L),
+// f32 cluster motions (C x 7, when recorded).
 #include "bake/frame_journal.h"
 
 #include <unistd.h>
@@ -34,6 +35,7 @@ std::vector<unsigned char> header_bytes(const JournalLayout& layout, uint64_t re
   std::memcpy(&header[24], &layout.vertices, 8);
   std::memcpy(&header[32], &layout.leaves, 8);
   header[40] = layout.velocities ? 1 : 0;
+  std::memcpy(&header[48], &layout.motion_clusters, 8);
   std::memcpy(&header[64], layout.scene_hash.data(), std::min(layout.scene_hash.size(), kHashBytes));
   return header;
 }
@@ -61,7 +63,7 @@ FrameJournal::~FrameJournal() {
 }
 
 uint64_t journal_record_bytes(const JournalLayout& layout) {
-  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves;
+  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves + 28 * layout.motion_clusters;
 }
 
 FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {
@@ -96,13 +98,16 @@ FrameData FrameJournal::read(long long index) {
   frame.positions.resize(n);
   if (layout_.velocities) frame.velocities.resize(n);
   frame.leaf_attached.resize(layout_.leaves);
+  const size_t motions = 7 * layout_.motion_clusters;
+  frame.cluster_motions.resize(motions);
   int64_t number = 0;
   const bool ok =
       index < records_ && std::fseek(file_, long(kHeaderBytes + uint64_t(index) * record_bytes()), SEEK_SET) == 0 &&
       std::fread(&number, 8, 1, file_) == 1 && std::fread(&frame.time, 8, 1, file_) == 1 &&
       std::fread(frame.positions.data(), 4, n, file_) == n &&
       (!layout_.velocities || std::fread(frame.velocities.data(), 4, n, file_) == n) &&
-      std::fread(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves;
+      std::fread(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves &&
+      std::fread(frame.cluster_motions.data(), 4, motions, file_) == motions;
   frame.frame = number;
   if (!ok || number != layout_.first_frame + index)
     throw InputError(path_.string() + ": record " + std::to_string(index) + " of the frame journal is damaged");
@@ -119,14 +124,16 @@ void FrameJournal::truncate(long long count) {
 
 void FrameJournal::append(const FrameData& frame) {
   const int64_t number = frame.frame;
-  const size_t n = 3 * layout_.vertices;
+  const size_t n = 3 * layout_.vertices, motions = 7 * layout_.motion_clusters;
   const bool ok = std::fseek(file_, 0, SEEK_END) == 0 && std::fwrite(&number, 8, 1, file_) == 1 &&
                   std::fwrite(&frame.time, 8, 1, file_) == 1 && frame.positions.size() == n &&
                   std::fwrite(frame.positions.data(), 4, n, file_) == n &&
                   (!layout_.velocities || (frame.velocities.size() == n &&
                                            std::fwrite(frame.velocities.data(), 4, n, file_) == n)) &&
                   frame.leaf_attached.size() == layout_.leaves &&
-                  std::fwrite(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves;
+                  std::fwrite(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves &&
+                  frame.cluster_motions.size() == motions &&
+                  std::fwrite(frame.cluster_motions.data(), 4, motions, file_) == motions;
   if (!ok) throw OutputError(io_failure(path_, "cannot append to the frame journal"));
   ++records_;
 }

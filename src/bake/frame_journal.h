@@ -19,9 +19,11 @@ struct JournalLayout {
   uint64_t vertices = 0;        // V: positions (and velocities) per record
   uint64_t leaves = 0;          // L: leaf flags per record
   bool velocities = false;      // records hold velocities (an output asked for them)
+  uint64_t motion_clusters = 0; // C when records hold the clusters' motions (FrameData::cluster_motions), else 0
 };
 
-// A layout => the bytes of one record: frame, time, positions (and velocities), leaf flags.
+// A layout => the bytes of one record: frame, time, positions (and velocities), leaf flags
+// (and cluster motions).
 uint64_t journal_record_bytes(const JournalLayout& layout);
 
 class FrameJournal {
@@ -41,7 +43,7 @@ class FrameJournal {
   FrameData read(long long index);
   // Keeps the first `count` records; the next append() follows them. Throws OutputError.
   void truncate(long long count);
-  // Appends one frame (positions, velocities when the layout has them, leaf flags).
+  // Appends one frame (positions, velocities and cluster motions when the layout has them, leaf flags).
   void append(const FrameData& frame);
   // Flushes the records to disk (before a checkpoint names them as written). Throws OutputError.
   void sync();

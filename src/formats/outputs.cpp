@@ -102,6 +102,7 @@ struct OutputSet::Impl {
   std::vector<std::unique_ptr<Worker>> workers;
   bool velocities = false;
   bool normals = false;
+  bool cluster_motions = false;
   std::vector<float> rest_normals;  // (V*3) fallback of vertices on no triangle of non-zero area
   bool leaf_flags = false;  // some output writes the leaves' attached flags
   bool done = false;  // finished or aborted
@@ -176,6 +177,7 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
                                                      model.cluster_count(), info.frame_count);
     impl_->velocities = impl_->velocities || options.velocities;
     impl_->normals = impl_->normals || options.normals;
+    impl_->cluster_motions = impl_->cluster_motions || joint_per_cluster(options, model.cluster_count());
     impl_->leaf_flags = impl_->leaf_flags || options.format->leaf_flags;
     impl_->workers.push_back(std::move(worker));
   }
@@ -195,6 +197,8 @@ OutputSet::~OutputSet() {
 
 bool OutputSet::wants_velocities() const { return impl_->velocities; }
 
+bool OutputSet::wants_cluster_motions() const { return impl_->cluster_motions; }
+
 void OutputSet::begin() {
   try {
     for (auto& worker : impl_->workers) worker->sink->begin();
@@ -207,7 +211,9 @@ void OutputSet::begin() {
 
 void OutputSet::push(FrameData frame) {
   const size_t n = 3 * impl_->model.vertex_count();
+  const size_t motions = frame.cluster_motions.size();
   if (frame.positions.size() != n || (impl_->velocities && frame.velocities.size() != n) ||
+      (motions != 0 && motions != 7 * impl_->model.cluster_count()) ||
       (impl_->leaf_flags && frame.leaf_attached.size() != impl_->model.leaf_count()))
     throw std::logic_error("OutputSet::push: frame " + std::to_string(frame.frame) +
                            " does not match the model (positions " + std::to_string(frame.positions.size()) +

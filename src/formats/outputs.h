@@ -47,6 +47,10 @@ struct FrameData {
   std::vector<float> velocities;       // (V*3) m/s; empty unless some output asked for them
   std::vector<float> normals;          // (V*3) unit; filled by OutputSet::push when an output wants them
   std::vector<uint8_t> leaf_attached;  // (L)
+  // (C*7) each cluster's rigid motion x = R x0 + t as the solver moved it: the quaternion of R
+  // (x, y, z, w), then t (m). Only from a bake on samples (hsm.particles "samples", whose mesh is
+  // placed from these) when an output asks (OutputSet::wants_cluster_motions); else empty.
+  std::vector<float> cluster_motions;
 };
 
 class OutputSet {
@@ -65,6 +69,9 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
 
   bool wants_velocities() const;
+  // Some output takes a joint per cluster (a skinned one without merged limbs): a bake on
+  // samples hands it the clusters' own motions, FrameData::cluster_motions.
+  bool wants_cluster_motions() const;
   // Opens temporaries, writes headers and the rest mesh; starts each sink's writer thread.
   void begin();
   // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.

@@ -24,9 +24,20 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> local_transform(const Skin& skin, co
 
 }  // namespace
 
-void add_skin_frame(const Skin& skin, const TreeModel& model, const float* positions, double time, SkinTrack& track) {
+void add_skin_frame(const Skin& skin, const TreeModel& model, const float* positions,
+                    const std::vector<float>& cluster_motions, double time, SkinTrack& track) {
   track.previous_rotation.resize(skin.joint_count(), Eigen::Quaterniond::Identity());
-  fit_joints(skin, model, positions, track.motions);
+  const size_t J = skin.joint_count();
+  if (J == model.cluster_count() && cluster_motions.size() == 7 * J) {
+    track.motions.resize(J);
+    for (size_t j = 0; j < J; ++j) {
+      const float* m = &cluster_motions[7 * j];
+      track.motions[j].rotation = Eigen::Quaterniond(m[3], m[0], m[1], m[2]).normalized().toRotationMatrix();
+      track.motions[j].translation = Eigen::Vector3d(m[4], m[5], m[6]);
+    }
+  } else {
+    fit_joints(skin, model, positions, track.motions);
+  }
   for (size_t j = 0; j < skin.joint_count(); ++j) {
     const auto [rotation, translation] = local_transform(skin, track.motions, j);
     Eigen::Quaterniond q(rotation);

@@ -3,6 +3,7 @@
 // transform relative to its parent joint, fitted to the bake (formats/skin_fit.h), and the error of
 // the skinned mesh against the bake. The skinned GLB and the UsdSkel layer write the same keys.
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,11 @@ struct SkinTrack {
 };
 
 // One baked frame (V*3 float positions at `time` s) => its keys and errors appended to `track`.
-void add_skin_frame(const Skin& skin, const TreeModel& model, const float* positions, double time, SkinTrack& track);
+// The joints' motions are fitted to the positions, or, given `cluster_motions` (FrameData's, the
+// solver's own) and a joint per cluster, taken from them: the mesh of a bake on samples was
+// placed from these, so the skin reproduces it to float rounding.
+void add_skin_frame(const Skin& skin, const TreeModel& model, const float* positions,
+                    const std::vector<float>& cluster_motions, double time, SkinTrack& track);
 
 // How far the skinned mesh strays from the bake over every frame of a track.
 struct SkinError {

@@ -47,7 +47,7 @@ class SkinnedGlbSink final : public FrameSink {
   }
 
   void write(const FrameData& frame) override {
-    add_skin_frame(skin_, model_, frame.positions.data(), frame.time, track_);
+    add_skin_frame(skin_, model_, frame.positions.data(), frame.cluster_motions, frame.time, track_);
   }
 
   void finish() override {

@@ -36,7 +36,7 @@ class SkinnedUsdSink final : public FrameSink {
   void begin() override { file_.emplace(staged_.stage(path_), path_); }
 
   void write(const FrameData& frame) override {
-    add_skin_frame(skin_, model_, frame.positions.data(), frame.time, track_);
+    add_skin_frame(skin_, model_, frame.positions.data(), frame.cluster_motions, frame.time, track_);
   }
 
   void finish() override {

@@ -106,6 +106,7 @@ const std::vector<OutputFormatRow> kFormats = {
      }},
     {.name = "skinned_glb",
      .keys = {kMaxJointsKey},
+     .skinned = true,
      .frame_bytes = skinned_frame_bytes},
     {.name = "usd",
      .keys = {kNormalsKey,
@@ -132,6 +133,10 @@ const std::vector<OutputFormatRow> kFormats = {
 }  // namespace
 
 std::span<const OutputFormatRow> output_formats() { return kFormats; }
+
+bool joint_per_cluster(const OutputOptions& options, size_t clusters) {
+  return (options.format->skinned || options.skinned) && joint_count(options, clusters) == double(clusters);
+}
 
 const OutputFormatRow* find_output_format(const std::string& name) {
   for (const OutputFormatRow& row : kFormats)

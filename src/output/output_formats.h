@@ -32,9 +32,13 @@ struct OutputFormatRow {
   std::vector<OutputKey> keys = {};  // in the order read, the order they take in the resolved scene
   bool always_normals = false;  // writes vertex normals without a `normals` key
   bool leaf_flags = false;      // writes FrameData::leaf_attached
+  bool skinned = false;         // writes joints and their keys (usd: with its `skinned` key)
   // options, mesh size => bytes of one written frame's data, uncompressed (formats/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
 };
+
+// The output writes one joint per cluster (skinned, no limbs merged under max_joints).
+bool joint_per_cluster(const OutputOptions& options, size_t clusters);
 
 // Every format, in the order messages and docs/outputs.md list them.
 std::span<const OutputFormatRow> output_formats();

@@ -105,6 +105,9 @@ HsmOptions read_hsm_options(SceneObject section) {
       static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
   o.precision = section.choice("precision", "double", {"double", "float"}) == "double" ? Precision::kDouble
                                                                                        : Precision::kFloat;
+  o.particles = section.choice("particles", "vertices", {"vertices", "samples"}) == "vertices"
+                    ? ParticleMode::kVertices
+                    : ParticleMode::kSamples;
   // Per-step rates of 0 for both terms leave nothing holding the tree: refuse, not bake a
   // tree that blows away.
   if (o.stiffness == StiffnessMode::kPerStep && o.alpha == 0 && (o.k_d == 0 || !o.global_matching))

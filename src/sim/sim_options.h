@@ -21,6 +21,12 @@ enum class Precision : uint8_t {
   kFloat,   // half the memory traffic; ~1e-7 relative round-off, far below the step's error
 };
 
+// What the solver's particles are (docs/solver.md, "Particles").
+enum class ParticleMode : uint8_t {
+  kVertices,  // every mesh vertex is a particle (the paper's set-up)
+  kSamples,   // a few particles per cluster stand for its vertices; the mesh is skinned per written frame
+};
+
 struct HsmOptions {
   // The scene's /hsm section.
   bool global_matching = true;           // paper Eq. 8 on/off
@@ -44,6 +50,7 @@ struct HsmOptions {
   double sleep_distance = 1e-6;          // m, ... and closer than this to rest => island sleeps
   int rotation_iterations = 12;          // max iterations of the rotation extraction per step
   Precision precision = Precision::kDouble;  // storage of the step state
+  ParticleMode particles = ParticleMode::kVertices;  // what the particles are
 };
 
 // One key of the wind time series; between keys the wind vector speed*direction and the gust

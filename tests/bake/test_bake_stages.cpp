@@ -193,6 +193,41 @@ TEST_F(BakeStages, AResumedBakeWritesTheSameBytes) {
   EXPECT_EQ(slurp(dir_ / "out" / "bake.pc2"), whole);
 }
 
+TEST_F(BakeStages, ASampledBakeResumedFromAnEarlierCheckpointWritesTheSameBytes) {
+  // The skinned GLB's keys are the clusters' motions: the journal replays them too.
+  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"},
+                                        {"format": "skinned_glb", "path": "bake.glb"}])",
+                            R"(hsm.particles="samples")", "lsystem.axiom=\"FFF[+FF]FF\""});
+  BakeConfig checkpointed = config();
+  checkpointed.checkpoints.every = 2;
+  ASSERT_EQ(bake_tree(line, checkpointed, nullptr, BakeLog{}).exit_code, 0);
+  const std::string whole = slurp(dir_ / "out" / "bake.pc2"), skinned = slurp(dir_ / "out" / "bake.glb");
+  ASSERT_FALSE(whole.empty());
+  // From frame 12: frames 13 and 14 simulated again from the samples' checkpoint.
+  fs::remove(checkpoint_path(dir_ / "checkpoints", 14));
+  checkpointed.checkpoints.resume = true;
+  const TreeBakeResult resumed = bake_tree(line, checkpointed, nullptr, BakeLog{});
+  EXPECT_EQ(resumed.substeps, 2 * 2);
+  EXPECT_EQ(slurp(dir_ / "out" / "bake.pc2"), whole);
+  EXPECT_EQ(slurp(dir_ / "out" / "bake.glb"), skinned);
+  // The samples' state is what a checkpoint holds: smaller than the mesh's.
+  BakeConfig vertices = config();
+  vertices.checkpoints.every = 2;
+  vertices.checkpoints.dir = dir_ / "vertex-checkpoints";
+  const Scene mesh = scene({R"(outputs=[{"format": "pc2", "path": "mesh.pc2"}])", "lsystem.axiom=\"FFF[+FF]FF\""});
+  ASSERT_EQ(bake_tree(mesh, vertices, nullptr, BakeLog{}).exit_code, 0);
+  EXPECT_LT(fs::file_size(checkpoint_path(dir_ / "checkpoints", 12)),
+            fs::file_size(checkpoint_path(dir_ / "vertex-checkpoints", 12)));
+}
+
+TEST_F(BakeStages, ASampledBakeWithoutOutputsStillSimulates) {
+  const Scene line = scene({"outputs=[]", R"(hsm.particles="samples")"});
+  const TreeBakeResult result = bake_tree(line, config(), nullptr, BakeLog{});
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_EQ(result.substeps, 4 * 2);
+  EXPECT_GT(result.bounds.max().y(), 2.9);  // the samples' own bounds
+}
+
 TEST_F(BakeStages, ALoopWarmsUpWholePeriods) {
   const Scene line = scene({"time.loop=true"});
   const BakePlan plan = plan_bake(line, config());

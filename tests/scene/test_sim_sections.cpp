@@ -51,6 +51,15 @@ TEST(HsmOptions, ReadsPrecision) {
   EXPECT_NE(error.find("\"float\""), std::string::npos) << error;
 }
 
+TEST(HsmOptions, ReadsParticles) {
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {}})")).particles, ParticleMode::kVertices);
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"particles": "samples"}})")).particles, ParticleMode::kSamples);
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"particles": "vertices"}})")).particles, ParticleMode::kVertices);
+  const std::string error = error_of([] { read_hsm(Json::parse(R"({"hsm": {"particles": "foo"}})")); });
+  EXPECT_NE(error.find("/hsm/particles: expected one of \"vertices\", \"samples\", got \"foo\""), std::string::npos)
+      << error;
+}
+
 TEST(HsmOptions, ReadsPerStepStiffness) {
   const HsmOptions o = read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 0.3, "k_d": 0.05,
                                                        "global_matching": false, "sleep": false}})"));

@@ -17,6 +17,8 @@
 #include "sim/simulator.h"
 #include "sim/solver_model.h"
 #include "sim/solver_step.h"
+#include "sim/particle_model.h"
+#include "sim/sample_skin.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {
@@ -228,7 +230,24 @@ TEST(Beam, AClusterIsMarkedReleasedExactlyWhenItLostAMembership) {
                            [](uint8_t r) { return r != 0; }));
 }
 
-TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
+// The cantilever's mesh after `frames` frames: simulated on its vertices, or on its samples and
+// placed from them (hsm.particles "samples"), the mesh at every frame handed to `visit`.
+template <typename Visit>
+void bake_cantilever(const TreeModel& model, bool samples, const HsmOptions& options, const WindOptions& wind,
+                     int frames, Visit&& visit) {
+  const TreeModel sampled = samples ? sample_tree_model(model) : TreeModel{};
+  const SampleSkin skin(model, samples ? sampled : model);
+  Simulator sim(samples ? sampled : model, options, wind, 1.0 / 240, 4);
+  SimState state = sim.initial_state(0), mesh;
+  ClusterFrames frames_scratch;
+  for (int f = 1; f <= frames; ++f) {
+    sim.advance_frame(state, f);
+    if (samples) skin.pose(state, false, frames_scratch, mesh);
+    visit(samples ? mesh : state);
+  }
+}
+
+void cantilever_bends_like_euler_bernoulli(bool samples) {
   // Uniform drag load q = 1/2 rho Cd (2r) U^2 on a clamped-free beam:
   // delta(x) = q L^4 (x^4 - 4x^3 + 6x^2) / (24 E I), x = s / L. Settled with critical damping.
   const double U = 15;
@@ -239,20 +258,22 @@ TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) {
   const double EI = kModulus * std::numbers::pi * std::pow(kRadius, 4) / 4;
   for (int segments : {8, 16}) {
     const TreeModel model = cantilever(segments);
-    Simulator sim(model, cantilever_options(1.0), wind, 1.0 / 240, 4);
-    SimState state = sim.initial_state(0);
-    for (int f = 1; f <= 480; ++f) sim.advance_frame(state, f);
+    SimState state;
+    bake_cantilever(model, samples, cantilever_options(1.0), wind, 480, [&](const SimState& s) { state = s; });
     for (double x : {0.25, 0.5, 0.75, 1.0}) {
       const double expected = q * std::pow(kLength, 4) * (x * x * x * x - 4 * x * x * x + 6 * x * x) / (24 * EI);
       const double measured = deflection_at(model, state, x * kLength);
-      std::printf("%d segments, x = %.2f L: %.3f mm, Euler-Bernoulli %.3f mm\n", segments, x, 1e3 * measured,
-                  1e3 * expected);
+      std::printf("%s, %d segments, x = %.2f L: %.3f mm, Euler-Bernoulli %.3f mm\n", samples ? "samples" : "vertices",
+                  segments, x, 1e3 * measured, 1e3 * expected);
       EXPECT_NEAR(measured, expected, 0.10 * expected) << segments << " segments, x = " << x;
     }
   }
 }
 
-TEST(Beam, PluckedCantileverSwaysAtItsFirstFrequency) {
+TEST(Beam, CantileverInASteadyWindBendsLikeEulerBernoulli) { cantilever_bends_like_euler_bernoulli(false); }
+TEST(Beam, SampledCantileverInASteadyWindBendsLikeEulerBernoulli) { cantilever_bends_like_euler_bernoulli(true); }
+
+void plucked_cantilever_sways_at_its_first_frequency(bool samples) {
   // f1 = 1.8751^2 / (2 pi L^2) sqrt(E I / (rho A)), within 10 %: a 0.3 s gust, then free
   // vibration, timed by the zero crossings of the tip's deflection over 2 s.
   WindOptions wind;
@@ -262,13 +283,10 @@ TEST(Beam, PluckedCantileverSwaysAtItsFirstFrequency) {
                     std::sqrt(kModulus * kRadius * kRadius / 4 / kDensity);
   for (int segments : {8, 16}) {
     const TreeModel model = cantilever(segments);
-    Simulator sim(model, cantilever_options(0.02), wind, 1.0 / 240, 4);
-    SimState state = sim.initial_state(0);
     double last = 0, first_crossing = -1, last_crossing = -1;
     int crossings = 0;
-    for (int f = 1; f <= 240 * 3; ++f) {
-      sim.advance_frame(state, f);
-      if (state.time < 0.5) continue;
+    bake_cantilever(model, samples, cantilever_options(0.02), wind, 240 * 3, [&](const SimState& state) {
+      if (state.time < 0.5) return;
       const double tip = deflection_at(model, state, kLength);
       if (last != 0 && (tip > 0) != (last > 0)) {
         if (first_crossing < 0) first_crossing = state.time;
@@ -276,13 +294,17 @@ TEST(Beam, PluckedCantileverSwaysAtItsFirstFrequency) {
         ++crossings;
       }
       last = tip;
-    }
+    });
     ASSERT_GE(crossings, 10);
     const double measured = (crossings - 1) / (2 * (last_crossing - first_crossing));
-    std::printf("%d segments: %.3f Hz, Euler-Bernoulli %.3f Hz\n", segments, measured, f1);
+    std::printf("%s, %d segments: %.3f Hz, Euler-Bernoulli %.3f Hz\n", samples ? "samples" : "vertices", segments,
+                measured, f1);
     EXPECT_NEAR(measured, f1, 0.10 * f1) << segments << " segments";
   }
 }
+
+TEST(Beam, PluckedCantileverSwaysAtItsFirstFrequency) { plucked_cantilever_sways_at_its_first_frequency(false); }
+TEST(Beam, SampledPluckedCantileverSwaysAtItsFirstFrequency) { plucked_cantilever_sways_at_its_first_frequency(true); }
 
 }  // namespace
 }  // namespace treeanim

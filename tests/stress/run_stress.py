@@ -5,7 +5,7 @@
   run_stress.py --treeanim BIN ctest-cases          every case marked "ctest"
   run_stress.py --treeanim BIN all-cases            every case
   run_stress.py --treeanim BIN random N [--seed S]  N scenes of scripts/stress-scenes
-  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4, TREEANIM_ISA (double and float)
+  run_stress.py --treeanim BIN determinism          /frames/positions bytes, OMP_NUM_THREADS 1, 2, 4, TREEANIM_ISA (double and float; and on the samples)
 
 A bake passes when treeanim exits 0 and its HDF5 holds only finite positions with every
 attached vertex closer to its rest position than 2.5 times the tree's size (the larger of the
@@ -303,7 +303,7 @@ def run_random(binary, count, seed):
 
 def run_determinism(binary):
     """The demo tree (parallel path: > 4096 memberships), 8 frames in wind, the solver in
-    double and float, and 4 frames of configs/table1-13548.json (float, clusters of ~50
+    double and float, and on its samples (hsm.particles, the mesh placed in parallel), and 4 frames of configs/table1-13548.json (float, clusters of ~50
     members: the chain's eight-lane sums), each at 1, 2 and 4 threads with the portable solver
     loops and at 1 and 2 with each wider instruction set this CPU runs (TREEANIM_ISA,
     docs/solver.md "Instruction sets"); table1-13548 also stepped in cache blocks of 1,024
@@ -311,8 +311,10 @@ def run_determinism(binary):
     demo_wind = {"wind.keys": [{"time": 0, "speed": 12, "direction": [1, 0, 0.3], "gust": 4}],
                  "hsm.leaf_detach_force": 0.3}
     texts = []
+    sampled_wind = {**demo_wind, "hsm.particles": "samples"}  # the mesh placed from the samples
     for scene, precision, frames, extra_sets in (("demo-sparse.json", "double", 8, demo_wind),
                                                   ("demo-sparse.json", "float", 8, demo_wind),
+                                                  ("demo-sparse.json", "double", 8, sampled_wind),
                                                   ("table1-13548.json", "float", 4, {})):
         digests = {}
         with tempfile.TemporaryDirectory(prefix="stress-det-") as tmp:
@@ -334,7 +336,8 @@ def run_determinism(binary):
                     digests[(ran.group(1), threads, blocks)] = f["/frames/positions"][()].tobytes()
         if len(set(digests.values())) != 1:
             return False, f"DIFFERENT /frames/positions across {sorted(map(str, digests))} ({scene}, {precision})"
-        texts.append(f"{scene} {precision} ({len(next(iter(digests.values())))} bytes)")
+        texts.append(f"{scene} {precision}{' samples' if 'hsm.particles' in extra_sets else ''} "
+                     f"({len(next(iter(digests.values())))} bytes)")
     sets_run = sorted({isa for isa, _, _ in digests})
     return True, f"identical /frames/positions for 1, 2, 4 threads, the loops in {', '.join(sets_run)} and " + \
         "cache blocks of 1,024 memberships or none: " + ", ".join(texts)

@@ -1,0 +1,174 @@
+// The mesh of hsm.particles "samples" placed from its clusters' frames (docs/solver.md,
+// "Particles"): a rigid fit per cluster to its samples, then every mesh vertex from its clusters.
+#include "sim/sample_skin.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "sim/rotation.h"
+#include "sim/solver_model.h"
+
+namespace treeanim {
+
+namespace {
+
+// Iterations of the frame's rotation: warm-started from the solver's last fit of the same
+// samples, it converges in one or two.
+constexpr int kFrameIterations = 12;
+
+}  // namespace
+
+SampleSkin::SampleSkin(const TreeModel& mesh, const TreeModel& samples) : mesh_(mesh), samples_(samples) {
+  const size_t C = samples.cluster_count(), V = mesh.vertex_count();
+  fit_offsets_.assign(1, 0);
+  rest_centre_.setZero(3, long(C));
+  match_scale_.assign(C, 0);
+  std::vector<Eigen::Vector3d> offsets;
+  for (size_t c = 0; c < C; ++c) {
+    // A branch fits its own samples: a leaf's shared vertex moves with the leaf as well.
+    const int32_t leaf = samples.cluster_kind[c] == kClusterLeaf ? samples.cluster_leaf[c] : -1;
+    const size_t first = fit_samples_.size();
+    double mass = 0;
+    for (uint32_t i = samples.cluster_offsets[c]; i < samples.cluster_offsets[c + 1]; ++i) {
+      const uint32_t s = samples.cluster_members[i];
+      if (samples.vertex_leaf[s] != leaf) continue;
+      fit_samples_.push_back(s);
+      mass += samples.vertex_mass[s];
+    }
+    if (fit_samples_.size() == first)  // none of its own: every member
+      for (uint32_t i = samples.cluster_offsets[c]; i < samples.cluster_offsets[c + 1]; ++i) {
+        fit_samples_.push_back(samples.cluster_members[i]);
+        mass += samples.vertex_mass[samples.cluster_members[i]];
+      }
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (size_t k = first; k < fit_samples_.size(); ++k) {
+      const uint32_t s = fit_samples_[k];
+      fit_weight_.push_back(samples.vertex_mass[s] / mass);
+      centre += fit_weight_.back() * samples.rest_positions.col(s);
+    }
+    rest_centre_.col(long(c)) = centre;
+    double spread = 0;
+    for (size_t k = first; k < fit_samples_.size(); ++k) {
+      offsets.push_back(samples.rest_positions.col(fit_samples_[k]) - centre);
+      spread += fit_weight_[k] * offsets.back().squaredNorm();
+    }
+    match_scale_[c] = spread > 0 ? 1 / spread : 0;
+    fit_offsets_.push_back(uint32_t(fit_samples_.size()));
+  }
+  fit_offset_.resize(3, long(offsets.size()));
+  for (size_t k = 0; k < offsets.size(); ++k) fit_offset_.col(long(k)) = offsets[k];
+  petiole_leaf_.assign(V, -1);
+  for (size_t l = 0; l < mesh.leaf_count(); ++l) petiole_leaf_[mesh.leaf_attachment_vertex[l]] = int32_t(l);
+}
+
+void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrames& frames) const {
+  const long C = long(samples_.cluster_count());
+  frames.rotation.resize(4, C);
+  frames.shift.resize(3, C);
+  if (velocities) {
+    frames.velocity.resize(3, C);
+    frames.spin.resize(3, C);
+  }
+  // On several threads from as many memberships as the solver's loops (kParallelMemberships).
+#pragma omp parallel for schedule(static) if (fit_samples_.size() >= kParallelMemberships)
+  for (long c = 0; c < C; ++c) {
+    // A = sum s (d - shift) q^T with d = u + q, u = x - x0: sum s u q^T + the rest moment
+    // sum s q q^T - shift (sum s q)^T, s = w k; at rest exactly the symmetric rest moment.
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero(), offset_sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d moved = Eigen::Matrix3d::Zero(), rest = Eigen::Matrix3d::Zero();
+    bool at_rest = true;
+    for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k) {
+      const uint32_t s = fit_samples_[k];
+      const Eigen::Vector3d u = state.positions.col(s) - samples_.rest_positions.col(s);
+      const Eigen::Vector3d q = fit_offset_.col(k);
+      const double w = fit_weight_[k];
+      at_rest = at_rest && u.isZero(0);
+      shift += w * u;
+      offset_sum += w * q;
+      moved += (w * u) * q.transpose();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) rest(i, j) += w * (q[i] * q[j]);
+    }
+    Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+    if (!at_rest) {
+      const Eigen::Matrix3d A = (moved + rest - shift * offset_sum.transpose()) * match_scale_[c];
+      const Eigen::Vector4d warm = state.cluster_rotations.col(c);
+      rotation = Eigen::Quaterniond(warm[3], warm[0], warm[1], warm[2]);
+      if (!(rotation.norm() > 0.5)) rotation = Eigen::Quaterniond::Identity();
+      rotation.normalize();
+      extract_rotation(A, rotation, kFrameIterations);
+    }
+    frames.rotation.col(c) = rotation.coeffs();
+    frames.shift.col(c) = shift;
+    if (!velocities) continue;
+    // The rigid motion nearest the samples' velocities: the centre's, and the spin whose
+    // angular momentum about the centre is theirs.
+    const Eigen::Matrix3d R = rotation.toRotationMatrix();
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero(), momentum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+    for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k)
+      velocity += fit_weight_[k] * state.velocities.col(fit_samples_[k]);
+    for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k) {
+      const Eigen::Vector3d r = R * fit_offset_.col(k);
+      const double w = fit_weight_[k];
+      momentum += w * r.cross(state.velocities.col(fit_samples_[k]) - velocity);
+      inertia += w * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    }
+    Eigen::Vector3d spin = Eigen::Vector3d::Zero();
+    const double size = inertia.trace();
+    if (size > 0 && std::abs(inertia.determinant()) > 1e-9 * size * size * size) spin = inertia.inverse() * momentum;
+    frames.velocity.col(c) = velocity;
+    frames.spin.col(c) = spin;
+  }
+}
+
+void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& frames, SimState& out) const {
+  fit_frames(state, velocities, frames);
+  const long V = long(mesh_.vertex_count()), C = long(samples_.cluster_count());
+  // (R - I) per cluster, column-major, so each vertex reads nine numbers.
+  Eigen::Matrix<double, 9, Eigen::Dynamic> turn(9, C);
+  for (long c = 0; c < C; ++c) {
+    const Eigen::Vector4d q = frames.rotation.col(c);
+    Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).toRotationMatrix();
+    if (q == Eigen::Vector4d(0, 0, 0, 1)) R.setIdentity();
+    R -= Eigen::Matrix3d::Identity();
+    turn.col(c) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());
+  }
+  out.positions.resize(3, V);
+  if (velocities) out.velocities.resize(3, V);
+  else out.velocities.resize(3, 0);
+#pragma omp parallel for schedule(static) if (mesh_.membership_count() >= kParallelMemberships)
+  for (long v = 0; v < V; ++v) {
+    const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
+    if (mesh_.vertex_anchored[v]) {  // fixed to the ground, as the solver holds it
+      out.positions.col(v) = x0;
+      if (velocities) out.velocities.col(v).setZero();
+      continue;
+    }
+    Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
+    int count = 0;
+    const int32_t leaf = petiole_leaf_[v];
+    // A detached leaf's shared vertex keeps the side it was built for (detachment.cpp).
+    const bool released = leaf >= 0 && !state.leaf_attached[leaf];
+    const bool goes_with_leaf = released && mesh_.vertex_leaf[v] == leaf;
+    for (uint32_t k = mesh_.vertex_cluster_offsets[v]; k < mesh_.vertex_cluster_offsets[v + 1]; ++k) {
+      const uint32_t c = mesh_.member_cluster[mesh_.vertex_memberships[k]];
+      if (released && (c == mesh_.leaf_cluster[leaf]) != goes_with_leaf) continue;
+      const Eigen::Vector3d arm = x0 - rest_centre_.col(c);
+      const Eigen::Map<const Eigen::Matrix3d> turned(&turn(0, c));
+      move += turned * arm + frames.shift.col(c);
+      if (velocities) speed += frames.velocity.col(c) + frames.spin.col(c).cross(turned * arm + arm);
+      ++count;
+    }
+    if (count > 1) {
+      move /= count;
+      speed /= count;
+    }
+    out.positions.col(v) = x0 + move;
+    if (velocities) out.velocities.col(v) = speed;
+  }
+  out.time = state.time;
+  out.leaf_attached = state.leaf_attached;
+}
+
+}  // namespace treeanim
