@@ -2,6 +2,7 @@
 // by the OpenVDB library itself (python3-openvdb, tests/volume/write_volumes.py) in the
 // layouts Houdini and Blender write, read and sampled as the solver samples its air.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include "common/errors.h"
 #include "sim/simulator.h"
 #include "sim/solver_step.h"
+#include "sim/grown_tree.h"
 #include "sim/sim_test_models.h"
 #include "sim/tip_motion.h"
 #include "temp_folder_test.h"
@@ -44,6 +46,18 @@ class WindVolumeTest : public TempFolderTest {
     return volume;
   }
 };
+
+TEST(WindVolume, FramePatternsNameTheFilesAsHoudiniAndPrintfDo) {
+  EXPECT_EQ(volume_frame_path("smoke/vel.####.vdb", 7), "smoke/vel.0007.vdb");
+  EXPECT_EQ(volume_frame_path("smoke/vel.####.vdb", 12345), "smoke/vel.12345.vdb");
+  EXPECT_EQ(volume_frame_path("smoke/vel.####.vdb", -1), "smoke/vel.-001.vdb");
+  EXPECT_EQ(volume_frame_path("cache#1/fluid_data_%04d.vdb", 3), "cache#1/fluid_data_0003.vdb");
+  EXPECT_EQ(volume_frame_path("vel.%d.vdb", 42), "vel.42.vdb");
+  EXPECT_EQ(volume_frame_path("still/vel.vdb", 42), "still/vel.vdb");  // one volume for all time
+  VolumeOptions still;
+  still.path = "still/vel.vdb";
+  EXPECT_EQ(volume_frames_at(still, 12.5).first, still.first_frame);
+}
 
 // The solver's air at every cluster of `model` at time t (no flying leaf): set_air_time and
 // sample_cluster_air as a step calls them.
@@ -162,6 +176,26 @@ TEST_F(WindVolumeTest, AGustFrontReachesEachTreeOfAForestInTurnAndPushesItDownwi
   }
   EXPECT_LT(moved_at[0], moved_at[1]);
   EXPECT_LT(moved_at[1], moved_at[2]);
+}
+
+TEST_F(WindVolumeTest, IdenticalBytesFor1And2And4Threads) {
+  // Every sample is a pure function of position and time: the same bytes at any thread count.
+  const TreeModel model = testing::grown_tree(7, 2, 2);
+  WindOptions wind;
+  wind.volume = write("shear", "split", "shear", "--frames 1 13 --voxel 0.5 --lower -6 0 -6 --upper 6 10 6");
+  std::vector<Eigen::Matrix3Xd> results;
+  const int saved = omp_get_max_threads();
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    Simulator sim(model, HsmOptions{}, wind, 1.0 / 24, 3);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 12; ++f) sim.advance_frame(state, f);
+    results.push_back(state.positions);
+  }
+  omp_set_num_threads(saved);
+  EXPECT_GT((results[0] - model.rest_positions).cwiseAbs().maxCoeff(), 1e-4);  // the wind moved it
+  EXPECT_EQ(results[0], results[1]);
+  EXPECT_EQ(results[0], results[2]);
 }
 
 }  // namespace
