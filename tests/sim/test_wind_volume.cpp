@@ -98,7 +98,7 @@ TEST_F(WindVolumeTest, AShearedVolumeGivesTheAnalyticWindAtTheAirPointsInEveryLa
   RecordProperty("largest_error_m_per_s", figure(worst));
 }
 
-TEST_F(WindVolumeTest, LinearInTimeBetweenFramesAndOnlyTheNeededFramesAreRead) {
+TEST_F(WindVolumeTest, LinearInTimeBetweenFramesAndAFrameMissingIsNamed) {
   // Frame k (from 1) blows 8 + (k - 1) m/s; the volume at 12 fps, the scene at 24.
   WindOptions wind;
   wind.volume = write("steps", "houdini", "steps", "--frames 1 3 --fps 12 --voxel 1");
