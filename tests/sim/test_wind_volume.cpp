@@ -4,14 +4,16 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <cstdlib>
+#include <numbers>
 #include <string>
 
 #include "common/errors.h"
+#include "sim/grown_tree.h"
 #include "sim/simulator.h"
 #include "sim/solver_step.h"
-#include "sim/grown_tree.h"
 #include "sim/sim_test_models.h"
 #include "sim/tip_motion.h"
 #include "temp_folder_test.h"
@@ -96,6 +98,32 @@ TEST_F(WindVolumeTest, AShearedVolumeGivesTheAnalyticWindAtTheAirPointsInEveryLa
     EXPECT_EQ(field.velocity(Eigen::Vector3d(0, 9, 0), 0), Eigen::Vector3d::Zero());
   }
   RecordProperty("largest_error_m_per_s", figure(worst));
+}
+
+TEST_F(WindVolumeTest, OutsideItTheKeysStillAirOrTheEdgeBlowAndItStandsWherePlaced) {
+  // (2 + 1.5 y, 0, 0) over [-4, 4] x [0, 8] x [-4, 4]; the keys blow 3 m/s along +z.
+  WindOptions wind;
+  wind.keys = {{0, 3, {0, 0, 1}, 0}};
+  wind.turbulence_intensity = 0;
+  wind.volume = write("shear", "houdini", "shear", "--frames 1 2 --voxel 0.5");
+  const Eigen::Vector3d above(0.5, 9, 0.5);
+  wind.volume->outside = VolumeOutside::kKeys;
+  EXPECT_TRUE(WindField(wind).velocity(above, 0).isApprox(Eigen::Vector3d(0, 0, 3)));
+  wind.volume->outside = VolumeOutside::kCalm;
+  EXPECT_EQ(WindField(wind).velocity(above, 0), Eigen::Vector3d::Zero());
+  wind.volume->outside = VolumeOutside::kEdge;  // the top voxels' 2 + 1.5 * 8
+  EXPECT_TRUE(WindField(wind).velocity(above, 0).isApprox(Eigen::Vector3d(14, 0, 0)));
+  // Placed: 2 m per unit, turned 90 degrees about +Y, its origin at (10, 0, 5). The cache's
+  // point p is the scene's 10, 0, 5 + R (2 p), and its velocity there is 2 R v(p).
+  wind.volume->outside = VolumeOutside::kCalm;
+  wind.volume->units = 2;
+  wind.volume->rotate = 90;
+  wind.volume->translate = Eigen::Vector3d(10, 0, 5);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Vector3d p(1, 3, -2);
+  const Eigen::Vector3d x = wind.volume->translate + turn * (2 * p);
+  const Eigen::Vector3d expected = 2 * (2 + 1.5 * p.y()) * (turn * Eigen::Vector3d::UnitX());
+  EXPECT_LT((WindField(wind).velocity(x, 0) - expected).norm(), 1e-5) << WindField(wind).velocity(x, 0).transpose();
 }
 
 TEST_F(WindVolumeTest, LinearInTimeBetweenFramesAndAFrameMissingIsNamed) {

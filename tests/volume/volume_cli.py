@@ -12,6 +12,7 @@ at test time by write_volumes.py (python3-openvdb):
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -178,6 +179,15 @@ def check_forest(treeanim, tmp):
     for x, t in zip((-6, 0, 6), moved):
         assert abs(t - (x + 12) / 6) < 0.5, (x, t)
     assert os.path.exists(os.path.join(whole, "forest.html"))
+    # The middle tree's page plots the volume's wind at the tree: still before the front, 12 m/s after.
+    page = open(os.path.join(whole, "t1.html"), encoding="utf-8").read()
+    plot = json.loads(re.search(r'<script id="treeanim-bake" type="application/json">(.*?)</script>', page,
+                                re.S).group(1))["plot"]
+    wind = np.array(plot["wind"]).reshape(-1, 3)
+    times = np.array(plot["time"])
+    before, after = wind[np.argmin(abs(times - 1.0))], wind[np.argmin(abs(times - 3.5))]
+    assert np.linalg.norm(before) < 0.01 and abs(after[0] - 12) < 0.01, (before, after)
+    print(f"the middle tree's page plots the wind {before} m/s at 1 s, {after} m/s at 3.5 s")
     # Three shards give the same bytes as one process.
     shards = os.path.join(tmp, "shards")
     for shard in range(3):
