@@ -111,7 +111,9 @@ VolumeOptions read_volume_options(SceneObject section) {
   o.first_frame = section.integer("first_frame", o.first_frame, -1'000'000'000, 1'000'000'000);
   o.z_up = section.choice("up", "y", {"y", "z"}) == "z";
   const std::string outside = section.choice("outside", "keys", {"keys", "calm", "edge"});
-  o.outside = outside == "keys" ? VolumeOutside::kKeys : outside == "calm" ? VolumeOutside::kCalm : VolumeOutside::kEdge;
+  o.outside = outside == "keys"   ? VolumeOutside::kKeys
+              : outside == "calm" ? VolumeOutside::kCalm
+                                  : VolumeOutside::kEdge;
   // From micrometres to kilometres per unit: a cache in any length unit a tool writes.
   o.units = section.number("units", o.units, Range::between(1e-6, 1000));
   o.rotate = section.number("rotate", o.rotate, Range::between(-360, 360));

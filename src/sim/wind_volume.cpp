@@ -52,7 +52,7 @@ VolumeFrame read_frame(const std::string& path, const std::string& name) {
   std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
-    throw InputError(path + ": the volume frame is missing (no such file)");
+    throw InputError(path + ": the volume frame is missing (no such file, or not a regular file)");
   VolumeFrame frame;
   try {
     openvdb::io::File file(path);
@@ -104,25 +104,6 @@ bool inside_box(const openvdb::CoordBBox& box, openvdb::Vec3d& ijk, bool clamp) 
   return inside || clamp;
 }
 
-// Frame, a point in the volume's own space => its velocity there in volume units (trilinear
-// over the voxel centres); false outside the active voxels (unless clamped to them).
-template <typename Accessors>
-bool sample_volume_space(const VolumeFrame& frame, Accessors& access, const openvdb::Vec3d& p, bool clamp,
-                         openvdb::Vec3d& v) {
-  if (frame.vector) {
-    openvdb::Vec3d ijk = frame.vector->worldToIndex(p);
-    if (!inside_box(frame.box[0], ijk, clamp)) return false;
-    v = openvdb::tools::BoxSampler::sample(access.vector, ijk);
-    return true;
-  }
-  for (int k = 0; k < 3; ++k) {
-    openvdb::Vec3d ijk = frame.split[k]->worldToIndex(p);
-    if (!inside_box(frame.box[k], ijk, clamp)) return false;
-    v[k] = openvdb::tools::BoxSampler::sample(access.split[k], ijk);
-  }
-  return true;
-}
-
 // Read accessors of one thread (an accessor caches its path through the tree; one per thread).
 struct FrameAccessors {
   explicit FrameAccessors(const VolumeFrame& frame)
@@ -142,6 +123,25 @@ struct FrameAccessors {
   std::array<openvdb::FloatGrid::ConstAccessor, 3> split;
 };
 
+// Frame, a point in the volume's own space => its velocity there in volume units (trilinear
+// over the voxel centres); false outside the active voxels (unless clamped to them).
+bool sample_volume_space(const VolumeFrame& frame, FrameAccessors& access, const openvdb::Vec3d& p, bool clamp,
+                         openvdb::Vec3d& v) {
+  if (frame.vector) {
+    openvdb::Vec3d ijk = frame.vector->worldToIndex(p);
+    if (!inside_box(frame.box[0], ijk, clamp)) return false;
+    v = openvdb::tools::BoxSampler::sample(access.vector, ijk);
+    return true;
+  }
+  for (int k = 0; k < 3; ++k) {
+    openvdb::Vec3d ijk = frame.split[k]->worldToIndex(p);
+    if (!inside_box(frame.box[k], ijk, clamp)) return false;
+    v[k] = openvdb::tools::BoxSampler::sample(access.split[k], ijk);
+  }
+  return true;
+}
+
+// A file name with #### or %d is one file per frame; without, one file for all time.
 bool has_frame_number(const std::filesystem::path& pattern) {
   const std::string name = pattern.filename().string();
   return name.find('#') != std::string::npos || name.find('%') != std::string::npos;
@@ -182,7 +182,8 @@ VolumeFrames volume_frames_at(const VolumeOptions& options, double t) {
 
 WindVolume::WindVolume(const VolumeOptions& options) : options_(options) {
   Eigen::Matrix3d up = Eigen::Matrix3d::Identity();
-  if (options.z_up) up << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // (x, y, z) => (x, z, -y), as Blender's glTF exporter turns a scene
+  // (x, y, z) => (x, z, -y), as Blender's glTF exporter turns a scene.
+  if (options.z_up) up << 1, 0, 0, 0, 0, 1, 0, -1, 0;
   const Eigen::Matrix3d turn =
       Eigen::AngleAxisd(options.rotate * std::numbers::pi / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
   to_scene_ = options.units * turn * up;
@@ -215,8 +216,8 @@ bool WindVolume::sample(const VolumeFrame& frame, const Eigen::Vector3d& point, 
   FrameAccessors access(frame);
   const Eigen::Vector3d p = from_scene_ * (point - options_.translate);
   openvdb::Vec3d v;
-  if (!sample_volume_space(frame, access, openvdb::Vec3d(p.x(), p.y(), p.z()), options_.outside == VolumeOutside::kEdge, v))
-    return false;
+  const bool clamp = options_.outside == VolumeOutside::kEdge;
+  if (!sample_volume_space(frame, access, openvdb::Vec3d(p.x(), p.y(), p.z()), clamp, v)) return false;
   velocity = to_scene_ * Eigen::Vector3d(v[0], v[1], v[2]);
   return true;
 }

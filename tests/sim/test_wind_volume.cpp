@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
@@ -176,6 +177,31 @@ TEST_F(WindVolumeTest, AUniformVolumeBakesAsTheSameKeyedWind) {
     RecordProperty(on_top ? "on_top_largest_difference_m" : "alone_largest_difference_m", figure(largest));
     RecordProperty(on_top ? "on_top_largest_sway_m" : "alone_largest_sway_m", figure(sway));
   }
+}
+
+TEST_F(WindVolumeTest, FlyingLeavesFeelTheVolumeWhereTheyAre) {
+  // Leaves that detach sample the volume at their centres each step; held at its edge beyond
+  // the box (`edge`), a uniform 20 m/s volume is the keys' 20 m/s wherever they fly.
+  const TreeModel model = testing::small_tree(6);
+  HsmOptions options;
+  options.leaf_detach_force = 0.01;
+  WindOptions keyed;
+  keyed.keys = {{0, 20, {1, 0, 0}, 0}};
+  keyed.turbulence_intensity = 0;
+  WindOptions volume = keyed;
+  volume.keys.clear();
+  volume.volume = write("uniform", "houdini", "uniform", "--frames 1 25 --voxel 1 --velocity 20 0 0");
+  volume.volume->outside = VolumeOutside::kEdge;
+  std::vector<SimState> states;
+  for (const WindOptions& wind : {keyed, volume}) {
+    Simulator sim(model, options, wind, 1.0 / 24, 4);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 24; ++f) sim.advance_frame(state, f);
+    states.push_back(state);
+  }
+  EXPECT_NE(std::count(states[0].leaf_attached.begin(), states[0].leaf_attached.end(), 0), 0);  // leaves flew
+  EXPECT_EQ(states[0].leaf_attached, states[1].leaf_attached);
+  EXPECT_LE((states[0].positions - states[1].positions).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 TEST_F(WindVolumeTest, AGustFrontReachesEachTreeOfAForestInTurnAndPushesItDownwind) {
