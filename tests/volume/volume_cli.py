@@ -20,6 +20,7 @@ import tempfile
 
 import h5py
 import numpy as np
+import pyopenvdb as vdb
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
@@ -70,7 +71,6 @@ def check_bad(treeanim, tmp):
     scalar = os.path.join(tmp, "scalar")  # 'vel' as a float grid
     write_volume("uniform", "split", scalar, "--frames", "1", "10", "--voxel", "1", "--grid", "vel")
     for frame in range(1, 11):
-        import pyopenvdb as vdb
         path = os.path.join(scalar, f"vel.{frame:04d}.vdb")
         grids = vdb.readAll(path)[0]
         grids[0].name = "vel"
