@@ -26,6 +26,25 @@ void print_counts(const Json& summary) {
               summary["model"]["mass_kg"].get<double>());
 }
 
+// The checked volume (Scene::volume) => its figures, for `info --json`.
+Json volume_json(const VolumeSummary& volume) {
+  return {{"frames", {volume.first_frame, volume.last_frame}},
+          {"layout", volume.layout},
+          {"bounds_min", {volume.lower.x(), volume.lower.y(), volume.lower.z()}},
+          {"bounds_max", {volume.upper.x(), volume.upper.y(), volume.upper.z()}},
+          {"voxel_size", volume.voxel_size},
+          {"largest_speed", volume.largest_speed}};
+}
+
+// The same as a line of text.
+void print_volume(const VolumeSummary& volume) {
+  std::printf("wind volume: frames %lld to %lld, %s, bounds [%g %g %g] .. [%g %g %g] m, voxel %g m, "
+              "largest speed %.3g m/s\n",
+              volume.first_frame, volume.last_frame, volume.layout.c_str(), volume.lower.x(), volume.lower.y(),
+              volume.lower.z(), volume.upper.x(), volume.upper.y(), volume.upper.z(), volume.voxel_size,
+              volume.largest_speed);
+}
+
 }  // namespace
 
 int validate_command(const std::filesystem::path& scene_file,
@@ -37,6 +56,7 @@ int validate_command(const std::filesystem::path& scene_file,
   } else {
     print_counts(tree_summary(scene, prepare_tree(scene)));
   }
+  if (scene.volume) print_volume(*scene.volume);
   std::printf("%s: OK\n", scene_file.string().c_str());
   return 0;
 }
@@ -68,6 +88,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
                        {"path", output.path.string()},
                        {"bytes", estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
                                                         tree.model.cluster_count(), one.time.frames)}});
+  if (scene.volume) summary["wind_volume"] = volume_json(*scene.volume);
   if (format == InfoFormat::kJson) {
     std::cout << summary.dump(2) << "\n";
     return 0;
@@ -91,6 +112,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
     else
       std::printf("output %s (%s): about %.1f MiB of frames, uncompressed\n", path.c_str(), format.c_str(), mib);
   }
+  if (scene.volume) print_volume(*scene.volume);
   return 0;
 }
 

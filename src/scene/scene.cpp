@@ -77,6 +77,21 @@ void check_tree_placeholders(const Scene& scene, const SceneReader& reader) {
   }
 }
 
+// /wind/volume => every frame the scene's times need read and checked before anything is
+// written, or InputError naming the file, grid and voxel.
+VolumeSummary check_volume(const SceneReader& reader, const Scene& scene) {
+  if (scene.time.loop)
+    reader.fail("/wind/volume", "a loop needs a wind that repeats, and a volume's frames do not: leave "
+                                "/time/loop or /wind/volume out");
+  const double t0 = double(scene.time.start) / scene.time.fps;
+  const double t1 = double(scene.time.start + scene.time.frames - 1) / scene.time.fps;
+  try {
+    return check_wind_volume(*scene.wind.volume, t0, t1, kMaxWindSpeed);
+  } catch (const InputError& e) {
+    reader.fail("/wind/volume", e.what());
+  }
+}
+
 }  // namespace
 
 void apply_override(Json& document, const std::string& assignment) {
@@ -164,6 +179,7 @@ Scene load_scene_text(const std::string& text, const std::string& name,
     scene.outputs.push_back(read_output_options(element));
   check_tree_placeholders(scene, reader);
   reader.check_unknown_keys();
+  if (scene.wind.volume) scene.volume = check_volume(reader, scene);
   return scene;
 }
 

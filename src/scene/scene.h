@@ -12,6 +12,7 @@
 #include "scene/forest.h"
 #include "scene/scene_reader.h"
 #include "sim/sim_options.h"
+#include "sim/wind_volume.h"
 #include "tree/tree_options.h"
 
 namespace treeanim {
@@ -36,6 +37,7 @@ struct Scene {
   TimeOptions time;
   std::vector<OutputOptions> outputs;
   std::optional<Forest> forest;  // /forest: many trees; none = the one tree of /lsystem
+  std::optional<VolumeSummary> volume;  // /wind/volume checked over the bake's times: what `info` prints
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a

@@ -1,6 +1,9 @@
 #include "scene/sim_sections.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 
@@ -15,7 +18,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Wind speed and gust amplitude, m/s: no recorded gust exceeds 113 m/s (Barrow Island, 1996), so a
 // larger value is a slip (1,000,000 for 10), not a storm.
-const Range kWindSpeed = Range::between(0, 113);
+const Range kWindSpeed = Range::between(0, kMaxWindSpeed);
 
 // A solver frequency, rad/s: at the shortest step the time keys allow (1000 fps, 10,000 substeps)
 // the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
@@ -72,6 +75,51 @@ std::string order_error(const std::vector<WindKey>& keys, size_t i) {
   if (i == 0 || keys[i].time > keys[i - 1].time) return "";
   return "time " + format_number(keys[i].time) + " must be greater than the previous key's time " +
          format_number(keys[i - 1].time);
+}
+
+// A frame pattern names the frame number at most once, as #### or %d / %0Nd (printf's, so
+// nothing else after a % is let through), at most 18 digits wide (a long long's).
+bool valid_frame_pattern(const std::string& text) {
+  const size_t hash = text.find('#'), percent = text.find('%');
+  if (hash != std::string::npos && percent != std::string::npos) return false;
+  if (hash != std::string::npos) {
+    const size_t end = std::min(text.find_first_not_of('#', hash), text.size());
+    return end - hash <= 18 && text.find('#', end) == std::string::npos;
+  }
+  if (percent == std::string::npos) return true;
+  size_t i = percent + 1;
+  if (i < text.size() && text[i] == '0') ++i;
+  const size_t digits = i;
+  while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
+  return i - digits <= 2 && std::atoi(text.c_str() + digits) <= 18 && i < text.size() && text[i] == 'd' &&
+         text.find('%', i) == std::string::npos;
+}
+
+// /wind/volume => where the volume's frames are, how they are timed and placed.
+VolumeOptions read_volume_options(SceneObject section) {
+  VolumeOptions o;
+  const std::optional<std::filesystem::path> path = section.optional_path("path");
+  if (!path) section.fail("path", "expected the volume's frame files, e.g. \"smoke/vel.####.vdb\"");
+  if (!valid_frame_pattern(path->filename().string()))
+    section.fail("path", "expected one frame number in the file name, as #### or %04d, got '" +
+                             path->filename().string() + "'");
+  o.path = *path;
+  o.grid = section.string("grid", o.grid);
+  if (o.grid.empty()) section.fail("grid", "expected a grid's name, e.g. \"vel\"");
+  // Volume caches are written at a shot's frame rate; as time.fps.
+  o.fps = section.number("fps", o.fps, Range::between(1, 1000));
+  o.first_frame = section.integer("first_frame", o.first_frame, -1'000'000'000, 1'000'000'000);
+  o.z_up = section.choice("up", "y", {"y", "z"}) == "z";
+  const std::string outside = section.choice("outside", "keys", {"keys", "calm", "edge"});
+  o.outside = outside == "keys"   ? VolumeOutside::kKeys
+              : outside == "calm" ? VolumeOutside::kCalm
+                                  : VolumeOutside::kEdge;
+  // From micrometres to kilometres per unit: a cache in any length unit a tool writes.
+  o.units = section.number("units", o.units, Range::between(1e-6, 1000));
+  o.rotate = section.number("rotate", o.rotate, Range::between(-360, 360));
+  // As far as a forest reaches (its spacing is at most 1 km, its trees a few thousand).
+  o.translate = section.vector3("translate", o.translate, Range::between(-1e6, 1e6));
+  return o;
 }
 
 }  // namespace
@@ -198,6 +246,8 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
   o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::between(0, 10));
   o.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0,
                                                  std::numeric_limits<long long>::max()));
+  // Read only when given, so that a scene without it resolves as before.
+  if (section.has("volume")) o.volume = read_volume_options(section.object("volume"));
   return o;
 }
 

@@ -16,6 +16,9 @@ HsmOptions read_hsm_options(SceneObject section);
 // /wind section => wind options. scene_seed is the top-level /seed (turbulence default).
 WindOptions read_wind_options(SceneObject section, uint64_t scene_seed);
 
+// The wind's maximum speed, m/s (docs/scene.md `wind.keys`): a volume's voxels are held to it too.
+constexpr double kMaxWindSpeed = 113;
+
 // CSV text (header "time,speed,dx,dy,dz[,gust]") => keys. `name` prefixes errors
 // ("name:line: ..."). Throws InputError.
 std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name);

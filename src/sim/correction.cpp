@@ -264,7 +264,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
 template <typename Real>
 void predict_from_state(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                         StepScratch<Real>& scratch, long long frame) {
-  set_air_time(model.wind, state.time, model.h, scratch.air);
+  set_air_time(model, state.time, scratch);
   scratch.member_correction.setZero();  // no step was matched: no shape kick (a rare pass)
 #pragma omp parallel for schedule(static) if (model.parallel)
   for (size_t c = 0; c < model.C; ++c) {

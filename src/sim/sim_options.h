@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace treeanim {
@@ -62,6 +63,27 @@ struct WindKey {
   double gust = 0;                       // m/s, amplitude of the temporal gusting along the wind
 };
 
+// What blows outside a wind volume (docs/scene.md `wind.volume`).
+enum class VolumeOutside : uint8_t {
+  kKeys,  // the keyed mean wind (calm without keys)
+  kCalm,  // still air
+  kEdge,  // the nearest voxel's velocity: the volume held beyond its edge
+};
+
+// A velocity volume sequence from a fluid simulation (docs/scene.md `wind.volume`): it replaces
+// the keyed mean wind inside it. Frame F of the sequence blows at scene time (F - first_frame) / fps.
+struct VolumeOptions {
+  std::filesystem::path path;            // the frame files: #### or %04d stands for the frame number; none: one frame for all time
+  std::string grid = "vel";              // a vec3s grid, or the float grids grid.x, grid.y, grid.z
+  double fps = 24;                       // volume frames per second
+  long long first_frame = 1;             // the frame at scene time 0
+  bool z_up = false;                     // a Z-up volume: (x, y, z) => (x, z, -y)
+  VolumeOutside outside = VolumeOutside::kKeys;
+  double units = 1;                      // m per volume unit, for positions and velocities alike
+  double rotate = 0;                     // degrees about +Y, after the up axis is turned
+  Eigen::Vector3d translate{0, 0, 0};    // m, where the volume's origin stands in the scene
+};
+
 struct WindOptions {
   // The scene's /wind section (keys or a CSV file, turbulence, drag).
   std::optional<std::filesystem::path> file;  // the CSV the keys came from, if any
@@ -75,6 +97,7 @@ struct WindOptions {
   int turbulence_modes = 8;                   // sinusoidal modes summed
   double gust_frequency = 0.2;                // Hz, typical gust rate
   uint64_t seed = 1;                          // turbulence and gusts
+  std::optional<VolumeOptions> volume;        // a velocity volume replacing the mean wind inside it
   // A seamless loop (time.loop): > 0 makes the wind periodic with this period (s) from
   // loop_start (s); the keys must give the same wind at both ends (checked by scene/).
   double loop_period = 0;

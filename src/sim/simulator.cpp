@@ -101,7 +101,7 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
       if (model.detach_enabled) detach_leaves(model, attachment, state, scratch);
       // 2, 3. Match the clusters on the predicted positions, branches, then attached leaves;
       // each samples the air of the next step (after the last: the next frame's first).
-      set_air_time(model.wind, last ? start + model.frame_dt : start + (k + 1) * model.h, model.h, scratch.air);
+      set_air_time(model, last ? start + model.frame_dt : start + (k + 1) * model.h, scratch);
       if (model.block_cluster_offsets.empty()) {
         match_clusters(model, attachment, state, scratch, frame, k);
         // 4, 1. Correct, and predict the next step; the last step writes the frame.

@@ -6,6 +6,7 @@
 // is a template on `Real`, what the step state is stored in (docs/solver.md, "Precision").
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -20,6 +21,7 @@
 namespace treeanim {
 
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr long long kNoVolumeFrame = std::numeric_limits<long long>::min();  // StepScratch::volume_sampled: none
 
 // Memberships from which the solver's loops run on several threads: below, the fork/join
 // costs more than the work (results are identical either way).
@@ -218,6 +220,12 @@ struct StepScratch {
   std::vector<double> cluster_damping_lever;  // (C) s, the same joints' sum of compliance C_j S_j . (j_c - j_j)
   std::vector<uint8_t> island_fell_asleep; // (I) islands put to sleep at the end of this frame
   AirSample air;                           // the wind at the time being sampled
+  // --- a wind volume (air.cpp): its frames around the time being sampled, and its velocity at
+  // the clusters' rest centres in the two frames last sampled, kept while the frames are current ---
+  VolumeInstant volume;
+  std::array<long long, 2> volume_sampled{kNoVolumeFrame, kNoVolumeFrame};  // frames of volume_at_rest
+  std::array<Eigen::Matrix3Xd, 2> volume_at_rest;     // (3 x C) m/s, at each cluster's rest centre
+  std::array<std::vector<uint8_t>, 2> volume_inside;  // (C) 1: that centre is inside the frame's volume
 
   explicit StepScratch(const SolverModel<Real>& model);
 };

@@ -11,9 +11,11 @@
 namespace treeanim {
 
 // --- air.cpp ---
-// t, step h => the wind terms every cluster shares at t (mean, gust, turbulence amplitude,
-// phases), each wave averaged over the step (WindField::sample_time).
-void set_air_time(const WindField& wind, double t, double step, AirSample& air);
+// t => the wind terms every cluster shares at t (mean, gust, turbulence amplitude, phases),
+// each wave averaged over the step h (WindField::sample_time); with a volume, its frames
+// around t, sampled at the rest centres when they are new (outside parallel regions: it reads files).
+template <typename Real>
+void set_air_time(const SolverModel<Real>& model, double t, StepScratch<Real>& scratch);
 // Cluster c + air at a time => scratch.cluster_air row c: at its rest centre, or for a
 // flying leaf at the centre of its last fit (t0 + state.cluster_shift).
 template <typename Real>

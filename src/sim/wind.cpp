@@ -32,7 +32,8 @@ WindField::WindField(const WindOptions& options)
     : keys(wind_key_series(options.keys)),
       intensity(options.turbulence_intensity),
       loop_period(options.loop_period),
-      loop_start(options.loop_start) {
+      loop_start(options.loop_start),
+      volume_(options.volume ? std::make_shared<const WindVolume>(*options.volume) : nullptr) {
   // Exact integral of the piecewise-linear mean wind (trapezoids), for the advection of the
   // frozen patterns: a function of t alone, so the field does not depend on the step.
   key_advection.assign(keys.time.size(), Eigen::Vector3d::Zero());
@@ -133,7 +134,7 @@ Eigen::Vector3d WindField::mean(double t) const { return key_mean_wind(keys, key
 
 double WindField::gust_amplitude(double t) const { return key_gust_amplitude(keys, key_time_of(t)); }
 
-bool WindField::calm(double t) const { return mean(t).squaredNorm() == 0; }
+bool WindField::calm(double t) const { return !volume_ && mean(t).squaredNorm() == 0; }
 
 Eigen::Vector3d WindField::advection(double t) const {
   if (!(loop_period > 0)) return key_advection_at(t);
@@ -185,8 +186,9 @@ void WindField::sample_time(double t, double window, AirSample& air) const {
 
 // sin(a + b) = sin(k . (x - D(t)) + w t + phi) for each phase: the turbulence modes along
 // their amplitude vectors, the gust waves averaged into a signal in [-1, 1] along the wind.
-Eigen::Vector3d WindField::velocity(const double* sin_a, const double* cos_a, const AirSample& air) const {
-  Eigen::Vector3d v = air.mean;
+Eigen::Vector3d WindField::velocity(const double* sin_a, const double* cos_a, const AirSample& air,
+                                    const Eigen::Vector3d& mean) const {
+  Eigen::Vector3d v = mean;
   if ((air.gust.array() != 0).any()) {
     double gust = 0;
     for (int j = mode_count(); j < phase_count(); ++j) gust += sin_a[j] * air.cos_b[j] + cos_a[j] * air.sin_b[j];
@@ -206,6 +208,7 @@ Eigen::Vector3d WindField::velocity(const Eigen::Vector3d& x, double t) const {
   spatial_phases(x, sin_a, cos_a);
   AirSample air;
   sample_time(t, 0, air);
+  if (volume_) return velocity(sin_a, cos_a, air, volume_->mean(volume_->at(t), x, air.mean));
   return velocity(sin_a, cos_a, air);
 }
 

@@ -8,10 +8,12 @@
 // options.loop_period > 0 the whole field is periodic (docs/solver.md "A periodic wind for
 // loops"): the keys repeat, and every rate and wave number is rounded to whole cycles.
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "sim/sim_options.h"
 #include "sim/wind_keys.h"
+#include "sim/wind_volume.h"
 
 namespace treeanim {
 
@@ -39,8 +41,11 @@ class WindField {
   int phase_count() const { return static_cast<int>(mode_wave.cols()); }
   // t => mean wind vector (m/s), speed*direction interpolated between keys.
   Eigen::Vector3d mean(double t) const;
-  // t => true when the air is still everywhere (no mean wind, no gust, hence no turbulence).
+  // t => true when the air is still everywhere (no mean wind, no gust, hence no turbulence;
+  // never with a volume, whose air is not known everywhere without reading it).
   bool calm(double t) const;
+  // The velocity volume that replaces the mean wind inside it; null without one.
+  const WindVolume* volume() const { return volume_.get(); }
   // t => amplitude of the gusts along the mean wind (m/s), interpolated between keys.
   double gust_amplitude(double t) const;
   // x (m) => the spatial phase terms sin/cos(k_j . x + phi_j) of every phase, into (phases) arrays.
@@ -51,7 +56,12 @@ class WindField {
   // what the averages left out, as a covariance (AirSample::unresolved).
   void sample_time(double t, double window, AirSample& air) const;
   // Spatial phases of x + the terms at t => the air velocity at (x, t) (m/s).
-  Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air) const;
+  Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air) const {
+    return velocity(sin_a, cos_a, air, air.mean);
+  }
+  // The same about the mean wind `mean` (a volume's at x) in place of air.mean.
+  Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air,
+                           const Eigen::Vector3d& mean) const;
   // x (m), t => the air velocity (m/s); the two calls above for a single point.
   Eigen::Vector3d velocity(const Eigen::Vector3d& x, double t) const;
 
@@ -77,6 +87,7 @@ class WindField {
   double loop_period = 0;                // s; > 0: the field repeats with this period
   double loop_start = 0;                 // s, start of the first period
   Eigen::Vector3d loop_advection = Eigen::Vector3d::Zero();  // m, advection over one period
+  std::shared_ptr<const WindVolume> volume_;  // shared by copies: one cache of frames
 };
 
 }  // namespace treeanim

@@ -15,6 +15,7 @@
 #include "correlation.h"
 #include "grown_tree.h"
 #include "sim_test_models.h"
+#include "tip_motion.h"
 
 namespace treeanim {
 namespace {
@@ -261,21 +262,6 @@ TEST(Behaviour, SleepingBakeMatchesTheFullBake) {
   EXPECT_GT(max_displacement(b, model), 0);
 }
 
-// The tip displacement from rest (m) of a small tree standing at `origin`, every frame of `frames`.
-std::vector<Eigen::Vector3d> tip_motion(const Eigen::Vector3d& origin, const WindOptions& wind, int frames) {
-  const TreeModel model = testing::small_tree(6, origin);
-  Eigen::Index tip = 0;
-  model.rest_positions.row(1).maxCoeff(&tip);
-  Simulator sim(model, HsmOptions{}, wind, 1.0 / 24, 4);
-  SimState state = sim.initial_state(0);
-  std::vector<Eigen::Vector3d> motion;
-  for (int f = 1; f <= frames; ++f) {
-    sim.advance_frame(state, f);
-    motion.push_back(state.positions.col(tip) - model.rest_positions.col(tip));
-  }
-  return motion;
-}
-
 TEST(Behaviour, TheTreeDownwindSwaysLikeTheOneUpwindLater) {
   // Two identical trees 24 m apart along an 8 m/s wind: the gusts and the frozen turbulence
   // (no evolution in place) reach the second 3 s = 72 frames later, and so does its sway once
@@ -288,9 +274,9 @@ TEST(Behaviour, TheTreeDownwindSwaysLikeTheOneUpwindLater) {
   const Eigen::Vector3d upwind(-10, 0, 5);
   const int frames = 24 * 40;
   const size_t settled = 24 * 10;
-  const std::vector<Eigen::Vector3d> a = tip_motion(upwind, wind, frames),
-                                     b = tip_motion(upwind + Eigen::Vector3d(24, 0, 0), wind, frames),
-                                     c = tip_motion(upwind + Eigen::Vector3d(0, 0, 1), wind, frames);
+  const std::vector<Eigen::Vector3d> a = testing::tip_motion(upwind, wind, frames),
+                                     b = testing::tip_motion(upwind + Eigen::Vector3d(24, 0, 0), wind, frames),
+                                     c = testing::tip_motion(upwind + Eigen::Vector3d(0, 0, 1), wind, frames);
   const size_t lag = best_lag(a, b, settled, 24 * 6);
   EXPECT_NEAR(double(lag), 72, 1);
   EXPECT_GT(correlation(a, b, settled, lag), 0.99);
