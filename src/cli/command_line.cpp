@@ -23,6 +23,7 @@ struct Arguments {
   std::filesystem::path info_scene;
   std::vector<std::string> info_overrides;
   bool info_json = false, info_resolved = false;
+  bool species_json = false;
   FarmRequest farm;
 };
 
@@ -31,6 +32,7 @@ struct Subcommands {
   CLI::App* run = nullptr;
   CLI::App* validate = nullptr;
   CLI::App* info = nullptr;
+  CLI::App* species = nullptr;
   CLI::App* plan = nullptr;    // farm plan
   CLI::App* submit = nullptr;  // farm submit
   CLI::App* gather = nullptr;  // farm gather
@@ -103,6 +105,19 @@ CLI::App* add_info(CLI::App& app, Arguments& args) {
   return info_app;
 }
 
+CLI::App* add_species(CLI::App& app, Arguments& args) {
+  CLI::App* species_app = app.add_subcommand(
+      "species", "List the species library: name, height range, vertices, clusters, first sway frequency");
+  species_app->add_flag("--json", args.species_json, "Print a JSON array of objects, one per species");
+  species_app->footer(
+      "Examples:\n"
+      "  treeanim species\n"
+      "  treeanim species --json | jq -r '.[].name'\n"
+      "A scene then starts from one: {\"species\": \"english_oak\"} or\n"
+      "{\"species\": {\"name\": \"english_oak\", \"height\": 22}} (docs/species.md).");
+  return species_app;
+}
+
 void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
   submit->add_option("--engine", farm.engine, "slurm: write sbatch scripts and submit them; script: a plain shell script for any queue")
       ->required()->check(CLI::IsMember({"slurm", "script"}));
@@ -148,6 +163,7 @@ int dispatch(const Subcommands& commands, Arguments& args) {
     return run_command(args.run);
   }
   if (*commands.validate) return validate_command(args.validate_scene, args.validate_overrides);
+  if (*commands.species) return species_command(args.species_json);
   if (*commands.plan) return farm_plan_command(args.farm);
   if (*commands.submit) return farm_submit_command(args.farm);
   if (*commands.gather) return farm_gather_command(args.farm);
@@ -196,6 +212,7 @@ int run_command_line(int argc, char** argv) {
   commands.run = add_run(app, args);
   commands.validate = add_validate(app, args);
   commands.info = add_info(app, args);
+  commands.species = add_species(app, args);
   add_farm(app, args.farm, commands);
   try {
     app.parse(argc, argv);

@@ -35,6 +35,10 @@ enum class InfoFormat { kText, kJson, kResolvedScene };
 int info_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides,
                  InfoFormat format);
 
+// Prints the species library (name, height range, vertices, clusters and first sway frequency at
+// the default height), as a table or as a JSON array.
+int species_command(bool json);
+
 // treeanim farm plan | submit | gather (docs/farm.md).
 struct FarmRequest {
   std::filesystem::path scene;

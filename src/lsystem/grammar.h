@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lsystem/expression.h"
+#include "lsystem/lsystem_options.h"
 #include "lsystem/module_string.h"
 
 namespace treeanim {
@@ -112,12 +113,6 @@ struct Grammar {
   std::string where(const SourcePos& pos) const;
 };
 
-// One text of a grammar: a whole file, or one inline rule (single_line: reported as name:column).
-struct GrammarText {
-  std::string name;
-  std::string text;
-  bool single_line = false;
-};
 
 // Texts (read in order, as one grammar) + define overrides => grammar. `axiom_text`, when
 // given, is an inline axiom (another text, single line). Throws InputError

@@ -18,13 +18,13 @@ std::string read_file(const std::filesystem::path& path) {
 
 // A scene define must replace a #define of the file: otherwise it is a typo that would
 // silently change nothing.
-void check_overrides(const LsystemOptions& options, const Grammar& grammar) {
+void check_overrides(const LsystemOptions& options, const Grammar& grammar, const std::string& source) {
   for (const auto& [name, value] : options.defines) {
     if (std::find(grammar.file_defines.begin(), grammar.file_defines.end(), name) != grammar.file_defines.end())
       continue;
     std::string known;
     for (const std::string& d : grammar.file_defines) known += (known.empty() ? "" : ", ") + d;
-    throw InputError(options.grammar->string() + ": " + options.inline_name + "/defines/" + name +
+    throw InputError(source + ": " + options.inline_name + "/defines/" + name +
                      ": the grammar has no '#define " + name + "' (it defines: " +
                      (known.empty() ? "nothing" : known) + ")");
   }
@@ -75,10 +75,11 @@ ViewSettings load_view(const LsystemOptions& options) {
 }
 
 Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
-  if (options.grammar) {
-    const std::vector<GrammarText> texts{{options.grammar->string(), read_file(*options.grammar), false}};
-    Grammar grammar = parse_grammar(texts, options.defines, std::nullopt, view.functions, view.curves);
-    check_overrides(options, grammar);
+  if (options.grammar || options.library_grammar) {
+    const GrammarText text = options.grammar ? GrammarText{options.grammar->string(), read_file(*options.grammar), false}
+                                             : *options.library_grammar;
+    Grammar grammar = parse_grammar({text}, options.defines, std::nullopt, view.functions, view.curves);
+    check_overrides(options, grammar, text.name);
     return grammar;
   }
   std::vector<GrammarText> texts;

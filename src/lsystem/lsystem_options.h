@@ -10,8 +10,16 @@
 
 namespace treeanim {
 
+// One text of a grammar: a whole file, or one inline rule (single_line: reported as name:column).
+struct GrammarText {
+  std::string name;
+  std::string text;
+  bool single_line = false;
+};
+
 struct LsystemOptions {
   std::optional<std::filesystem::path> grammar;  // grammar file, resolved against the scene folder
+  std::optional<GrammarText> library_grammar;    // a species' grammar (in memory), when no file or inline one is given
   std::optional<std::filesystem::path> view;     // cpfg view file (.v), with a grammar file
   std::string axiom;                             // inline grammar (when no file)
   std::vector<std::string> productions;          // inline productions, one rule per string

@@ -9,6 +9,7 @@
 
 #include "lsystem/lsystem_options.h"
 #include "scene/scene_reader.h"
+#include "sim/sim_options.h"
 #include "tree/tree_options.h"
 
 namespace treeanim {
@@ -19,6 +20,8 @@ struct ForestVariant {
   double weight = 1;       // share of the scattered trees
   LsystemOptions lsystem;  // its own /lsystem, else the scene's
   TreeOptions tree;        // its own /tree, else the scene's
+  HsmOptions hsm;          // the scene's /hsm, under the variant's species and its own /hsm
+  std::string pointer;     // "/forest/variants/2" (messages)
   Json resolved;           // the variant's resolved object (what a tree's own scene records)
 };
 
@@ -44,6 +47,7 @@ struct ForestDefaults {
   uint64_t seed = 1;                     // /seed
   const LsystemOptions* lsystem = nullptr;  // null when the scene has no top-level /lsystem
   const TreeOptions* tree = nullptr;
+  const HsmOptions* hsm = nullptr;
 };
 
 // /forest => the forest, every tree placed. Throws InputError (exit 2) naming the JSON pointer:

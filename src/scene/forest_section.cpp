@@ -10,6 +10,8 @@
 #include "scene/forest.h"
 #include "scene/forest_layout.h"
 #include "scene/lsystem_section.h"
+#include "scene/sim_sections.h"
+#include "scene/species.h"
 #include "scene/tree_section.h"
 
 namespace treeanim {
@@ -48,14 +50,24 @@ ForestVariant read_variant(SceneObject element, const ForestDefaults& defaults) 
     element.fail_expected("name", "a name of 1 to 64 letters, digits, '_', '-' or '.' (not first)");
   variant.name = *name;
   variant.weight = element.number("weight", 1, Range::non_negative());
-  if (element.has("lsystem"))
-    variant.lsystem = read_lsystem_options(element.object("lsystem"), defaults.seed);
+  variant.pointer = element.pointer();
+  const std::optional<SpeciesChoice> species = read_species(element);
+  if (element.has("lsystem") || species)
+    variant.lsystem = read_lsystem_options(element.object("lsystem"), defaults.seed,
+                                           species ? &species->species->grammar : nullptr);
   else if (defaults.lsystem)
     variant.lsystem = *defaults.lsystem;
   else
-    element.fail("lsystem", "expected the variant's grammar (an object like /lsystem): the scene has no "
-                            "top-level /lsystem for it to fall back to");
-  variant.tree = element.has("tree") ? read_tree_options(element.object("tree")) : *defaults.tree;
+    element.fail("lsystem", "expected the variant's grammar (an object like /lsystem, or a species): the scene has "
+                            "no top-level /lsystem for it to fall back to");
+  if (species) check_species_scale(*species, element.object("tree"));
+  variant.tree = element.has("tree") || species
+                     ? read_tree_options(element.object("tree"), species ? species_tree(*species) : TreeOptions{})
+                     : *defaults.tree;
+  // A species brings its wood; the variant's own /hsm goes over it and over the scene's.
+  variant.hsm = element.has("hsm") || species
+                    ? read_hsm_options(element.object("hsm"), species ? species_hsm(*species, *defaults.hsm) : *defaults.hsm)
+                    : *defaults.hsm;
   variant.resolved = element.json();
   return variant;
 }
@@ -71,6 +83,7 @@ std::vector<ForestVariant> read_variants(SceneObject& section, const ForestDefau
     variant.name = "default";
     variant.lsystem = *defaults.lsystem;
     variant.tree = *defaults.tree;
+    variant.hsm = *defaults.hsm;
     variant.resolved = Json{{"name", variant.name}, {"weight", variant.weight}};
     variants.push_back(std::move(variant));
     return variants;

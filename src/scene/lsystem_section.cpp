@@ -44,7 +44,7 @@ std::vector<std::pair<std::string, double>> read_defines(SceneObject& section) {
 
 }  // namespace
 
-LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
+LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, const GrammarText* species_grammar) {
   LsystemOptions options;
   options.inline_name = "<scene>" + section.pointer();
   options.grammar = section.optional_path("grammar");
@@ -52,8 +52,10 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed) {
   options.productions = read_productions(section);
   if (options.grammar && axiom)
     section.fail("axiom", "give either a grammar file (/lsystem/grammar) or an inline grammar (/lsystem/axiom), not both");
-  if (!options.grammar && !axiom)
-    section.fail("grammar", "expected a grammar file, or an inline grammar as /lsystem/axiom and /lsystem/productions");
+  if (!options.grammar && !axiom && species_grammar) options.library_grammar = *species_grammar;
+  else if (!options.grammar && !axiom)
+    section.fail("grammar", "expected a grammar file, or an inline grammar as /lsystem/axiom and /lsystem/productions "
+                            "(or a /species, which brings its own)");
   if (options.grammar && !options.productions.empty())
     section.fail("productions", "inline productions go with /lsystem/axiom, not with a grammar file (/lsystem/grammar)");
   if (axiom) options.axiom = *axiom;

@@ -8,6 +8,7 @@
 #include "scene/lsystem_section.h"
 #include "scene/output_section.h"
 #include "scene/sim_sections.h"
+#include "scene/species.h"
 #include "scene/tree_section.h"
 #include "sim/wind_keys.h"
 
@@ -163,18 +164,28 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   SceneObject root = reader.root();
   root.optional_string("description");
   scene.seed = static_cast<uint64_t>(root.integer("seed", 1, 0, (1LL << 53)));
+  const std::optional<SpeciesChoice> species = read_species(root);
   const bool forest = root.has("forest");
   // A forest whose variants all bring their own grammar needs no top-level one.
-  const bool top_lsystem = !forest || root.has("lsystem");
-  if (top_lsystem) scene.lsystem = read_lsystem_options(root.object("lsystem"), scene.seed);
-  else root.declare("lsystem");
-  scene.tree = read_tree_options(root.object("tree"));
-  scene.hsm = read_hsm_options(root.object("hsm"));
+  const bool top_lsystem = !forest || root.has("lsystem") || species;
+  if (top_lsystem)
+    scene.lsystem = read_lsystem_options(root.object("lsystem"), scene.seed, species ? &species->species->grammar : nullptr);
+  else
+    root.declare("lsystem");
+  if (species) check_species_scale(*species, root.object("tree"));
+  scene.tree = read_tree_options(root.object("tree"), species ? species_tree(*species) : TreeOptions{});
+  scene.hsm = read_hsm_options(root.object("hsm"), species ? species_hsm(*species, HsmOptions{}) : HsmOptions{});
   scene.wind = read_wind_options(root.object("wind"), scene.seed);
   scene.time = read_time_options(root.object("time"));
   if (scene.time.loop) prepare_loop(root.object("time"), scene);
-  if (forest)
-    scene.forest = read_forest(root.object("forest"), {scene.seed, top_lsystem ? &scene.lsystem : nullptr, &scene.tree});
+  if (forest) {
+    scene.forest =
+        read_forest(root.object("forest"), {scene.seed, top_lsystem ? &scene.lsystem : nullptr, &scene.tree, &scene.hsm});
+    for (const ForestVariant& variant : scene.forest->variants)
+      if (scene.time.loop && variant.hsm.leaf_detach_force > 0)
+        reader.fail(variant.pointer + "/hsm/leaf_detach_force",
+                    "leaves that detach never come back, so the loop cannot repeat; set it to 0 or leave /time/loop out");
+  }
   for (SceneObject element : root.array_of_objects("outputs"))
     scene.outputs.push_back(read_output_options(element));
   check_tree_placeholders(scene, reader);

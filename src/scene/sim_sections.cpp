@@ -124,10 +124,9 @@ VolumeOptions read_volume_options(SceneObject section) {
 
 }  // namespace
 
-HsmOptions read_hsm_options(SceneObject section) {
-  HsmOptions o;
+HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
   o.global_matching = section.boolean("global_matching", o.global_matching);
-  o.stiffness = section.choice("stiffness", "physical", {"physical", "per_step"}) == "physical"
+  o.stiffness = section.choice("stiffness", o.stiffness == StiffnessMode::kPhysical ? "physical" : "per_step", {"physical", "per_step"}) == "physical"
                     ? StiffnessMode::kPhysical
                     : StiffnessMode::kPerStep;
   o.alpha = section.number("alpha", o.alpha, Range::between(0, 1));
@@ -151,9 +150,9 @@ HsmOptions read_hsm_options(SceneObject section) {
   o.sleep_distance = section.number("sleep_distance", o.sleep_distance, {0, 1, true, false});
   o.rotation_iterations =
       static_cast<int>(section.integer("rotation_iterations", o.rotation_iterations, 1, 100));
-  o.precision = section.choice("precision", "double", {"double", "float"}) == "double" ? Precision::kDouble
+  o.precision = section.choice("precision", o.precision == Precision::kDouble ? "double" : "float", {"double", "float"}) == "double" ? Precision::kDouble
                                                                                        : Precision::kFloat;
-  o.particles = section.choice("particles", "vertices", {"vertices", "samples"}) == "vertices"
+  o.particles = section.choice("particles", o.particles == ParticleMode::kVertices ? "vertices" : "samples", {"vertices", "samples"}) == "vertices"
                     ? ParticleMode::kVertices
                     : ParticleMode::kSamples;
   // Per-step rates of 0 for both terms leave nothing holding the tree: refuse, not bake a

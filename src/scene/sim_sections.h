@@ -11,8 +11,8 @@
 
 namespace treeanim {
 
-// /hsm section => solver options.
-HsmOptions read_hsm_options(SceneObject section);
+// /hsm section => solver options; a key the section leaves out takes its value from `defaults`.
+HsmOptions read_hsm_options(SceneObject section, HsmOptions defaults = {});
 // /wind section => wind options. scene_seed is the top-level /seed (turbulence default).
 WindOptions read_wind_options(SceneObject section, uint64_t scene_seed);
 

@@ -26,7 +26,7 @@ Scene tree_scene(const Scene& forest_scene, size_t index) {
   scene.lsystem = variant.lsystem;
   scene.lsystem.seed = tree.seed;
   scene.tree = scaled_tree_options(variant.tree, tree.scale);
-  scene.hsm = forest_scene.hsm;
+  scene.hsm = variant.hsm;
   scene.wind = forest_scene.wind;
   scene.time = forest_scene.time;
   scene.outputs = forest_scene.outputs;

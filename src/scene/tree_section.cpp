@@ -7,13 +7,12 @@ namespace treeanim {
 constexpr Range kRadius{0, 10, true, false};
 
 // /tree/leaf object => leaf options (defaults written back into the scene).
-static LeafOptions read_leaf_options(SceneObject section) {
-  LeafOptions o;
+static LeafOptions read_leaf_options(SceneObject section, LeafOptions o) {
   o.size = section.number("size", o.size, {0, 25, true, false});
   o.aspect = section.number("aspect", o.aspect, {0, 10, true, false});
   o.petiole = section.number("petiole", o.petiole, Range::between(0, 10));
   o.areal_density = section.number("areal_density", o.areal_density, {0, 20, true, false});
-  o.mesh = section.optional_path("mesh");
+  if (auto mesh = section.optional_path("mesh")) o.mesh = mesh;
   return o;
 }
 
@@ -26,16 +25,14 @@ static Eigen::Vector3d read_color(SceneObject& section, const std::string& key, 
 }
 
 // /tree/cluster object => cluster options.
-static ClusterOptions read_cluster_options(SceneObject section) {
-  ClusterOptions o;
+static ClusterOptions read_cluster_options(SceneObject section, ClusterOptions o) {
   o.segments_per_cluster =
       int(section.integer("segments_per_cluster", o.segments_per_cluster, 1, 1'000'000));
   o.target_vertices = int(section.integer("target_vertices", o.target_vertices, 0, 100'000'000));
   return o;
 }
 
-TreeOptions read_tree_options(SceneObject section) {
-  TreeOptions o;
+TreeOptions read_tree_options(SceneObject section, TreeOptions o) {
   o.scale = section.number("scale", o.scale, {0, 100, true, false});
   o.width_scale = section.number("width_scale", o.width_scale, Range::positive());
   o.ring_sides = int(section.integer("ring_sides", o.ring_sides, 3, 256));
@@ -47,8 +44,8 @@ TreeOptions read_tree_options(SceneObject section) {
   o.bark_color = read_color(section, "bark_color", o.bark_color);
   o.leaf_color = read_color(section, "leaf_color", o.leaf_color);
   o.leaf_color_variation = section.number("leaf_color_variation", o.leaf_color_variation, Range::between(0.0, 1.0));
-  o.leaf = read_leaf_options(section.object("leaf"));
-  o.cluster = read_cluster_options(section.object("cluster"));
+  o.leaf = read_leaf_options(section.object("leaf"), o.leaf);
+  o.cluster = read_cluster_options(section.object("cluster"), o.cluster);
   return o;
 }
 

@@ -5,7 +5,8 @@
 
 namespace treeanim {
 
-// /tree section => options.
-TreeOptions read_tree_options(SceneObject section);
+// /tree section => options; a key the section leaves out takes its value from `defaults` (a
+// species' preset, or the built-in defaults).
+TreeOptions read_tree_options(SceneObject section, TreeOptions defaults = {});
 
 }  // namespace treeanim

@@ -55,7 +55,7 @@ TEST(LsystemOptions, InlineGrammar) {
 TEST(LsystemOptions, ErrorsAreJsonPointers) {
   EXPECT_EQ(error_of(R"({"lsystem": {}})"),
             "scene.json: /lsystem/grammar: expected a grammar file, or an inline grammar as /lsystem/axiom and "
-            "/lsystem/productions");
+            "/lsystem/productions (or a /species, which brings its own)");
   EXPECT_EQ(error_of(R"({"lsystem": {"grammar": "a.lsys", "axiom": "F"}})"),
             "scene.json: /lsystem/axiom: give either a grammar file (/lsystem/grammar) or an inline grammar "
             "(/lsystem/axiom), not both");
