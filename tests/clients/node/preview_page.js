@@ -1,8 +1,12 @@
 #!/usr/bin/env node
 // The html output's page in Debian's chromium (headless, software GL), driven by playwright-core:
 //   preview_page.js shot PAGE.html OUT.png SECONDS [SECONDS...]
-//       the page's 3D view at each time (page.html#t=SECONDS, once the title says "ready"),
-//       side by side in one PNG (scripts/render-preview makes docs/demo.png so)
+//       the page's 3D view at each time (page.html#t=SECONDS, once the title says "ready"; SECONDS
+//       "largest": the frame of largest displacement), side by side in one PNG
+//       (scripts/render-preview makes docs/demo.png so)
+//   preview_page.js gallery OUT.png COLUMNS LABEL PAGE.html SECONDS [LABEL PAGE.html SECONDS...]
+//       each page's view at rest (t = 0) and at SECONDS side by side under its LABEL, the pairs
+//       in rows of COLUMNS (scripts/species-gallery makes docs/species.png so)
 //   preview_page.js check PAGE.html --bark R,G,B --leaf R,G,B [--min-leaf-share F] [--trees N]
 //       fails unless the view at the first and last third of the bake is not blank, the two
 //       differ (the tree moves), bark and leaf pixels have the given sRGB colours (0..1) within
@@ -13,9 +17,11 @@
 const path = require('path');
 const { chromium } = require('playwright-core');
 
-// Browser windows: the checks' (the view 960 x 558), and the pictures' (a tall view, 600 x 620).
+// Browser windows: the checks' (the view 960 x 558), the pictures' (a tall view, 600 x 620) and
+// the gallery's (a smaller tall view).
 const kCheckSize = { width: 960, height: 900 };
 const kShotSize = { width: 600, height: 1000 };
+const kGallerySize = { width: 340, height: 640 };
 
 async function openBrowser() {
   return chromium.launch({
@@ -85,6 +91,39 @@ async function sideBySide(browser, pngs) {
   return Buffer.from(b64, 'base64');
 }
 
+// Labelled pairs of PNG images => one PNG: each pair side by side under its label, the pairs in
+// rows of `columns`.
+async function gallery(browser, cells, columns) {
+  const tab = await browser.newPage();
+  const b64 = await tab.evaluate(async ({ cells, columns }) => {
+    const load = async (s) => {
+      const image = new Image();
+      image.src = `data:image/png;base64,${s}`;
+      await image.decode();
+      return image;
+    };
+    const pairs = await Promise.all(cells.map(async (c) => ({ label: c.label, images: await Promise.all(c.pngs.map(load)) })));
+    const w = pairs[0].images[0].width, h = pairs[0].images[0].height, caption = 34;
+    const canvas = document.createElement('canvas');
+    canvas.width = Math.min(columns, pairs.length) * 2 * w;
+    canvas.height = Math.ceil(pairs.length / columns) * (h + caption);
+    const g = canvas.getContext('2d');
+    g.fillStyle = '#fff';
+    g.fillRect(0, 0, canvas.width, canvas.height);
+    g.font = '20px sans-serif';
+    g.textAlign = 'center';
+    pairs.forEach((pair, k) => {
+      const x = (k % columns) * 2 * w, y = Math.floor(k / columns) * (h + caption);
+      g.fillStyle = '#222';
+      g.fillText(pair.label, x + w, y + 24);
+      pair.images.forEach((image, i) => g.drawImage(image, x + i * w, y + caption));
+    });
+    return canvas.toDataURL('image/png').split(',')[1];
+  }, { cells: cells.map((c) => ({ label: c.label, pngs: c.pngs.map((p) => p.toString('base64')) })), columns });
+  await tab.close();
+  return Buffer.from(b64, 'base64');
+}
+
 // sRGB 0..255 => hue (degrees) and saturation (0..1) of HSV.
 function hueSat(r, g, b) {
   const max = Math.max(r, g, b), min = Math.min(r, g, b), c = max - min;
@@ -148,12 +187,25 @@ async function checkTrees(browser, page, t, count, failures) {
   });
 }
 
-async function check(browser, page, options) {
-  const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
+// The bake data a page embeds (its plot: time, max_displacement, ...).
+function bakeData(page) {
   const text = require('fs').readFileSync(page, 'utf8');
   const json = /<script id="treeanim-bake" type="application\/json">(.*?)<\/script>/s.exec(text);
   if (!json) throw new Error(`${page}: no <script id="treeanim-bake"> element`);
-  const times = JSON.parse(json[1]).plot.time;
+  return JSON.parse(json[1]);
+}
+
+// SECONDS of a command line => a time; "largest": the frame of the page's largest displacement.
+function timeOf(page, text) {
+  if (text !== 'largest') return text;
+  const plot = bakeData(page).plot;
+  const k = plot.max_displacement.reduce((best, d, i) => (d > plot.max_displacement[best] ? i : best), 0);
+  return plot.time[k];
+}
+
+async function check(browser, page, options) {
+  const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
+  const times = bakeData(page).plot.time;
   const t0 = times[Math.floor(times.length / 3)], t1 = times[Math.floor((2 * times.length) / 3)];
   const a = await viewAt(browser, page, t0), b = await viewAt(browser, page, t1);
   const [ia, ib] = await pixels(browser, [a.png, b.png]);
@@ -195,9 +247,22 @@ async function main() {
     if (command === 'shot') {
       const [out, ...times] = rest;
       const views = [];
-      for (const t of times) views.push((await viewAt(browser, page, t, kShotSize)).png);
+      for (const t of times) views.push((await viewAt(browser, page, timeOf(page, t), kShotSize)).png);
       require('fs').writeFileSync(out, await sideBySide(browser, views));
       console.log(out);
+      return 0;
+    }
+    if (command === 'gallery') {
+      const [columns, ...triples] = rest;
+      const cells = [];
+      for (let i = 0; i + 2 < triples.length; i += 3) {
+        const [label, file, t] = triples.slice(i, i + 3);
+        const views = [];
+        for (const time of [0, timeOf(file, t)]) views.push((await viewAt(browser, file, time, kGallerySize)).png);
+        cells.push({ label, pngs: views });
+      }
+      require('fs').writeFileSync(page, await gallery(browser, cells, Number(columns)));
+      console.log(page);
       return 0;
     }
     if (command === 'check') {
@@ -207,7 +272,8 @@ async function main() {
       for (const f of failures) console.log(`FAIL: ${f}`);
       return failures.length ? 1 : 0;
     }
-    console.error('usage: preview_page.js shot PAGE OUT.png SECONDS... | check PAGE --bark R,G,B --leaf R,G,B');
+    console.error('usage: preview_page.js shot PAGE OUT.png SECONDS... | gallery OUT.png COLUMNS LABEL PAGE SECONDS... | ' +
+                  'check PAGE --bark R,G,B --leaf R,G,B');
     return 2;
   } finally {
     await browser.close();
