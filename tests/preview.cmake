@@ -8,6 +8,7 @@
 # inside TREEANIM_TESTS; chromium and playwright-core come from `scripts/setup test`.
 set(preview_out ${CMAKE_BINARY_DIR}/preview_pages)
 set(preview_page_only "outputs=[{\"format\":\"html\",\"path\":\"page.html\"}]")
+set(preview_forest_pages "outputs=[{\"format\":\"html\",\"path\":\"trees/{tree}.html\"}]")
 set(preview_small_reduced "outputs=[{\"format\":\"html\",\"path\":\"page.html\",\"max_mib\":2}]")
 # The golden tree's leaves, larger and kept on: enough leaf pixels to check their colour.
 set(preview_small_leaves "--set tree.leaf.size=0.3 --set hsm.leaf_detach_force=0")
@@ -19,6 +20,7 @@ add_test(NAME preview.bake
 \"$t\" run tests/golden/small_tree.json -o '${preview_out}/small' --quiet ${preview_scene_colors} ${preview_small_leaves} --set '${preview_page_only}' && \
 \"$t\" run tests/golden/small_tree.json -o '${preview_out}/reduced' --quiet ${preview_scene_colors} ${preview_small_leaves} --set time.frames=1200 --set '${preview_small_reduced}' && \
 \"$t\" run tests/clients/scenes/forest_preview.json -o '${preview_out}/forest' --quiet && \
+\"$t\" run configs/forest-demo.json -o '${preview_out}/forest-demo' --quiet ${preview_scene_colors} --set time.frames=12 --set '${preview_forest_pages}' && \
 \"$t\" run configs/demo.json -o '${preview_out}/demo' --quiet ${preview_scene_colors} --set time.frames=96 --set '${preview_page_only}' && \
 exec \"$t\" run configs/conifer.json -o '${preview_out}/conifer' --quiet ${preview_scene_colors} --set time.frames=72 --set '${preview_page_only}'"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
@@ -26,13 +28,13 @@ set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP previ
 
 find_program(TREEANIM_NODE node)
 set(preview_client ${CMAKE_SOURCE_DIR}/tests/clients/node/preview_page.js)
-# A page of preview.bake's (a path under its folder) or any other (an absolute path).
-function(preview_page_test name page)
+# preview_page.js COMMAND on a page of preview.bake's (a path under its folder) or any other (an absolute path).
+function(preview_client_test name command page)
   if(NOT IS_ABSOLUTE ${page})
     set(page ${preview_out}/${page})
   endif()
   if(TREEANIM_NODE AND EXISTS ${CMAKE_SOURCE_DIR}/tests/clients/node/node_modules/playwright-core AND EXISTS /usr/bin/chromium)
-    add_test(NAME preview.${name} COMMAND ${TREEANIM_NODE} ${preview_client} check ${page} ${preview_colors} ${ARGN})
+    add_test(NAME preview.${name} COMMAND ${TREEANIM_NODE} ${preview_client} ${command} ${page} ${ARGN})
   else()
     add_test(NAME preview.${name}
              COMMAND sh -c "echo 'preview.${name}: node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
@@ -40,11 +42,20 @@ function(preview_page_test name page)
   set_tests_properties(preview.${name} PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 300
                        WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 endfunction()
+function(preview_page_test name page)
+  preview_client_test(${name} check ${page} ${preview_colors} ${ARGN})
+endfunction()
 preview_page_test(small small/page.html)
 preview_page_test(reduced reduced/page.html --reduced yes)
 preview_page_test(demo demo/page.html --min-leaf-share 0.3)
 preview_page_test(conifer conifer/page.html --min-leaf-share 0.3)
 preview_page_test(forest forest/forest.html --trees 3)
+# configs/forest-demo.json seen whole (16 trees over 30 m x 20 m, leaves of 14 cm a few pixels
+# each): its leaves still read, the wind arrow stays inside the view in a square, a tall and a
+# wide window, and no plot's legend covers its title.
+preview_client_test(forest_demo_leaves leaves forest-demo/forest.html ${preview_colors} --min-leaf-share 0.25)
+preview_client_test(forest_demo_arrow arrow forest-demo/forest.html)
+preview_client_test(forest_demo_captions captions forest-demo/forest.html)
 
 # The farm's gather writes the same forest.html as `run`: the forest baked as three shards, then gathered.
 set(preview_forest_scene ${CMAKE_SOURCE_DIR}/tests/clients/scenes/forest_preview.json)

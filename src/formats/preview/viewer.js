@@ -31,7 +31,11 @@ style.textContent = `
   #clock { font-variant-numeric: tabular-nums; min-width: 15em; }
   #note { padding: 4px 10px; color: #8a4b00; }
   #plots { display: flex; flex-wrap: wrap; gap: 8px; padding: 8px 10px; }
-  #plots canvas { flex: 1 1 420px; height: 170px; min-width: 300px; background: #fff; border: 1px solid #ccd; }
+  .plot { flex: 1 1 420px; min-width: 300px; margin: 0; background: #fff; border: 1px solid #ccd; }
+  .plot figcaption { display: flex; flex-wrap: wrap; gap: 2px 16px; padding: 5px 10px 0 48px; font-size: 11px; color: #334; }
+  .plot .legend::before { content: ''; display: inline-block; width: 14px; margin-right: 4px;
+                          border-top: 2px solid currentColor; vertical-align: middle; }
+  .plot canvas { display: block; width: 100%; height: 150px; }
   #title { position: absolute; left: 10px; top: 8px; color: #334; text-shadow: 0 0 3px #fff; }`;
 document.head.appendChild(style);
 const app = document.createElement('div');  // before the data, which stays in the page
@@ -46,7 +50,10 @@ app.innerHTML = `
     <span id="clock"></span>
   </div>
   <div id="note"></div>
-  <div id="plots"><canvas id="windplot"></canvas><canvas id="dispplot"></canvas></div>`;
+  <div id="plots">
+    <figure class="plot" id="windplot"><figcaption></figcaption><canvas></canvas></figure>
+    <figure class="plot" id="dispplot"><figcaption></figcaption><canvas></canvas></figure>
+  </div>`;
 document.body.prepend(app);
 document.getElementById('title').textContent = bake.title;
 document.getElementById('note').textContent = bake.reduced;
@@ -68,6 +75,78 @@ const materials = [
   new THREE.MeshLambertMaterial({ color: srgb(bake.colors.bark) }),
   new THREE.MeshLambertMaterial({ color: srgb(bake.colors.leaf), side: THREE.DoubleSide }),
 ];
+// A blade a few pixels long, or seen edge-on, falls between pixels, and a forest seen whole
+// reads as bare twigs: every leaf under three dots long on screen is also drawn as a round
+// dot of the leaf colour at its centre (dotPx, the drawing buffer's pixels).
+const leafDots = new THREE.ShaderMaterial({
+  uniforms: { color: { value: materials[1].color }, halfHeight: { value: 1 }, dotPx: { value: 1 } },
+  vertexShader: `
+    attribute float leafSize;
+    uniform float halfHeight, dotPx;
+    void main() {
+      vec4 at = modelViewMatrix * vec4(position, 1.0);
+      gl_Position = projectionMatrix * at;
+      gl_PointSize = dotPx;
+      // a point of size 0 may still be drawn as one pixel: a leaf large enough is moved off screen
+      if (leafSize * projectionMatrix[1][1] * halfHeight / -at.z >= 3.0 * dotPx) gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    }`,
+  fragmentShader: `
+    uniform vec3 color;
+    void main() {
+      if (length(gl_PointCoord - 0.5) > 0.5) discard;
+      gl_FragColor = vec4(color, 1.0);
+      #include <colorspace_fragment>
+    }`,
+});
+const kLeafDotCssPx = 3;
+
+// Triangle indices from `first` on => their vertices, one array per connected piece (a leaf).
+function connectedPieces(index, first) {
+  const parent = new Map();
+  const root = (v) => {
+    while (parent.get(v) !== v) v = parent.get(v);
+    return v;
+  };
+  for (let i = first; i < index.length; ++i) parent.set(index[i], index[i]);
+  for (let i = first; i < index.length; i += 3) {
+    const a = root(index[i]);
+    parent.set(root(index[i + 1]), a);
+    parent.set(root(index[i + 2]), a);
+  }
+  const pieces = new Map();
+  for (const v of parent.keys()) {
+    const r = root(v);
+    if (!pieces.has(r)) pieces.set(r, []);
+    pieces.get(r).push(v);
+  }
+  return [...pieces.values()];
+}
+
+// Vertices of each leaf => their centres in `out` (x y z a leaf), from positions `p`.
+function leafCentres(leaves, p, out) {
+  leaves.forEach((leaf, k) => {
+    let x = 0, y = 0, z = 0;
+    for (const v of leaf) { x += p[3 * v]; y += p[3 * v + 1]; z += p[3 * v + 2]; }
+    out[3 * k] = x / leaf.length; out[3 * k + 1] = y / leaf.length; out[3 * k + 2] = z / leaf.length;
+  });
+}
+
+// A tree's leaves as dots (leafDots) at their centres, in the tree's mesh.
+function makeLeafDots(mesh, rest, barkIndices) {
+  const leaves = connectedPieces(mesh.geometry.index.array, barkIndices);
+  const centres = new THREE.BufferAttribute(new Float32Array(3 * leaves.length), 3);
+  centres.setUsage(THREE.DynamicDrawUsage);
+  leafCentres(leaves, rest, centres.array);
+  const sizes = leaves.map((leaf, k) => 2 * Math.max(...leaf.map((v) => Math.hypot(
+    rest[3 * v] - centres.array[3 * k], rest[3 * v + 1] - centres.array[3 * k + 1], rest[3 * v + 2] - centres.array[3 * k + 2]))));
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', centres);
+  geometry.setAttribute('leafSize', new THREE.BufferAttribute(new Float32Array(sizes), 1));
+  const dots = new THREE.Points(geometry, leafDots);
+  dots.frustumCulled = false;  // the leaves move past the rest pose's bounds
+  mesh.add(dots);  // placed, and shown alone (&tree=K), with its tree
+  return { leaves, centres };
+}
 
 // One tree: its mesh, placed as the bake places it, and its frames.
 function makeTree(tree) {
@@ -85,10 +164,11 @@ function makeTree(tree) {
   mesh.position.fromArray(tree.position);
   mesh.rotation.y = THREE.MathUtils.degToRad(tree.rotation);
   scene.add(mesh);
+  const dots = makeLeafDots(mesh, rest, barkIndices);
   const data = tree.frames.encoding === 'int16' ? decode(tree.frames.data, Int16Array)
                                                  : decode(tree.frames.data, Float32Array);
   const quantized = tree.frames.encoding === 'int16';
-  return { rest, mesh, positions, data, sample: tree.frames.sample, quantized,
+  return { rest, mesh, positions, dots, data, sample: tree.frames.sample, quantized,
            step: quantized ? decode(tree.frames.step, Float32Array) : null };
 }
 const trees = bake.trees.map(makeTree);
@@ -109,11 +189,12 @@ function pose(tree, t) {
     out[i] = tree.quantized ? tree.rest[i] + v * tree.step[(i / 3) | 0] : v;
   }
   tree.positions.needsUpdate = true;
+  leafCentres(tree.dots.leaves, out, tree.dots.centres.array);
+  tree.dots.centres.needsUpdate = true;
   tree.mesh.geometry.computeVertexNormals();
 }
 
-// Framing: the box of every tree at rest, from the front and a little above, its height
-// (or width, in a narrow view) filling nine tenths of the view.
+// The box of every tree at rest.
 const box = new THREE.Box3();
 for (const tree of trees) {
   tree.mesh.geometry.computeBoundingBox();
@@ -124,14 +205,7 @@ const size = box.getSize(new THREE.Vector3());
 const center = box.getCenter(new THREE.Vector3());
 const radius = Math.max(size.length() / 2, 0.1);
 const camera = new THREE.PerspectiveCamera(35, 1, radius / 100, radius * 100);
-const viewDirection = new THREE.Vector3(0, 0.12, 1).normalize();
-function frame() {
-  const halfHeight = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
-  const reach = Math.max(size.y / 2, Math.max(size.x, size.z) / 2 / camera.aspect) / (0.9 * halfHeight);
-  camera.position.copy(center).addScaledVector(viewDirection, reach + Math.max(size.x, size.z) / 2);
-}
 const controls = new OrbitControls(camera, renderer.domElement);
-controls.target.copy(center);
 
 // Ground grid: metre lines over the trees' footprint and two metres around it.
 const extent = Math.ceil(Math.max(size.x, size.z) / 2 + 2);
@@ -139,33 +213,85 @@ const grid = new THREE.GridHelper(2 * extent, 2 * extent, 0x7d8a7a, 0xb4bdb1);
 grid.position.set(Math.round(center.x), box.min.y, Math.round(center.z));
 scene.add(grid);
 
-// Wind arrow: the air velocity at the probe point, from upwind, 1 m/s = 4 % of the trees' size.
+// Wind arrow: the air velocity at the probe point, from upwind, 1 m/s = 4 % of the trees' height
+// (not of a forest's width, which would draw it longer than the forest).
 const probe = new THREE.Vector3().fromArray(bake.wind_probe);
 const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), probe, 1, 0x2060d0);
 scene.add(arrow);
-const arrowScale = 0.04 * Math.max(size.x, size.y, size.z);
-function placeArrow(sample) {
+const arrowScale = 0.04 * size.y;
+// The arrow at a sample: its tail, direction, length, and its head's length and width; none in still air.
+function arrowAt(sample) {
   const w = new THREE.Vector3().fromArray(bake.plot.wind, 3 * sample);
   const speed = w.length();
-  arrow.visible = speed > 1e-3;
-  if (!arrow.visible) return;
+  if (speed <= 1e-3) return null;
   const length = speed * arrowScale;
   const dir = w.clone().divideScalar(speed);
-  arrow.position.copy(probe).addScaledVector(dir, -length - 0.5 * Math.max(size.x, size.z));
-  arrow.setDirection(dir);
-  arrow.setLength(length, Math.min(0.3 * length, 0.1 * radius), Math.min(0.15 * length, 0.05 * radius));
+  const tail = probe.clone().addScaledVector(dir, -length - 0.5 * Math.max(size.x, size.z));
+  return { tail, dir, length, head: Math.min(0.3 * length, 0.1 * radius), width: Math.min(0.15 * length, 0.05 * radius) };
+}
+function placeArrow(sample) {
+  const a = arrowAt(sample);
+  arrow.visible = a !== null;
+  if (!a) return;
+  arrow.position.copy(a.tail);
+  arrow.setDirection(a.dir);
+  arrow.setLength(a.length, a.head, a.width);
+}
+
+// Framing: the trees and the arrow at every sample (a forest's reaches well past the trees),
+// from the front and a little above, the nearest to fill nine tenths of the view either way.
+const framedBox = box.clone();
+for (let i = 0; i < samples; ++i) {
+  const a = arrowAt(i);
+  if (!a) continue;
+  const ends = new THREE.Box3().setFromPoints([a.tail, a.tail.clone().addScaledVector(a.dir, a.length)]);
+  framedBox.union(ends.expandByScalar(a.width / 2));
+}
+const aim = framedBox.getCenter(new THREE.Vector3());
+controls.target.copy(aim);
+const viewDirection = new THREE.Vector3(0, 0.12, 1).normalize();
+function frame() {
+  const halfHeight = 0.9 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
+  const up = new THREE.Vector3(0, 1, 0).projectOnPlane(viewDirection).normalize();
+  const right = new THREE.Vector3().crossVectors(up, viewDirection);
+  // each corner of the box inside the view: the camera at least this far from the centre
+  let reach = 0;
+  for (let k = 0; k < 8; ++k) {
+    const corner = new THREE.Vector3(k & 1 ? framedBox.max.x : framedBox.min.x, k & 2 ? framedBox.max.y : framedBox.min.y,
+                                     k & 4 ? framedBox.max.z : framedBox.min.z).sub(aim);
+    const toward = corner.dot(viewDirection);
+    reach = Math.max(reach, toward + Math.abs(corner.dot(up)) / halfHeight,
+                     toward + Math.abs(corner.dot(right)) / (halfHeight * camera.aspect));
+  }
+  camera.position.copy(aim).addScaledVector(viewDirection, reach);
 }
 
 // --- plots ---
 const plotStyles = { grid: '#e3e6ea', axis: '#667', text: '#334', cursor: '#d03030' };
-function drawPlot(canvas, title, unit, series, cursorTime) {
+// A plot's title and legend: page text in its caption, which wraps the legend below the title
+// rather than over it where the plot is narrow.
+function caption(figure, title, unit, series) {
+  const text = figure.querySelector('figcaption');
+  const name = document.createElement('span');
+  name.className = 'title';
+  name.textContent = `${title} (${unit})`;
+  text.append(name);
+  for (const s of series) {
+    const key = document.createElement('span');
+    key.className = 'legend';
+    key.style.color = s.color;
+    key.textContent = s.name;
+    text.append(key);
+  }
+}
+function drawPlot(canvas, series, cursorTime) {
   const dpr = window.devicePixelRatio || 1;
   const w = canvas.clientWidth, h = canvas.clientHeight;
   canvas.width = w * dpr;
   canvas.height = h * dpr;
   const g = canvas.getContext('2d');
   g.scale(dpr, dpr);
-  const left = 48, right = 10, top = 22, bottom = 24;
+  const left = 48, right = 10, top = 10, bottom = 24;
   let ymax = 0;
   for (const s of series) for (const v of s.values) ymax = Math.max(ymax, v);
   ymax = ymax > 0 ? ymax * 1.1 : 1;
@@ -174,7 +300,6 @@ function drawPlot(canvas, title, unit, series, cursorTime) {
   const y = (v) => h - bottom - (v / ymax) * (h - top - bottom);
   g.font = '11px system-ui, sans-serif';
   g.fillStyle = plotStyles.text;
-  g.fillText(`${title} (${unit})`, left, 14);
   g.strokeStyle = plotStyles.grid;
   for (let k = 0; k <= 4; ++k) {
     const v = (ymax * k) / 4;
@@ -185,16 +310,12 @@ function drawPlot(canvas, title, unit, series, cursorTime) {
     const t = t0 + ((t1 - t0) * k) / 5;
     g.fillText(`${t.toFixed(1)} s`, Math.min(x(t) - 12, w - 36), h - 8);
   }
-  let legend = left + 180;
   for (const s of series) {
     g.strokeStyle = s.color;
     g.lineWidth = 1.5;
     g.beginPath();
     s.values.forEach((v, i) => (i ? g.lineTo(x(times[i]), y(v)) : g.moveTo(x(times[i]), y(v))));
     g.stroke();
-    g.fillStyle = s.color;
-    g.fillText(s.name, legend, 14);
-    legend += 90;
   }
   g.strokeStyle = plotStyles.cursor;
   g.lineWidth = 1;
@@ -202,12 +323,15 @@ function drawPlot(canvas, title, unit, series, cursorTime) {
 }
 const windSpeed = times.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
 const windTitle = trees.length > 1 ? 'wind speed at the first tree' : 'wind speed at the tree';
+const windSeries = [{ name: 'speed', values: windSpeed, color: '#2060d0' }];
+const dispSeries = [{ name: 'largest', values: bake.plot.max_displacement, color: '#c05a00' },
+                    { name: 'RMS', values: bake.plot.rms_displacement, color: '#2a8a3a' }];
+const windPlot = document.getElementById('windplot'), dispPlot = document.getElementById('dispplot');
+caption(windPlot, windTitle, 'm/s', windSeries);
+caption(dispPlot, 'displacement from rest', 'm', dispSeries);
 function drawPlots(t) {
-  drawPlot(document.getElementById('windplot'), windTitle, 'm/s',
-           [{ name: 'speed', values: windSpeed, color: '#2060d0' }], t);
-  drawPlot(document.getElementById('dispplot'), 'displacement from rest', 'm',
-           [{ name: 'largest', values: bake.plot.max_displacement, color: '#c05a00' },
-            { name: 'RMS', values: bake.plot.rms_displacement, color: '#2a8a3a' }], t);
+  drawPlot(windPlot.querySelector('canvas'), windSeries, t);
+  drawPlot(dispPlot.querySelector('canvas'), dispSeries, t);
 }
 
 // --- playback ---
@@ -242,6 +366,8 @@ function show(t) {
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
   renderer.setSize(w, h);
+  leafDots.uniforms.halfHeight.value = renderer.getDrawingBufferSize(new THREE.Vector2()).y / 2;
+  leafDots.uniforms.dotPx.value = kLeafDotCssPx * renderer.getPixelRatio();
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
   if (!framed) frame();

@@ -12,6 +12,14 @@
 //       differ (the tree moves), bark and leaf pixels have the given sRGB colours (0..1) within
 //       shading, leaves are at least F of the tree's pixels, and (--trees) the page holds N trees,
 //       each drawn on its own (page.html#t=SECONDS&tree=K) and apart from the others on screen.
+//   preview_page.js leaves PAGE.html --bark R,G,B --leaf R,G,B --min-leaf-share F
+//       the view at the middle of the bake only: leaves at least F of the trees' pixels (a
+//       forest seen whole, where leaves are a few pixels each).
+//   preview_page.js arrow PAGE.html
+//       the wind arrow alone (no tree shown) at the windiest frame, in a square, a tall and a
+//       wide window: drawn, and clear of the view's edges (wholly inside it).
+//   preview_page.js captions PAGE.html
+//       in a wide and a narrow window: each plot's title and legend entries drawn, none over another.
 // CHROMIUM names the browser (default /usr/bin/chromium).
 'use strict';
 const path = require('path');
@@ -22,6 +30,10 @@ const { chromium } = require('playwright-core');
 const kCheckSize = { width: 960, height: 900 };
 const kShotSize = { width: 600, height: 1000 };
 const kGallerySize = { width: 340, height: 640 };
+// The wind arrow's windows: the checks', a tall and a wide one; the captions': the checks' and
+// one where a plot is at its narrowest (300 px).
+const kArrowSizes = [kCheckSize, kShotSize, { width: 1600, height: 700 }];
+const kCaptionSizes = [kCheckSize, { width: 360, height: 900 }];
 
 async function openBrowser() {
   return chromium.launch({
@@ -42,9 +54,17 @@ async function viewAt(browser, page, t, viewport = kCheckSize, more = '') {
     throw new Error(`${page}#t=${t}: the title never became "ready" (${errors.join('; ') || e.message})`);
   }
   const png = await tab.locator('#view canvas').screenshot();
-  const info = await tab.evaluate(() => ({ clock: document.getElementById('clock').textContent,
-                                           note: document.getElementById('note').textContent,
-                                           data: JSON.parse(document.getElementById('treeanim-bake').textContent) }));
+  const info = await tab.evaluate(() => ({
+    clock: document.getElementById('clock').textContent,
+    note: document.getElementById('note').textContent,
+    data: JSON.parse(document.getElementById('treeanim-bake').textContent),
+    // each plot's caption: its title's box and its legend entries' (page pixels)
+    plots: [...document.querySelectorAll('#plots .plot')].map((plot) => {
+      const box = (e) => { const r = e.getBoundingClientRect(); return { x: r.x, y: r.y, w: r.width, h: r.height }; };
+      const title = plot.querySelector('.title');
+      return { id: plot.id, title: title && box(title), legend: [...plot.querySelectorAll('.legend')].map(box) };
+    }),
+  }));
   await tab.close();
   return { png, info };
 }
@@ -167,6 +187,79 @@ function difference(image, base) {
   return { n, x: n ? x / n : 0, y: n ? y / n : 0 };
 }
 
+// The page's bake (its JSON) without opening it in the browser.
+function bakeOf(page) {
+  const text = require('fs').readFileSync(page, 'utf8');
+  const json = /<script id="treeanim-bake" type="application\/json">(.*?)<\/script>/s.exec(text);
+  if (!json) throw new Error(`${page}: no <script id="treeanim-bake"> element`);
+  return JSON.parse(json[1]);
+}
+
+// The view at the middle of the bake: leaves at least `minShare` of the leaf and bark pixels.
+async function checkLeaves(browser, page, options) {
+  const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
+  const times = bakeOf(page).plot.time;
+  const t = times[Math.floor(times.length / 2)];
+  const [image] = await pixels(browser, [(await viewAt(browser, page, t)).png]);
+  const barkPixels = countLike(image, bark), leafPixels = countLike(image, leaf);
+  const share = leafPixels / Math.max(1, leafPixels + barkPixels);
+  console.log(`${page}: t=${t}: ${barkPixels} bark-coloured, ${leafPixels} leaf-coloured pixels ` +
+              `(leaves ${(100 * share).toFixed(1)} % of the trees)`);
+  const minShare = Number(options['min-leaf-share']);
+  return share >= minShare ? []
+    : [`leaves are ${(100 * share).toFixed(1)} % of the trees' pixels, below ${100 * minShare} %: foliage does not read`];
+}
+
+// The arrow alone (&tree=COUNT shows no tree) at the windiest sample, in each of kArrowSizes:
+// its pixels (the arrow's blue) at least 2 pixels from every edge of the view.
+async function checkArrow(browser, page) {
+  const bake = bakeOf(page);
+  const speeds = bake.plot.time.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
+  const t = bake.plot.time[speeds.indexOf(Math.max(...speeds))];
+  const failures = [];
+  for (const size of kArrowSizes) {
+    const [image] = await pixels(browser, [(await viewAt(browser, page, t, size, `&tree=${bake.trees.length}`)).png]);
+    const blue = hueSat(0x20, 0x60, 0xd0);
+    let n = 0, x0 = Infinity, y0 = Infinity, x1 = -1, y1 = -1;
+    for (let i = 0; i < image.data.length; i += 4) {
+      const got = hueSat(image.data[i], image.data[i + 1], image.data[i + 2]);
+      if (Math.abs(got.hue - blue.hue) > 12 || got.sat < 0.5 * blue.sat) continue;
+      const x = (i / 4) % image.width, y = Math.floor(i / 4 / image.width);
+      ++n; x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+    const where = `${size.width}x${size.height} window, t=${t}`;
+    console.log(`${page}: ${where}: the arrow's ${n} pixels in x ${x0}..${x1}, y ${y0}..${y1} of ` +
+                `${image.width}x${image.height}`);
+    if (n < 20) failures.push(`${where}: no wind arrow (${n} pixels of its colour)`);
+    else if (x0 < 2 || y0 < 2 || x1 > image.width - 3 || y1 > image.height - 3)
+      failures.push(`${where}: the wind arrow reaches the view's edge (x ${x0}..${x1}, y ${y0}..${y1} ` +
+                    `of ${image.width}x${image.height}): part of it is out of the view`);
+  }
+  return failures;
+}
+
+// In each of kCaptionSizes: every plot's title and legend entries, none over another.
+async function checkCaptions(browser, page) {
+  const t = bakeOf(page).plot.time[0];
+  const failures = [];
+  const apart = (a, b) => a.x + a.w <= b.x || b.x + b.w <= a.x || a.y + a.h <= b.y || b.y + b.h <= a.y;
+  for (const size of kCaptionSizes) {
+    const { plots } = (await viewAt(browser, page, t, size)).info;
+    const where = `${size.width}x${size.height} window`;
+    console.log(`${page}: ${where}: ` + plots.map((p) => `${p.id} title ${JSON.stringify(p.title)}, legend ` +
+                                                          JSON.stringify(p.legend)).join('; '));
+    if (plots.length !== 2) failures.push(`${where}: ${plots.length} captioned plots, expected 2`);
+    for (const p of plots) {
+      if (!p.title || !p.legend.length) failures.push(`${where}: plot ${p.id} lacks its title or its legend`);
+      const boxes = [p.title, ...p.legend].filter(Boolean);
+      for (let i = 0; i < boxes.length; ++i)
+        for (let j = 0; j < i; ++j)
+          if (!apart(boxes[i], boxes[j])) failures.push(`${where}: plot ${p.id}: ${j ? 'legend entries' : 'the title and a legend entry'} overlap`);
+    }
+  }
+  return failures;
+}
+
 // Each of the page's trees alone at time t (&tree=K) against the view of none (&tree=COUNT:
 // the grid and the wind arrow alone): drawn, and away from the others on screen.
 async function checkTrees(browser, page, t, count, failures) {
@@ -187,25 +280,17 @@ async function checkTrees(browser, page, t, count, failures) {
   });
 }
 
-// The bake data a page embeds (its plot: time, max_displacement, ...).
-function bakeData(page) {
-  const text = require('fs').readFileSync(page, 'utf8');
-  const json = /<script id="treeanim-bake" type="application\/json">(.*?)<\/script>/s.exec(text);
-  if (!json) throw new Error(`${page}: no <script id="treeanim-bake"> element`);
-  return JSON.parse(json[1]);
-}
-
 // SECONDS of a command line => a time; "largest": the frame of the page's largest displacement.
 function timeOf(page, text) {
   if (text !== 'largest') return text;
-  const plot = bakeData(page).plot;
+  const plot = bakeOf(page).plot;
   const k = plot.max_displacement.reduce((best, d, i) => (d > plot.max_displacement[best] ? i : best), 0);
   return plot.time[k];
 }
 
 async function check(browser, page, options) {
   const bark = parseColor(options.bark, 'bark'), leaf = parseColor(options.leaf, 'leaf');
-  const times = bakeData(page).plot.time;
+  const times = bakeOf(page).plot.time;
   const t0 = times[Math.floor(times.length / 3)], t1 = times[Math.floor((2 * times.length) / 3)];
   const a = await viewAt(browser, page, t0), b = await viewAt(browser, page, t1);
   const [ia, ib] = await pixels(browser, [a.png, b.png]);
@@ -265,15 +350,17 @@ async function main() {
       console.log(page);
       return 0;
     }
-    if (command === 'check') {
+    const checks = { check, leaves: checkLeaves, arrow: checkArrow, captions: checkCaptions };
+    if (checks[command]) {
       const options = {};
       for (let i = 0; i < rest.length; i += 2) options[rest[i].replace(/^--/, '')] = rest[i + 1];
-      const failures = await check(browser, page, options);
+      const failures = await checks[command](browser, page, options);
       for (const f of failures) console.log(`FAIL: ${f}`);
       return failures.length ? 1 : 0;
     }
-    console.error('usage: preview_page.js shot PAGE OUT.png SECONDS... | gallery OUT.png COLUMNS LABEL PAGE SECONDS... | ' +
-                  'check PAGE --bark R,G,B --leaf R,G,B');
+    console.error('usage: preview_page.js shot PAGE OUT.png SECONDS... | gallery OUT.png COLUMNS LABEL PAGE SECONDS...' +
+                  ' | check PAGE --bark R,G,B --leaf R,G,B | leaves PAGE --bark R,G,B --leaf R,G,B --min-leaf-share F' +
+                  ' | arrow PAGE | captions PAGE');
     return 2;
   } finally {
     await browser.close();
