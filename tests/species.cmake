@@ -52,3 +52,21 @@ exec '${TREEANIM_NODE}' tests/clients/node/preview_page.js check '${page}/page.h
   endif()
   set_tests_properties(species.preview_${name} PROPERTIES LABELS "species;preview" TIMEOUT 300)
 endforeach()
+
+# configs/forest-species.json seen whole: a wood of nine species, its leaves (needle sprays and
+# fronds) still reading at that distance against the oaks' colours of bark and leaf.
+set(species_forest ${species_pages}/forest-species)
+species_color(0 bark_color bark)
+species_color(0 leaf_color leaf)
+if(TREEANIM_NODE AND EXISTS ${CMAKE_SOURCE_DIR}/tests/clients/node/node_modules/playwright-core AND EXISTS /usr/bin/chromium)
+  add_test(NAME species.forest_page
+    COMMAND sh -c "rm -rf '${species_forest}' && '$<TARGET_FILE:treeanim>' run configs/forest-species.json \
+-o '${species_forest}' --quiet --set time.frames=24 && \
+exec '${TREEANIM_NODE}' tests/clients/node/preview_page.js leaves '${species_forest}/forest.html' --bark ${bark} \
+--leaf ${leaf} --min-leaf-share 0.4"
+    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+else()
+  add_test(NAME species.forest_page
+           COMMAND sh -c "echo 'node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
+endif()
+set_tests_properties(species.forest_page PROPERTIES LABELS "species;preview" TIMEOUT 300)

@@ -1,30 +1,14 @@
 // treeanim species [--json]: the species library, each grown at its default height.
-#include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <limits>
-#include <numbers>
 
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
 #include "scene/species.h"
-#include "sim/bar_chain.h"
 
 namespace treeanim {
 
 namespace {
-
-// The tree's first sway frequency (Hz) as the solver's stiffness sets it: Rayleigh's estimate for
-// the limb hanging from each root cluster, root plate included (docs/solver.md "Stiffness"), the
-// softest stem's.
-double first_sway_frequency(const TreeModel& model, const HsmOptions& hsm) {
-  const std::vector<double> limb = limb_frequencies(model, build_bar_chain(model, hsm));
-  double omega = std::numeric_limits<double>::infinity();
-  for (size_t c = 0; c < model.cluster_count(); ++c)
-    if (model.cluster_parent[c] < 0 && model.cluster_kind[c] == kClusterBranch) omega = std::min(omega, limb[c]);
-  omega = std::min(std::max(omega, hsm.min_limb_frequency), hsm.max_limb_frequency);
-  return omega / (2 * std::numbers::pi);
-}
 
 Json species_row(const Species& species) {
   const Scene scene = load_scene_text(Json{{"species", species.name}}.dump(), "species " + species.name, "", {});
@@ -37,7 +21,7 @@ Json species_row(const Species& species) {
           {"vertices", tree.model.vertex_count()},
           {"clusters", tree.model.cluster_count()},
           {"leaves", tree.model.leaf_count()},
-          {"sway_frequency_hz", first_sway_frequency(tree.model, scene.hsm)},
+          {"sway_frequency_hz", species.sway_frequency},
           {"youngs_modulus", scene.hsm.youngs_modulus},
           {"wood_density", scene.tree.wood_density},
           {"sources", species.sources}};

@@ -61,6 +61,8 @@ Species read_entry(const Json& entry) {
   s.max_height = height.value("max", 0.0);
   if (!(0 < s.min_height && s.min_height <= s.default_height && s.default_height <= s.max_height))
     table_defect(s.name + ": expected 0 < height.min <= height.default <= height.max");
+  s.sway_frequency = entry.value("sway_frequency_hz", 0.0);
+  if (!(s.sway_frequency > 0)) table_defect(s.name + ": expected its measured sway_frequency_hz > 0");
   s.grammar = embedded_grammar(table_string(entry, "grammar"));
   s.tree = read_preset(s, entry, "tree", [](SceneObject section) { return read_tree_options(section); });
   s.hsm = entry.value("hsm", Json::object());

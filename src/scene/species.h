@@ -19,6 +19,7 @@ struct Species {
   std::string latin;   // Quercus robur
   std::string habit;   // one line on its shape
   double default_height = 0, min_height = 0, max_height = 0;  // m; the grammar grows default_height at scale 1
+  double sway_frequency = 0;  // Hz, its first sway frequency at default_height, plucked (tests/species holds it to that)
   GrammarText grammar;  // named "grammars/species/<file>" in messages
   TreeOptions tree;     // the preset's /tree at default_height
   Json hsm;             // the preset's /hsm keys (its wood), read over a scene's own
