@@ -36,14 +36,14 @@ int species_command(bool json) {
     std::cout << rows.dump(2) << "\n";
     return 0;
   }
-  std::printf("%-18s %-44s %-18s %8s %8s %9s\n", "name", "species", "height m (default)", "vertices", "clusters",
+  std::printf("%-18s %-52s %-18s %8s %8s %9s\n", "name", "species", "height m (default)", "vertices", "clusters",
               "sway Hz");
   for (const Json& row : rows) {
     const std::string name = row["common"].get<std::string>() + " (" + row["latin"].get<std::string>() + ")";
     char height[96];
     std::snprintf(height, sizeof height, "%g-%g (%g)", row["height"]["min"].get<double>(),
                   row["height"]["max"].get<double>(), row["height"]["default"].get<double>());
-    std::printf("%-18s %-44s %-18s %8lld %8lld %9.2f\n", row["name"].get<std::string>().c_str(), name.c_str(), height,
+    std::printf("%-18s %-52s %-18s %8lld %8lld %9.2f\n", row["name"].get<std::string>().c_str(), name.c_str(), height,
                 row["vertices"].get<long long>(), row["clusters"].get<long long>(),
                 row["sway_frequency_hz"].get<double>());
   }
