@@ -61,6 +61,7 @@ json tree_json(const PageHeader& header, std::string rest, std::string triangles
   tree["rest"] = std::move(rest);
   tree["triangles"] = std::move(triangles);
   tree["bark_triangles"] = header.bark_triangles;
+  tree["colors"] = {{"bark", header.bark}, {"leaf", header.leaf}};  // a forest page keeps each tree's
   tree["frames"] = std::move(frames);
   return tree;
 }

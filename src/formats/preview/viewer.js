@@ -71,15 +71,13 @@ sun.position.set(0.4, 1, 0.7);
 scene.add(sun);
 
 const srgb = (rgb) => new THREE.Color().setRGB(rgb[0], rgb[1], rgb[2], THREE.SRGBColorSpace);
-const materials = [
-  new THREE.MeshLambertMaterial({ color: srgb(bake.colors.bark) }),
-  new THREE.MeshLambertMaterial({ color: srgb(bake.colors.leaf), side: THREE.DoubleSide }),
-];
 // A blade a few pixels long, or seen edge-on, falls between pixels, and a forest seen whole
 // reads as bare twigs: every leaf under three dots long on screen is also drawn as a round
-// dot of the leaf colour at its centre (dotPx, the drawing buffer's pixels).
+// dot of the leaf colour at its centre (dotPx, the drawing buffer's pixels; the uniforms the
+// dots of every tree share).
+const dotUniforms = { halfHeight: { value: 1 }, dotPx: { value: 1 } };
 const leafDots = new THREE.ShaderMaterial({
-  uniforms: { color: { value: materials[1].color }, halfHeight: { value: 1 }, dotPx: { value: 1 } },
+  uniforms: { color: { value: new THREE.Color() }, ...dotUniforms },
   vertexShader: `
     attribute float leafSize;
     uniform float halfHeight, dotPx;
@@ -99,6 +97,19 @@ const leafDots = new THREE.ShaderMaterial({
     }`,
 });
 const kLeafDotCssPx = 3;
+// A tree's colours (its own, as a forest of several species has them, else the page's) => its
+// bark and leaf materials and its leaf dots', one set per colour pair.
+const materialSets = new Map();
+function materialsOf(colors) {
+  const key = JSON.stringify(colors);
+  if (!materialSets.has(key)) {
+    const leaf = new THREE.MeshLambertMaterial({ color: srgb(colors.leaf), side: THREE.DoubleSide });
+    const dots = leafDots.clone();
+    dots.uniforms = { color: { value: leaf.color }, ...dotUniforms };
+    materialSets.set(key, { mesh: [new THREE.MeshLambertMaterial({ color: srgb(colors.bark) }), leaf], dots });
+  }
+  return materialSets.get(key);
+}
 
 // Triangle indices from `first` on => their vertices, one array per connected piece (a leaf).
 function connectedPieces(index, first) {
@@ -131,8 +142,8 @@ function leafCentres(leaves, p, out) {
   });
 }
 
-// A tree's leaves as dots (leafDots) at their centres, in the tree's mesh.
-function makeLeafDots(mesh, rest, barkIndices) {
+// A tree's leaves as dots (`material`, its leafDots) at their centres, in the tree's mesh.
+function makeLeafDots(mesh, rest, barkIndices, material) {
   const leaves = connectedPieces(mesh.geometry.index.array, barkIndices);
   const centres = new THREE.BufferAttribute(new Float32Array(3 * leaves.length), 3);
   centres.setUsage(THREE.DynamicDrawUsage);
@@ -142,7 +153,7 @@ function makeLeafDots(mesh, rest, barkIndices) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', centres);
   geometry.setAttribute('leafSize', new THREE.BufferAttribute(new Float32Array(sizes), 1));
-  const dots = new THREE.Points(geometry, leafDots);
+  const dots = new THREE.Points(geometry, material);
   dots.frustumCulled = false;  // the leaves move past the rest pose's bounds
   mesh.add(dots);  // placed, and shown alone (&tree=K), with its tree
   return { leaves, centres };
@@ -160,11 +171,12 @@ function makeTree(tree) {
   geometry.addGroup(0, barkIndices, 0);
   geometry.addGroup(barkIndices, geometry.index.count - barkIndices, 1);
   geometry.computeVertexNormals();
-  const mesh = new THREE.Mesh(geometry, materials);
+  const own = materialsOf(tree.colors || bake.colors);
+  const mesh = new THREE.Mesh(geometry, own.mesh);
   mesh.position.fromArray(tree.position);
   mesh.rotation.y = THREE.MathUtils.degToRad(tree.rotation);
   scene.add(mesh);
-  const dots = makeLeafDots(mesh, rest, barkIndices);
+  const dots = makeLeafDots(mesh, rest, barkIndices, own.dots);
   const data = tree.frames.encoding === 'int16' ? decode(tree.frames.data, Int16Array)
                                                  : decode(tree.frames.data, Float32Array);
   const quantized = tree.frames.encoding === 'int16';
@@ -366,8 +378,8 @@ function show(t) {
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
   renderer.setSize(w, h);
-  leafDots.uniforms.halfHeight.value = renderer.getDrawingBufferSize(new THREE.Vector2()).y / 2;
-  leafDots.uniforms.dotPx.value = kLeafDotCssPx * renderer.getPixelRatio();
+  dotUniforms.halfHeight.value = renderer.getDrawingBufferSize(new THREE.Vector2()).y / 2;
+  dotUniforms.dotPx.value = kLeafDotCssPx * renderer.getPixelRatio();
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
   if (!framed) frame();
