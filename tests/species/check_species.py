@@ -261,6 +261,9 @@ def main():
     parser.add_argument("--list", action="store_true")
     parser.add_argument("species", nargs="?")
     args = parser.parse_args()
+    # One thread per bake, the 64-substep references too: ctest runs tests side by side, and
+    # OpenMP threads that wait on a busy core spin.
+    os.environ["OMP_NUM_THREADS"] = "1"
     with tempfile.TemporaryDirectory() as tmp:
         failures = check_list(args.treeanim, tmp) if args.list else check_species(args.treeanim, args.species, tmp)
     for failure in failures:
