@@ -19,7 +19,7 @@ namespace treeanim {
 // frame loop's last substeps may still read.
 constexpr size_t kVolumeFramesKept = 3;
 
-// One frame of the sequence in memory (defined in wind_volume.cpp: OpenVDB grids).
+// One frame of the sequence in memory (defined in wind_volume.cpp: the grids the OpenVDB module read).
 struct VolumeFrame;
 
 // The frames around one time: velocity = (1 - weight) frame[0] + weight frame[1].

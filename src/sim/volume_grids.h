@@ -1,0 +1,45 @@
+#pragma once
+// One frame's velocity grids, as the OpenVDB reader (src/vdb/) holds them. That reader is a module
+// that treeanim loads, and OpenVDB with it, only when a scene blows a wind volume: linked into the
+// binary, OpenVDB's 57 MB library cost every run some 29 MB of memory and most of its start-up
+// (docs/design.md, "OpenVDB on demand").
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace treeanim {
+
+class VolumeGrids {
+ public:
+  virtual ~VolumeGrids() = default;
+  // "vec3s grid 'vel'" or "float grids 'vel.x', 'vel.y', 'vel.z'"
+  virtual std::string layout() const = 0;
+  // The first grid's largest voxel edge, in the volume's units.
+  virtual double voxel_size() const = 0;
+  // The eight corners of each grid's box of active voxel centres, in the volume's space (none
+  // for a grid without active voxels).
+  virtual std::vector<Eigen::Vector3d> corners() const = 0;
+  // Points in the volume's space (3 x N) => the velocity at each (volume units, trilinear over
+  // the voxel centres) and whether it is inside the active voxels; `clamp` moves a point onto
+  // their box first (the nearest voxel's value beyond the edge). Parallel over 4,096 points or more.
+  virtual void sample(const Eigen::Matrix3Xd& points, bool clamp, Eigen::Matrix3Xd& velocity,
+                      std::vector<uint8_t>& inside) const = 0;
+  // The same for one point; false outside.
+  virtual bool sample(const Eigen::Vector3d& point, bool clamp, Eigen::Vector3d& velocity) const = 0;
+  // Every active voxel => visit(its grid's name, its index coordinates, its speed in volume units,
+  // whether its velocity is finite). A split grid's speed is its components' at that voxel.
+  using VoxelVisit = std::function<void(const std::string& grid, const std::array<int, 3>& ijk, double speed,
+                                        bool finite)>;
+  virtual void visit_active(const VoxelVisit& visit) const = 0;
+};
+
+// The module's entry point, found by this name: a frame file and its grid's name => its
+// grids read whole (no delayed loading: a truncated file fails here, not in a step), or null
+// with `error` set to what is wrong (a message that follows the file's path).
+using ReadVolumeGrids = VolumeGrids*(const std::string& path, const std::string& grid, std::string& error);
+constexpr const char* kReadVolumeGrids = "treeanim_read_volume_grids";
+
+}  // namespace treeanim

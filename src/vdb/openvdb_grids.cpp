@@ -1,0 +1,218 @@
+// The OpenVDB reader module (sim/volume_grids.h): the only code that links OpenVDB, loaded by
+// sim/wind_volume.cpp when a scene has a wind volume.
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Interpolation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <mutex>
+
+#include "sim/volume_grids.h"
+
+namespace treeanim {
+
+namespace {
+
+std::once_flag openvdb_initialised;
+
+// The grid's type as messages name it.
+std::string grid_type(const openvdb::GridBase& grid) { return grid.valueType(); }
+
+// Grids of the file => "'a' (vec3s), 'b' (float)" for a message naming what is there.
+std::string grid_list(openvdb::io::File& file) {
+  std::string list;
+  const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+  for (const openvdb::GridBase::Ptr& grid : *grids)
+    list += (list.empty() ? "'" : ", '") + grid->getName() + "' (" + grid_type(*grid) + ")";
+  return list.empty() ? "none" : list;
+}
+
+// Index-space point => inside the box of active voxels (voxel centres at whole coordinates);
+// `clamp`: moved onto the box first.
+bool inside_box(const openvdb::CoordBBox& box, openvdb::Vec3d& ijk, bool clamp) {
+  if (box.empty()) return false;
+  bool inside = true;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = box.min()[k], hi = box.max()[k];
+    if (ijk[k] < lo || ijk[k] > hi) {
+      inside = false;
+      if (clamp) ijk[k] = std::clamp(ijk[k], lo, hi);
+    }
+  }
+  return inside || clamp;
+}
+
+// A frame's velocity: one vec3s grid, or three float grids (Houdini's split vel.x/.y/.z, each
+// with its own transform, as a staggered grid has), each with its active voxels' box.
+class OpenVdbGrids final : public VolumeGrids {
+ public:
+  std::string name;                                    // the velocity grid's name
+  openvdb::Vec3SGrid::ConstPtr vector;                 // null for split grids
+  std::array<openvdb::FloatGrid::ConstPtr, 3> split;   // null for a vec3s grid
+  std::array<openvdb::CoordBBox, 3> box;               // index space: the active voxels' box, per grid
+
+  std::string layout() const override {
+    return vector ? "vec3s grid '" + name + "'" : "float grids '" + name + ".x', '" + name + ".y', '" + name + ".z'";
+  }
+
+  double voxel_size() const override {
+    const openvdb::Vec3d voxel = vector ? vector->voxelSize() : split[0]->voxelSize();
+    return std::max({voxel[0], voxel[1], voxel[2]});
+  }
+
+  std::vector<Eigen::Vector3d> corners() const override {
+    std::vector<Eigen::Vector3d> points;
+    for (int k = 0; k < (vector ? 1 : 3); ++k) {
+      const openvdb::GridBase& grid = vector ? static_cast<const openvdb::GridBase&>(*vector) : *split[k];
+      if (box[k].empty()) continue;
+      const openvdb::Coord &lo = box[k].min(), &hi = box[k].max();
+      for (int corner = 0; corner < 8; ++corner) {
+        const openvdb::Vec3d ijk((corner & 1 ? hi : lo).x(), (corner & 2 ? hi : lo).y(), (corner & 4 ? hi : lo).z());
+        const openvdb::Vec3d p = grid.transform().indexToWorld(ijk);
+        points.emplace_back(p[0], p[1], p[2]);
+      }
+    }
+    return points;
+  }
+
+  void sample(const Eigen::Matrix3Xd& points, bool clamp, Eigen::Matrix3Xd& velocity,
+              std::vector<uint8_t>& inside) const override {
+    const Eigen::Index n = points.cols();
+    velocity.resize(3, n);
+    inside.resize(size_t(n));
+#pragma omp parallel if (n >= 4096)
+    {
+      Accessors access(*this);
+#pragma omp for schedule(static)
+      for (Eigen::Index i = 0; i < n; ++i) {
+        Eigen::Vector3d v = Eigen::Vector3d::Zero();
+        inside[size_t(i)] = sample_at(access, points.col(i), clamp, v);
+        velocity.col(i) = v;
+      }
+    }
+  }
+
+  bool sample(const Eigen::Vector3d& point, bool clamp, Eigen::Vector3d& velocity) const override {
+    Accessors access(*this);
+    return sample_at(access, point, clamp, velocity);
+  }
+
+  void visit_active(const VoxelVisit& visit) const override {
+    auto coordinates = [](const openvdb::Coord& c) { return std::array<int, 3>{c.x(), c.y(), c.z()}; };
+    if (vector) {
+      for (auto it = vector->cbeginValueOn(); it; ++it) {
+        const openvdb::Vec3s v = *it;
+        const bool finite = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+        visit(name, coordinates(it.getCoord()), finite ? v.length() : 0, finite);
+      }
+      return;
+    }
+    std::array<openvdb::FloatGrid::ConstAccessor, 3> access{split[0]->getConstAccessor(), split[1]->getConstAccessor(),
+                                                           split[2]->getConstAccessor()};
+    const char* axes[3] = {".x", ".y", ".z"};
+    for (int k = 0; k < 3; ++k)
+      for (auto it = split[k]->cbeginValueOn(); it; ++it) {
+        double squared = 0;
+        bool finite = true;
+        for (int j = 0; j < 3; ++j) {
+          const float c = j == k ? *it : access[j].getValue(it.getCoord());
+          finite = finite && std::isfinite(c);
+          squared += double(c) * c;
+        }
+        visit(name + axes[k], coordinates(it.getCoord()), finite ? std::sqrt(squared) : 0, finite);
+      }
+  }
+
+ private:
+  // Read accessors of one thread (an accessor caches its path through the tree).
+  struct Accessors {
+    explicit Accessors(const OpenVdbGrids& grids)
+        : vector(grids.vector ? grids.vector->getConstAccessor() : empty_vector().getConstAccessor()),
+          split{grids.split[0] ? grids.split[0]->getConstAccessor() : empty_float().getConstAccessor(),
+                grids.split[1] ? grids.split[1]->getConstAccessor() : empty_float().getConstAccessor(),
+                grids.split[2] ? grids.split[2]->getConstAccessor() : empty_float().getConstAccessor()} {}
+    static const openvdb::Vec3SGrid& empty_vector() {
+      static const openvdb::Vec3SGrid::Ptr grid = openvdb::Vec3SGrid::create();
+      return *grid;
+    }
+    static const openvdb::FloatGrid& empty_float() {
+      static const openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create();
+      return *grid;
+    }
+    openvdb::Vec3SGrid::ConstAccessor vector;
+    std::array<openvdb::FloatGrid::ConstAccessor, 3> split;
+  };
+
+  // A point in the volume's space => its velocity in volume units; false outside the active
+  // voxels (unless clamped to them).
+  bool sample_at(Accessors& access, const Eigen::Vector3d& point, bool clamp, Eigen::Vector3d& velocity) const {
+    const openvdb::Vec3d p(point.x(), point.y(), point.z());
+    openvdb::Vec3d v;
+    if (vector) {
+      openvdb::Vec3d ijk = vector->worldToIndex(p);
+      if (!inside_box(box[0], ijk, clamp)) return false;
+      v = openvdb::tools::BoxSampler::sample(access.vector, ijk);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        openvdb::Vec3d ijk = split[k]->worldToIndex(p);
+        if (!inside_box(box[k], ijk, clamp)) return false;
+        v[k] = openvdb::tools::BoxSampler::sample(access.split[k], ijk);
+      }
+    }
+    velocity = Eigen::Vector3d(v[0], v[1], v[2]);
+    return true;
+  }
+};
+
+// Frame file, grid name => its grids read whole; throws std::runtime_error with what is wrong.
+std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::string& name) {
+  std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
+  auto frame = std::make_unique<OpenVdbGrids>();
+  frame->name = name;
+  openvdb::io::File file(path);
+  file.open(false);
+  if (file.hasGrid(name)) {
+    openvdb::GridBase::Ptr grid = file.readGrid(name);
+    frame->vector = openvdb::GridBase::grid<openvdb::Vec3SGrid>(grid);
+    if (!frame->vector)
+      throw std::invalid_argument("grid '" + name + "' holds " + grid_type(*grid) +
+                                  " values; a velocity is a vec3s grid, or the float grids '" + name + ".x', '" +
+                                  name + ".y', '" + name + ".z'");
+    frame->box[0] = frame->vector->evalActiveVoxelBoundingBox();
+  } else {
+    const char* axes[3] = {".x", ".y", ".z"};
+    for (int k = 0; k < 3; ++k) {
+      const std::string component = name + axes[k];
+      if (!file.hasGrid(component))
+        throw std::invalid_argument("no grid '" + name + "' (nor '" + name + ".x', '" + name + ".y', '" + name +
+                                    ".z'); its grids: " + grid_list(file));
+      openvdb::GridBase::Ptr grid = file.readGrid(component);
+      frame->split[k] = openvdb::GridBase::grid<openvdb::FloatGrid>(grid);
+      if (!frame->split[k])
+        throw std::invalid_argument("grid '" + component + "' holds " + grid_type(*grid) +
+                                    " values; a velocity component is a float grid");
+      frame->box[k] = frame->split[k]->evalActiveVoxelBoundingBox();
+    }
+  }
+  file.close();
+  return frame;
+}
+
+}  // namespace
+
+}  // namespace treeanim
+
+// The entry point (sim/volume_grids.h): no exception leaves the module.
+extern "C" __attribute__((visibility("default"))) treeanim::VolumeGrids* treeanim_read_volume_grids(
+    const std::string& path, const std::string& grid, std::string& error) {
+  try {
+    return treeanim::read_grids(path, grid).release();
+  } catch (const std::invalid_argument& e) {
+    error = e.what();
+  } catch (const std::exception& e) {  // openvdb::Exception, and the streams' failures on a truncated file
+    error = std::string("not a readable VDB file (") + e.what() + ")";
+  }
+  return nullptr;
+}
