@@ -24,6 +24,25 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
   return Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix();
 }
 
+// The same by Rodrigues' formula, R = cos a I + (sin a / a) [theta]x + ((1 - cos a) / a^2) theta theta^T,
+// its factors from their series below 0.05 rad (to a^8: the next term is below 3e-21), where
+// a joint of the chain turns in all but a gale; rotation_of above it. hsm.particles "samples"
+// takes it: its clusters' fixed costs are its step's, and the sine and cosine were a twentieth
+// of them; "vertices" keeps the paper's set-up byte for byte.
+Eigen::Matrix3d small_rotation_of(const Eigen::Vector3d& theta) {
+  const double a2 = theta.squaredNorm();
+  if (!(a2 < 0.0025)) return rotation_of(theta);
+  const double sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
+  const double versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
+  Eigen::Matrix3d R = versine * theta * theta.transpose();
+  R.diagonal().array() += 1 - versine * a2;
+  const Eigen::Vector3d s = sine * theta;
+  R(0, 1) -= s.z(), R(1, 0) += s.z();
+  R(0, 2) += s.y(), R(2, 0) -= s.y();
+  R(1, 2) -= s.x(), R(2, 1) += s.x();
+  return R;
+}
+
 // A joint's turn => the same turn, at most `largest` long (its yield turn).
 Eigen::Vector3d capped_turn(const Eigen::Vector3d& theta, double largest) {
   const double angle = theta.norm();
@@ -260,7 +279,8 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
                                      compliance * attachment.cluster_drag_arm.col(c), unresolved, largest)
                  : capped_turn(loaded, largest);
     scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
-    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
+    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) =
+        model.small_turns ? small_rotation_of(theta) : rotation_of(theta);
   }
   // The trunk on one thread, then the limbs below it in parallel.
   auto carry_down = [&](uint32_t c) {

@@ -19,7 +19,7 @@ Eigen::Quaterniond increment(const Eigen::Vector3d& omega, double angle) {
 
 }  // namespace
 
-int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations) {
+int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations, double newton_stop) {
   // Müller et al. step: the torque sum_i r_i x a_i of the columns (the gradient of
   // tr(R^T A) over a rotation increment), divided by |tr(R^T A)| + 1e-9. That step is slow
   // about the long axis of an elongated cluster (a branch segment: 1% per iteration at a
@@ -71,10 +71,10 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
     }
     q = increment(omega, angle) * q;
     q.normalize();
-    // Newton converges quadratically: after a step below 1e-6 rad the error left is of the
-    // order of 1e-12 rad, what the test above would find, so that test is not repeated; a
-    // gradient step below 1e-9 rad has nowhere left to go.
-    if (angle < kEps || (newton && angle < 1e-6)) {
+    // Newton converges quadratically: after a step below newton_stop the error left is of the
+    // order of its square (1e-12 rad after 1e-6, what the test above would find), so that test
+    // is not repeated; a gradient step below 1e-9 rad has nowhere left to go.
+    if (angle < kEps || (newton && angle < newton_stop)) {
       ++iteration;
       break;
     }

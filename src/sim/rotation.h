@@ -6,8 +6,18 @@
 
 namespace treeanim {
 
+// Where the Newton iterations stop (docs/solver.md, "Rotation"): after a step below 1e-6 rad,
+// with some 1e-12 rad left, the rotation of round-off that the paper's set-up (hsm.particles
+// "vertices") keeps; after one below 1e-3 rad, with at most some 1e-10 rad left (test
+// Rotation.AWarmStartASubstepAwayTakesOneStepWithTheSamplesTolerance), far below a step's own
+// error: "samples", where a cluster's fixed costs are the step's, takes one step a substep
+// where the vertices take two.
+constexpr double kNewtonStopRoundOff = 1e-6;
+constexpr double kNewtonStopSamples = 1e-3;
+
 // A (any 3x3, e.g. a cluster's normalised A_pq) + warm start q => q updated in place to the
-// rotation R maximising tr(R^T A) locally, reached by at most `max_iterations` steps.
+// rotation R maximising tr(R^T A) locally, reached by at most `max_iterations` steps; a Newton
+// step shorter than `newton_stop` rad ends them, its square of the order of what is left.
 //
 // Why this method and not a polar decomposition (SVD, or the paper's S^-1 from A^T A):
 // it works on the rotation directly, so R is a proper rotation (det +1) by construction, also
@@ -15,6 +25,7 @@ namespace treeanim {
 // planar leaf (rank 2) or a collinear two-ring cluster (rank 1) yields no NaN; where A leaves
 // the rotation undetermined (the spin about a collinear cluster's axis) it keeps the warm start,
 // so nothing jitters. Returns the iterations used.
-int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations);
+int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations,
+                     double newton_stop = kNewtonStopRoundOff);
 
 }  // namespace treeanim

@@ -19,8 +19,8 @@ namespace treeanim {
 
 template <typename Real>
 bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
-                 const Eigen::Vector3d* pinned_point, int max_iterations, Eigen::Quaterniond& rotation,
-                 Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
+                 const Eigen::Vector3d* pinned_point, int max_iterations, double newton_stop,
+                 Eigen::Quaterniond& rotation, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
   const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
   // numbers wherever the tree stands and however far it travelled. With the rest terms
@@ -60,7 +60,7 @@ bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<R
   A *= a.cluster_match_scale[c];
   A += Eigen::Map<const Eigen::Matrix3d>(&a.cluster_rest_moment(0, c));
   A -= point_shift * a.cluster_offset_sum.col(c).transpose();
-  extract_rotation(A, rotation, max_iterations);
+  extract_rotation(A, rotation, max_iterations, newton_stop);
   R = rotation.toRotationMatrix();
   // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
   shift = point_shift - (R * point - point);
@@ -123,7 +123,7 @@ bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attac
   Eigen::Matrix3d R;
   Eigen::Vector3d shift;
   const bool finite = fit_cluster(model.tree, attachment, predicted_offset, c, pinned_point,
-                                  model.options.rotation_iterations, rotation, R, shift);
+                                  model.options.rotation_iterations, model.rotation_newton_stop, rotation, R, shift);
   state.cluster_rotations.col(c) = rotation.coeffs();
   state.cluster_shift.col(c) = shift;
   Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
@@ -185,7 +185,8 @@ void throw_match_failure(long long frame, int substep, uint32_t cluster) {
 
 #define TREEANIM_SHAPE_MATCHING(Real)                                                                              \
   template bool fit_cluster(const TreeModel&, const Attachment<Real>&, const Rows3<Real>&, size_t,                 \
-                            const Eigen::Vector3d*, int, Eigen::Quaterniond&, Eigen::Matrix3d&, Eigen::Vector3d&); \
+                            const Eigen::Vector3d*, int, double, Eigen::Quaterniond&, Eigen::Matrix3d&,          \
+                            Eigen::Vector3d&);                                                                     \
   template void write_corrections(const SolverModel<Real>&, const Attachment<Real>&, const Rows3<Real>&, size_t,   \
                                   const Eigen::Matrix3d&, const Eigen::Vector3d&, Rows3<Real>&);                   \
   template bool match_cluster(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,    \

@@ -15,8 +15,8 @@ namespace treeanim {
 // value is not finite.
 template <typename Real>
 bool fit_cluster(const TreeModel& tree, const Attachment<Real>& attachment, const Rows3<Real>& predicted_offset,
-                 size_t c, const Eigen::Vector3d* pinned_point, int max_iterations, Eigen::Quaterniond& rotation,
-                 Eigen::Matrix3d& R, Eigen::Vector3d& shift);
+                 size_t c, const Eigen::Vector3d* pinned_point, int max_iterations, double newton_stop,
+                 Eigen::Quaterniond& rotation, Eigen::Matrix3d& R, Eigen::Vector3d& shift);
 
 // Goals g = R q + t of cluster c, with t given as t - t0 => per-membership corrections
 // alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p) in `corrections` (0 for a released

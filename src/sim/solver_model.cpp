@@ -6,6 +6,7 @@
 
 #include "common/errors.h"
 #include "sim/bar_chain.h"
+#include "sim/rotation.h"
 #include "sim/solver_step.h"
 #include "sim/stiffness.h"
 
@@ -306,7 +307,9 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
       M(t.membership_count()), L(t.leaf_count()), I(0), detach_enabled(o.leaf_detach_force > 0 && t.leaf_count() > 0),
       beam(o.global_matching), kick(beam && o.stiffness == StiffnessMode::kPhysical),
       store_drag_force(detach_enabled || beam),
-      parallel(t.membership_count() >= kParallelMemberships) {
+      parallel(t.membership_count() >= kParallelMemberships),
+      rotation_newton_stop(o.particles == ParticleMode::kSamples ? kNewtonStopSamples : kNewtonStopRoundOff),
+      small_turns(o.particles == ParticleMode::kSamples) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   const double extent = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
   chain = build_bar_chain(t, o);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstdio>
 #include <random>
 
 #include "sim/rotation.h"
@@ -133,6 +134,27 @@ TEST(Rotation, TinyScaleWorks) {
     expect_proper(q);
     EXPECT_LT(angle_between(q, truth), 1e-6) << "trial " << trial;
   }
+}
+
+// A warm start a substep's turn away (below 1e-3 rad): the samples' tolerance takes one
+// Newton step and leaves of the order of its square; the vertices' takes a second, to round-off.
+TEST(Rotation, AWarmStartASubstepAwayTakesOneStepWithTheSamplesTolerance) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> turn(1e-5, 9e-4);
+  double worst_one = 0, worst_two = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const Eigen::Quaterniond truth = random_rotation(rng);
+    const Eigen::Matrix3d A = truth.toRotationMatrix() * random_stretch(rng);
+    const Eigen::Quaterniond off(Eigen::AngleAxisd(turn(rng), random_rotation(rng) * Eigen::Vector3d::UnitX()));
+    Eigen::Quaterniond samples = off * truth, vertices = samples;
+    EXPECT_EQ(extract_rotation(A, samples, 12, kNewtonStopSamples), 1) << "trial " << trial;
+    EXPECT_EQ(extract_rotation(A, vertices, 12, kNewtonStopRoundOff), 2) << "trial " << trial;
+    worst_one = std::max(worst_one, angle_between(samples, truth));
+    worst_two = std::max(worst_two, angle_between(vertices, truth));
+  }
+  EXPECT_LT(worst_one, 1e-9);
+  EXPECT_LT(worst_two, 1e-12);
+  std::printf("one step: %.3g rad at most; two: %.3g rad\n", worst_one, worst_two);
 }
 
 TEST(Rotation, ZeroMatrixKeepsWarmStart) {

@@ -119,6 +119,25 @@ def check_bad(treeanim, tmp):
                 failures.append(f"{name} ({arguments[0]}): " + "; ".join(problems))
             else:
                 print(f"{name} ({arguments[0]}): exit 2: {result.stderr.strip()}")
+    # A binary copied without the OpenVDB module beside it bakes a scene without a volume, and
+    # refuses one with a volume, before writing anything, saying why.
+    copied = os.path.join(tmp, "copied", "treeanim")
+    os.makedirs(os.path.dirname(copied))
+    shutil.copy2(treeanim, copied)
+    path = scene(tmp, "no-module.json", volume(vol), nine)
+    for arguments in (["run", path, "-o", os.path.join(tmp, "out-no-module")], ["validate", path]):
+        result = run(copied, *arguments)
+        message = "treeanim's OpenVDB reader could not be loaded"
+        if result.returncode != 2 or message not in result.stderr:
+            failures.append(f"no module ({arguments[0]}): exit {result.returncode}, stderr {result.stderr.strip()!r}")
+        elif os.path.exists(os.path.join(tmp, "out-no-module")) and os.listdir(os.path.join(tmp, "out-no-module")):
+            failures.append(f"no module ({arguments[0]}): wrote {os.listdir(os.path.join(tmp, 'out-no-module'))}")
+        else:
+            print(f"no module ({arguments[0]}): exit 2: {result.stderr.strip()}")
+    calm = scene(tmp, "no-volume.json", {"keys": [{"time": 0, "speed": 2, "direction": [1, 0, 0]}]}, nine)
+    result = run(copied, "run", calm, "-o", os.path.join(tmp, "out-no-volume"))
+    if result.returncode != 0:
+        failures.append(f"no module, no volume: exit {result.returncode}, stderr {result.stderr.strip()!r}")
     if failures:
         raise SystemExit("\n".join(failures))
 

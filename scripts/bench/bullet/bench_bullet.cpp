@@ -1,6 +1,8 @@
 // Shape matching against Bullet's soft-body clusters (optional; not a test): the same
 // vertices, masses and clusters, one thread each.
-//   bench_bullet_float|bench_bullet_double SCENE [--frames N]
+//   bench_bullet_float|bench_bullet_double SCENE [--frames N] [--particles vertices|samples]
+// With --particles samples ours steps the samples (docs/solver.md, "Particles") and Bullet the
+// mesh, whose nodes are then placed from our cluster frames (SampleSkin, timed on its own line).
 // Ours: Simulator::advance_frame, in the precision Bullet was built with (hsm.precision is
 // overridden to match btScalar); per substep it predicts every vertex (damping, drag, wind,
 // the global term), matches every cluster and averages the goals of shared vertices, so its
@@ -18,10 +20,13 @@
 #include <chrono>
 #include <cstdio>
 #include <new>
+#include <optional>
 #include <string>
 #include <type_traits>
 
 #include "../bench_common.h"
+#include "sim/particle_model.h"
+#include "sim/sample_skin.h"
 #include "sim/simulator.h"
 #include "sim/stiffness.h"
 
@@ -64,7 +69,14 @@ btSoftBody* make_body(btSoftBodyWorldInfo& info, const TreeModel& model, const s
 
 int main(int argc, char** argv) {
   long long frames = 24;
-  if (!bench::parse_arguments(argc, argv, "[--frames N]", frames, [](const std::string&, int&) { return false; }))
+  bool samples = false;
+  if (!bench::parse_arguments(argc, argv, "[--frames N] [--particles vertices|samples]", frames,
+                              [&](const std::string& arg, int& i) {
+                                if (arg != "--particles" || i + 1 >= argc) return false;
+                                const std::string mode = argv[++i];
+                                samples = mode == "samples";
+                                return samples || mode == "vertices";
+                              }))
     return 2;
   try {
     omp_set_num_threads(1);
@@ -73,32 +85,44 @@ int main(int argc, char** argv) {
     scene.hsm.precision = kDouble ? Precision::kDouble : Precision::kFloat;
     scene.hsm.sleep = false;  // time the full step
     const TreeModel model = bench::scene_model(scene);
+    const TreeModel sampled = samples ? sample_tree_model(model) : TreeModel();
+    const TreeModel& simulated = samples ? sampled : model;
+    const std::optional<SampleSkin> skin = samples ? std::optional<SampleSkin>(std::in_place, model, sampled) : std::nullopt;
     const double frame_dt = 1.0 / scene.time.fps;
     const int substeps = scene.time.substeps;
     const StepRates rates = compute_step_rates(model, scene.hsm, frame_dt / substeps);
 
     btSoftBodyWorldInfo info;
     btSoftBody* body = make_body(info, model, rates.cluster_alpha);
-    Simulator sim(model, scene.hsm, scene.wind, frame_dt, substeps);
-    SimState state = sim.initial_state(0);
+    Simulator sim(simulated, scene.hsm, scene.wind, frame_dt, substeps);
+    SimState state = sim.initial_state(0), mesh_state;
+    ClusterFrames cluster_frames;
     for (long long f = 1; f <= 2; ++f) sim.advance_frame(state, f);  // warm caches and rotations
 
-    double ours = 0, bullet = 0;
+    double ours = 0, skinning = 0, bullet = 0;
     for (long long f = 3; f < frames + 3; ++f) {
       const auto start = Clock::now();
       sim.advance_frame(state, f);
       ours += seconds_since(start);
+      const auto skin_start = Clock::now();
+      if (skin) skin->pose(state, false, cluster_frames, mesh_state);
+      skinning += seconds_since(skin_start);
+      const SimState& placed = samples ? mesh_state : state;
       for (size_t v = 0; v < model.vertex_count(); ++v)
-        body->m_nodes[static_cast<int>(v)].m_x =
-            btVector3(btScalar(state.positions(0, v)), btScalar(state.positions(1, v)), btScalar(state.positions(2, v)));
+        body->m_nodes[static_cast<int>(v)].m_x = btVector3(
+            btScalar(placed.positions(0, v)), btScalar(placed.positions(1, v)), btScalar(placed.positions(2, v)));
       const auto bullet_start = Clock::now();
       for (int k = 0; k < substeps; ++k) body->updateClusters();
       bullet += seconds_since(bullet_start);
     }
     const double steps = double(frames * substeps);
-    std::printf("%s: %zu vertices, %zu clusters, %zu memberships; %s precision, 1 thread\n", argv[1],
-                model.vertex_count(), model.cluster_count(), model.membership_count(), kDouble ? "double" : "float");
+    std::printf("%s: %zu vertices, %zu clusters, %zu memberships; %s precision, 1 thread; ours on the %s (%zu)\n",
+                argv[1], model.vertex_count(), model.cluster_count(), model.membership_count(),
+                kDouble ? "double" : "float", samples ? "samples" : "vertices", simulated.vertex_count());
     std::printf("  treeanim, whole substep (prediction, wind, drag, matching, averaging): %.3f ms\n", 1e3 * ours / steps);
+    if (samples)
+      std::printf("  treeanim, the mesh placed from the cluster frames, per frame / %d:      %.3f ms\n", substeps,
+                  1e3 * skinning / steps);
     std::printf("  Bullet %d.%02d updateClusters (cluster matching, no collision):          %.3f ms (%.2fx ours)\n",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, 1e3 * bullet / steps, bullet / ours);
     body->releaseClusters();
