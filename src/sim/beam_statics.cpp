@@ -25,10 +25,10 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
 }
 
 // The same by Rodrigues' formula, R = cos a I + (sin a / a) [theta]x + ((1 - cos a) / a^2) theta theta^T,
-// its factors from their series below 0.05 rad (to a^8: the next term is below 3e-21), where
-// a joint of the chain turns in all but a gale; rotation_of above it. hsm.particles "samples"
-// takes it: its clusters' fixed costs are its step's, and the sine and cosine were a twentieth
-// of them; "vertices" keeps the paper's set-up byte for byte.
+// its factors from their series below 0.05 rad (to a^8: the next term is below 3e-21), as far
+// as a joint of the chain turns in an ordinary wind; rotation_of above it. hsm.particles
+// "samples" takes it: its clusters' fixed costs are its step's, and the library's sine, cosine
+// and matrix were some 4 % of them; "vertices" keeps the paper's set-up byte for byte.
 Eigen::Matrix3d small_rotation_of(const Eigen::Vector3d& theta) {
   const double a2 = theta.squaredNorm();
   if (!(a2 < 0.0025)) return rotation_of(theta);
