@@ -71,12 +71,29 @@ bool unresolved_points(const AirSample& air, Eigen::Vector3d (&point)[6]) {
 // included); each point changes that air and so |u| u, quadratically. A load that swings
 // within the step past the yield turn and across it bends the joint less than its mean
 // would; below yield the mean keeps the quadratic drag's second-order rise.
+// With `linear` (hsm.particles "samples", whose clusters' fixed costs are its step's) and
+// `spread` the farthest point from the air, a joint that no point can turn to its yield takes
+// the mean of the uncapped turns, theta + reach x (mean |a| a - g), in one cross product: the
+// same turn but for round-off, since ||a| a - |u| u| <= (|a| + |u|) |a - u| bounds each point's.
 Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vector3d& load, double area,
-                                  const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double largest) {
+                                  const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double spread,
+                                  double largest, bool linear) {
   if (!(area > 0)) return capped_turn(theta, largest);
   const Eigen::Vector3d g = load / area;
   const double size = std::sqrt(g.norm());
   const Eigen::Vector3d u = size > 0 ? Eigen::Vector3d(g / size) : Eigen::Vector3d::Zero();
+  if (linear) {
+    Eigen::Vector3d drag = Eigen::Vector3d::Zero();
+    double fastest = 0;
+    for (const Eigen::Vector3d& d : point) {
+      const Eigen::Vector3d air = u + d;
+      const double speed = air.norm();
+      drag += speed * air;
+      fastest = std::max(fastest, speed);
+    }
+    if (theta.norm() + reach.norm() * (fastest + size) * spread <= largest)
+      return theta + reach.cross(drag / 6 - g);
+  }
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& d : point) {
     const Eigen::Vector3d air = u + d;
@@ -100,10 +117,11 @@ constexpr int kLoadLanes = 8;
 
 // Per lane: the force (x, y, z), its moment about the joint (x, y, z), the damping 2 D (the
 // largest rate at which the quadratic drag changes with the velocity) and its moment (x, y, z),
-// the chain's aerodynamic damping.
-template <typename Real>
+// the chain's aerodynamic damping. A cluster of at most four members (a leaf) fills only the
+// first four of the eight lanes: it sums in four (sum_lanes), to the same bits.
+template <typename Real, int Lanes = kLoadLanes>
 struct LoadLanes {
-  Real lane[10][kLoadLanes];
+  Real lane[10][Lanes];
 };
 
 // Where the load sums read: per vertex the drag, its damping D and 1 / (active memberships);
@@ -120,8 +138,9 @@ struct MemberLoads {
 // Membership s of vertex v, `on` 1 when it is active, else 0 => the vertex's share of the loads
 // and their moments, added in lane l. `on` comes as a Real: a byte read in the vector loop would
 // make GCC run it in 8-byte vectors.
-template <typename Real>
-inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Real on, int l, LoadLanes<Real>& sum) {
+template <typename Real, int Lanes>
+inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Real on, int l,
+                            LoadLanes<Real, Lanes>& sum) {
   const Real share = in.inv_count[v] * on;
   const Real gx = in.force[0][v] * share, gy = in.force[1][v] * share, gz = in.force[2][v] * share;
   const Real d = 2 * in.drag_damping[v] * share;
@@ -136,6 +155,12 @@ inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Rea
 template <typename Real>
 inline double sum_lanes(const Real (&lane)[kLoadLanes]) {
   return double(((lane[0] + lane[4]) + (lane[2] + lane[6])) + ((lane[1] + lane[5]) + (lane[3] + lane[7])));
+}
+// The first four of them, the others +0: the same sum, since y + (+0) is y for every y but -0,
+// and no lane or partial sum is -0 (each lane starts at +0, and x + y is -0 only for two -0).
+template <typename Real>
+inline double sum_lanes(const Real (&lane)[4]) {
+  return double((lane[0] + lane[2]) + (lane[1] + lane[3]));
 }
 
 }  // namespace
@@ -180,38 +205,47 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
                                    {model.member_arm.col(0).data(), model.member_arm.col(1).data(),
                                     model.member_arm.col(2).data()}};
   const uint32_t* members = tree.cluster_members.data();
-  with_kernel_isa([&] {
-    for (size_t i = 0; i < n; ++i) {
-      const size_t c = at(i);
-      LoadLanes<Real> sum = {};
-      // A cluster without released memberships takes every member's flag as 1, read from no byte.
-      auto add_loads = [&](auto any_released) {
-        const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
-        for (uint32_t base = begin; base < end; base += kLoadLanes) {
-          // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
-          const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
-          Real on[kLoadLanes];
-          for (uint32_t l = 0; l < n; ++l) on[l] = any_released ? static_cast<Real>(loads.active[base + l]) : Real(1);
+  // Cluster c's members => their loads summed in `Lanes` lanes, stored.
+  auto sum_cluster = [&](size_t c, auto lanes) {
+    LoadLanes<Real, decltype(lanes)::value> sum = {};
+    // A cluster without released memberships takes every member's flag as 1, read from no byte.
+    auto add_loads = [&](auto any_released) {
+      const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
+      for (uint32_t base = begin; base < end; base += kLoadLanes) {
+        // Eight members with consecutive vertices (ascending in a cluster) load as vectors.
+        const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
+        Real on[kLoadLanes];
+        for (uint32_t l = 0; l < n; ++l) on[l] = any_released ? static_cast<Real>(loads.active[base + l]) : Real(1);
+        if constexpr (decltype(lanes)::value == kLoadLanes) {
           if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
 #pragma omp simd
             for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, on[l], l, sum);
-          } else {
-            for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], on[l], int(l), sum);
+            continue;
           }
         }
-      };
-      if (!attachment.cluster_flying[c]) {
-        if (attachment.cluster_released[c])
-          add_loads(std::true_type{});
-        else
-          add_loads(std::false_type{});
+        for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], on[l], int(l), sum);
       }
-      scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
-      scratch.cluster_moment.col(c) =
-          Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
-      scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
-      scratch.cluster_damping_moment.col(c) =
-          Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
+    };
+    if (!attachment.cluster_flying[c]) {
+      if (attachment.cluster_released[c])
+        add_loads(std::true_type{});
+      else
+        add_loads(std::false_type{});
+    }
+    scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
+    scratch.cluster_moment.col(c) =
+        Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
+    scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
+    scratch.cluster_damping_moment.col(c) =
+        Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
+  };
+  with_kernel_isa([&] {
+    for (size_t i = 0; i < n; ++i) {
+      const size_t c = at(i);
+      if (tree.cluster_offsets[c + 1] - tree.cluster_offsets[c] <= 4)
+        sum_cluster(c, std::integral_constant<int, 4>{});
+      else
+        sum_cluster(c, std::integral_constant<int, kLoadLanes>{});
     }
   });
 }
@@ -245,6 +279,8 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
   const Eigen::Matrix3Xd& joint = model.chain.cluster_joint;
   Eigen::Vector3d unresolved[6];
   const bool averaged = unresolved_points(scratch.air, unresolved);
+  double spread = 0;
+  for (const Eigen::Vector3d& d : unresolved) spread = averaged ? std::max(spread, d.norm()) : 0.0;
   // 2. Children before parents: a joint carries the moment of everything beyond it. The
   // limbs below the trunk in parallel, then the trunk (BarChain::walk_trunk).
   auto carry_up = [&](uint32_t c) {
@@ -276,11 +312,12 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
     const double give = angle > largest ? largest / angle : 1.0;
     const Eigen::Vector3d theta =
         averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), attachment.cluster_drag_area[c],
-                                     compliance * attachment.cluster_drag_arm.col(c), unresolved, largest)
+                                     compliance * attachment.cluster_drag_arm.col(c), unresolved, spread, largest,
+                                     model.quick_chain)
                  : capped_turn(loaded, largest);
     scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
     Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) =
-        model.small_turns ? small_rotation_of(theta) : rotation_of(theta);
+        model.quick_chain ? small_rotation_of(theta) : rotation_of(theta);
   }
   // The trunk on one thread, then the limbs below it in parallel.
   auto carry_down = [&](uint32_t c) {

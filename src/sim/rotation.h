@@ -8,12 +8,13 @@ namespace treeanim {
 
 // Where the Newton iterations stop (docs/solver.md, "Rotation"): after a step below 1e-6 rad,
 // with some 1e-12 rad left, the rotation of round-off that the paper's set-up (hsm.particles
-// "vertices") keeps; after one below 1e-3 rad, with at most some 1e-10 rad left (test
+// "vertices") keeps; after one below 1e-2 rad: about the optimum the objective is even, so a
+// step from a turn a away leaves some a^3 / 2, at most 2.5e-7 rad (test
 // Rotation.AWarmStartASubstepAwayTakesOneStepWithTheSamplesTolerance), far below a step's own
-// error: "samples", where a cluster's fixed costs are the step's, takes one step a substep
+// error. "samples", where a cluster's fixed costs are the step's, takes one step a substep
 // where the vertices take two.
 constexpr double kNewtonStopRoundOff = 1e-6;
-constexpr double kNewtonStopSamples = 1e-3;
+constexpr double kNewtonStopSamples = 1e-2;
 
 // A (any 3x3, e.g. a cluster's normalised A_pq) + warm start q => q updated in place to the
 // rotation R maximising tr(R^T A) locally, reached by at most `max_iterations` steps; a Newton

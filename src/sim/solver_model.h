@@ -129,11 +129,12 @@ struct SolverModel {
   bool kick;
   bool store_drag_force;                   // the prediction keeps each vertex's drag (detachment, beam)
   bool parallel;                           // at least kParallelMemberships: the loops run on several threads
-  // hsm.particles "samples", whose clusters' fixed costs are its step's, takes two cheaper
-  // choices of the same accuracy (docs/solver.md, "Particles"); "vertices" keeps the paper's set-up byte for byte.
+  // hsm.particles "samples", whose clusters' fixed costs are its step's, takes cheaper choices
+  // of the same accuracy (docs/solver.md, "Particles"); "vertices" keeps the paper's set-up byte for byte.
   double rotation_newton_stop;             // rad, the Newton step that ends a rotation's iterations (rotation.h)
-  bool small_turns;                        // the chain's turns by their series (beam_statics.cpp, small_rotation_of)
-
+  // The chain's turns by their series (beam_statics.cpp, small_rotation_of), and their unscented
+  // mean in one cross product where no point reaches the yield turn (mean_yielded_turn)
+  bool quick_chain;
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint32_t> cluster_pin_own_slot;  // (C) leaf pinned to a branch: membership of the shared vertex in the leaf
