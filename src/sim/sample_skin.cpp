@@ -57,8 +57,26 @@ SampleSkin::SampleSkin(const TreeModel& mesh, const TreeModel& samples) : mesh_(
   }
   fit_offset_.resize(3, long(offsets.size()));
   for (size_t k = 0; k < offsets.size(); ++k) fit_offset_.col(long(k)) = offsets[k];
+  rest_moment_.setZero(9, long(C));
+  offset_sum_.setZero(3, long(C));
+  for (size_t c = 0; c < C; ++c)
+    for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k) {
+      const Eigen::Vector3d q = fit_offset_.col(k);
+      const double w = fit_weight_[k];
+      offset_sum_.col(long(c)) += w * q;
+      Eigen::Map<Eigen::Matrix3d> rest(&rest_moment_(0, long(c)));
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) rest(i, j) += w * (q[i] * q[j]);
+    }
   petiole_leaf_.assign(V, -1);
   for (size_t l = 0; l < mesh.leaf_count(); ++l) petiole_leaf_[mesh.leaf_attachment_vertex[l]] = int32_t(l);
+  std::vector<uint8_t> single(V, 0);
+  for (size_t v = 0; v < V; ++v) single[v] = mesh.vertex_anchored[v] || petiole_leaf_[v] >= 0;
+  runs_ = vertex_runs(mesh, single);
+  std::vector<uint8_t> in_run(V, 0);
+  for (const VertexRun& run : runs_) std::fill(in_run.begin() + run.begin, in_run.begin() + run.end, 1);
+  for (uint32_t v = 0; v < V; ++v)
+    if (!in_run[v]) single_vertices_.push_back(v);
 }
 
 void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrames& frames) const {
@@ -74,8 +92,8 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
   for (long c = 0; c < C; ++c) {
     // A = sum s (d - shift) q^T with d = u + q, u = x - x0: sum s u q^T + the rest moment
     // sum s q q^T - shift (sum s q)^T, s = w k; at rest exactly the symmetric rest moment.
-    Eigen::Vector3d shift = Eigen::Vector3d::Zero(), offset_sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d moved = Eigen::Matrix3d::Zero(), rest = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d moved = Eigen::Matrix3d::Zero();
     bool at_rest = true;
     for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k) {
       const uint32_t s = fit_samples_[k];
@@ -84,11 +102,10 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
       const double w = fit_weight_[k];
       at_rest = at_rest && u.isZero(0);
       shift += w * u;
-      offset_sum += w * q;
       moved += (w * u) * q.transpose();
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) rest(i, j) += w * (q[i] * q[j]);
     }
+    const Eigen::Vector3d offset_sum = offset_sum_.col(c);
+    const Eigen::Map<const Eigen::Matrix3d> rest(&rest_moment_(0, c));
     Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
     if (!at_rest) {
       const Eigen::Matrix3d A = (moved + rest - shift * offset_sum.transpose()) * match_scale_[c];
@@ -137,8 +154,42 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
   out.positions.resize(3, V);
   if (velocities) out.velocities.resize(3, V);
   else out.velocities.resize(3, 0);
-#pragma omp parallel for schedule(static) if (mesh_.membership_count() >= kParallelMemberships)
-  for (long v = 0; v < V; ++v) {
+  const bool parallel = mesh_.membership_count() >= kParallelMemberships;
+  // A run: its clusters' (R - I), rest centres and shifts (and motions) read once, then each
+  // vertex the mean of its clusters' moves, in the order of its memberships.
+#pragma omp parallel for schedule(static) if (parallel)
+  for (size_t r = 0; r < runs_.size(); ++r) {
+    const VertexRun& run = runs_[r];
+    Eigen::Matrix3d turned[kMaxRunClusters];
+    Eigen::Vector3d centre[kMaxRunClusters], shift[kMaxRunClusters], velocity[kMaxRunClusters], spin[kMaxRunClusters];
+    for (uint32_t j = 0; j < run.count; ++j) {
+      const long c = run.cluster[j];
+      turned[j] = Eigen::Map<const Eigen::Matrix3d>(&turn(0, c));
+      centre[j] = rest_centre_.col(c);
+      shift[j] = frames.shift.col(c);
+      if (!velocities) continue;
+      velocity[j] = frames.velocity.col(c);
+      spin[j] = frames.spin.col(c);
+    }
+    for (uint32_t v = run.begin; v < run.end; ++v) {
+      const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
+      Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
+      for (uint32_t j = 0; j < run.count; ++j) {
+        const Eigen::Vector3d arm = x0 - centre[j];
+        move += turned[j] * arm + shift[j];
+        if (velocities) speed += velocity[j] + spin[j].cross(turned[j] * arm + arm);
+      }
+      if (run.count > 1) {
+        move /= int(run.count);
+        speed /= int(run.count);
+      }
+      out.positions.col(v) = x0 + move;
+      if (velocities) out.velocities.col(v) = speed;
+    }
+  }
+#pragma omp parallel for schedule(static) if (parallel)
+  for (size_t i = 0; i < single_vertices_.size(); ++i) {
+    const uint32_t v = single_vertices_[i];
     const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
     if (mesh_.vertex_anchored[v]) {  // fixed to the ground, as the solver holds it
       out.positions.col(v) = x0;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/sim_state.h"
+#include "sim/vertex_run.h"
 #include "tree/tree_model.h"
 
 namespace treeanim {
@@ -47,7 +48,14 @@ class SampleSkin {
   Eigen::Matrix3Xd fit_offset_;       // (3 x F) m
   Eigen::Matrix3Xd rest_centre_;      // (3 x C) m
   std::vector<double> match_scale_;   // (C) 1/m^2, 1 / sum w |q|^2 (0 for a point)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> rest_moment_;  // (9 x C) sum w q q^T of each fit, column-major
+  Eigen::Matrix3Xd offset_sum_;       // (3 x C) m, sum w q of each fit (0 but for round-off)
   std::vector<int32_t> petiole_leaf_; // (V) the leaf whose shared vertex this mesh vertex is; -1
+  // The mesh's vertices placed a run at a time, their clusters' frames read once (a ring, a
+  // leaf's blade); the others (anchored, a leaf's shared vertex, in no cluster or in more than
+  // kMaxRunClusters) one at a time, ascending.
+  std::vector<VertexRun> runs_;
+  std::vector<uint32_t> single_vertices_;
 };
 
 }  // namespace treeanim

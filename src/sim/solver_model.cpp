@@ -69,34 +69,10 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
       m.shared_correction_rows.push_back(m.member_correction_row[tree.vertex_memberships[s]]);
     m.shared_row_offsets.push_back(static_cast<uint32_t>(m.shared_correction_rows.size()));
   }
-  const std::vector<uint32_t>& offsets = tree.vertex_cluster_offsets;
-  std::vector<uint8_t> runs(m.V, 0);  // (V) 1: in 1 to kMaxRunClusters clusters, whose memberships stay
-  for (size_t v = 0; v < m.V; ++v) runs[v] = offsets[v + 1] > offsets[v] && offsets[v + 1] - offsets[v] <= kMaxRunClusters;
-  for (size_t l = 0; l < m.L; ++l) runs[tree.leaf_attachment_vertex[l]] = 0;
-  // v and v + 1 => whether v + 1 continues v's run: the same clusters, the next membership in each.
-  auto continues = [&](size_t v) {
-    const uint32_t n = offsets[v + 1] - offsets[v];
-    if (!runs[v + 1] || offsets[v + 2] - offsets[v + 1] != n) return false;
-    for (uint32_t j = 0; j < n; ++j) {
-      const uint32_t slot = tree.vertex_memberships[offsets[v] + j], next = tree.vertex_memberships[offsets[v + 1] + j];
-      if (next != slot + 1 || tree.member_cluster[next] != tree.member_cluster[slot]) return false;
-    }
-    return true;
-  };
-  for (size_t v = 0; v < m.V;) {
-    if (!runs[v]) {
-      ++v;
-      continue;
-    }
-    VertexRun run = {static_cast<uint32_t>(v), 0, offsets[v + 1] - offsets[v], {}, {}};
-    for (uint32_t j = 0; j < run.count; ++j) {
-      run.first_slot[j] = tree.vertex_memberships[offsets[v] + j];
-      run.cluster[j] = tree.member_cluster[run.first_slot[j]];
-    }
-    while (v + 1 < m.V && continues(v)) ++v;
-    run.end = static_cast<uint32_t>(++v);
-    m.vertex_runs.push_back(run);
-  }
+  // A leaf's shared vertex is in no run: its memberships may be released.
+  std::vector<uint8_t> excluded(m.V, 0);
+  for (size_t l = 0; l < m.L; ++l) excluded[tree.leaf_attachment_vertex[l]] = 1;
+  m.vertex_runs = vertex_runs(tree, excluded);
 }
 
 // Leaves => the membership slots that pin each attached leaf to its branch (attached_leaves.cpp).

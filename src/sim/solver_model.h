@@ -15,6 +15,7 @@
 #include "sim/bar_chain.h"
 #include "sim/sim_options.h"
 #include "sim/sim_state.h"
+#include "sim/vertex_run.h"
 #include "sim/wind.h"
 #include "tree/tree_model.h"
 
@@ -36,17 +37,6 @@ using Rows3 = Eigen::Matrix<Real, Eigen::Dynamic, 3>;
 // (SolverModel::runaway_distance2): twice is the farthest a connected rigid pose reaches (a
 // half turn at the root), the rest a margin for a swing past it and the clusters' stretch.
 constexpr double kRunawaySizes = 2.5;
-
-// The most clusters a vertex of a run may be in (SolverModel::vertex_runs): a branch's
-// vertices are in one, the rings where two clusters overlap in two.
-constexpr uint32_t kMaxRunClusters = 4;
-
-// Vertices [begin, end) in the same `count` clusters: vertex v's membership in cluster[j] is
-// first_slot[j] + (v - begin).
-struct VertexRun {
-  uint32_t begin, end, count;
-  uint32_t first_slot[kMaxRunClusters], cluster[kMaxRunClusters];
-};
 
 // Memberships [begin, end) of one cluster whose corrections go to consecutive rows of
 // StepScratch::member_correction from `row` (SolverModel::correction_runs). Below V the row is
