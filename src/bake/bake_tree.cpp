@@ -217,6 +217,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   if (result.exit_code != 0) return result;
   result = finish_bake(plan, start, warmup, frames, placement, log);
   result.vertices = tree.model.vertex_count();
+  result.samples = samples ? samples->vertex_count() : 0;
   result.clusters = tree.model.cluster_count();
   result.seconds = seconds_since(began);
   result.run_seconds = seconds_since(run_began);

@@ -55,6 +55,7 @@ struct TreeBakeResult {
   int exit_code = 0;                                      // 0, or 130/143 when interrupted
   FrameRange written;                                     // the frames written
   size_t vertices = 0;
+  size_t samples = 0;                                     // hsm.particles "samples": the particles simulated; 0 otherwise
   size_t clusters = 0;
   long long substeps = 0;                                 // simulated by this process
   double seconds = 0;                                     // s, the whole bake

@@ -2,6 +2,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <string>
 
 #include "bake/bake_tree.h"
 #include "bake/forest_manifest.h"
@@ -35,9 +36,10 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
 }
 
 void BakePrinter::print_summary(const TreeBakeResult& result) const {
-  std::printf("baked %lld frames: %zu vertices, %zu clusters, %lld substeps in %.2f s (simulation + writing %.2f s)\n",
-              result.written.count(), result.vertices, result.clusters, result.substeps, result.seconds,
-              result.run_seconds);
+  const std::string samples = result.samples ? " placed from " + std::to_string(result.samples) + " samples" : "";
+  std::printf("baked %lld frames: %zu vertices%s, %zu clusters, %lld substeps in %.2f s (simulation + writing %.2f s)\n",
+              result.written.count(), result.vertices, samples.c_str(), result.clusters, result.substeps,
+              result.seconds, result.run_seconds);
   for (const auto& path : result.final_paths) std::printf("  wrote %s\n", path.string().c_str());
   for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
   if (!result.loop) return;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "temp_folder_test.h"
@@ -184,6 +185,18 @@ TEST_F(Cli, RunWritesTheBakeAndNoTemporaries) {
   EXPECT_TRUE(fs::exists(dir_ / "out" / "bake.h5"));
   for (const auto& entry : fs::directory_iterator(dir_ / "out"))
     EXPECT_EQ(entry.path().filename(), "bake.h5") << "left over: " << entry.path();
+}
+
+TEST_F(Cli, ASampledBakeSaysHowManySamplesMovedTheMesh) {
+  const fs::path scene = write("line.json", kLine);
+  const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() +
+                       " --set 'hsm.particles=\"samples\"'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(baked 5 frames: (\d+) vertices placed from (\d+) samples, )")))
+      << r.out;
+  EXPECT_LT(std::stoul(m[2]), std::stoul(m[1])) << r.out;
+  EXPECT_EQ(run("run " + scene.string() + " -o " + (dir_ / "out2").string()).out.find("samples"), std::string::npos);
 }
 
 TEST_F(Cli, QuietPrintsNothing) {
