@@ -12,6 +12,21 @@ namespace treeanim {
 
 namespace {
 
+// A cluster's frame as pose reads it: R - I, its rest centre t0 and shift, and (with
+// velocities) its centre's velocity and its spin.
+struct PlacedFrame {
+  Eigen::Matrix3d turned;
+  Eigen::Vector3d centre, shift, velocity, spin;
+
+  // A vertex at rest x0 => its move in this frame, R (x0 - t0) + t0 + shift - x0, and its
+  // velocity, added to the sums.
+  void add_move(const Eigen::Vector3d& x0, bool velocities, Eigen::Vector3d& move, Eigen::Vector3d& speed) const {
+    const Eigen::Vector3d arm = x0 - centre;
+    move += turned * arm + shift;
+    if (velocities) speed += velocity + spin.cross(turned * arm + arm);
+  }
+};
+
 // Iterations of the frame's rotation: warm-started from the solver's last fit of the same
 // samples, it converges in one or two.
 constexpr int kFrameIterations = 12;
@@ -154,37 +169,35 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
   out.positions.resize(3, V);
   if (velocities) out.velocities.resize(3, V);
   else out.velocities.resize(3, 0);
+  // Cluster c's frame as a vertex reads it: (R - I), rest centre, shift, and the motion.
+  auto frame_of = [&](uint32_t c) {
+    PlacedFrame f{Eigen::Map<const Eigen::Matrix3d>(&turn(0, c)), rest_centre_.col(c), frames.shift.col(c), {}, {}};
+    if (!velocities) return f;
+    f.velocity = frames.velocity.col(c);
+    f.spin = frames.spin.col(c);
+    return f;
+  };
+  // Vertex v at rest x0 and the sums of its `count` clusters' moves => its place, their mean.
+  auto place = [&](uint32_t v, const Eigen::Vector3d& x0, Eigen::Vector3d move, Eigen::Vector3d speed, int count) {
+    if (count > 1) {
+      move /= count;
+      speed /= count;
+    }
+    out.positions.col(v) = x0 + move;
+    if (velocities) out.velocities.col(v) = speed;
+  };
   const bool parallel = mesh_.membership_count() >= kParallelMemberships;
-  // A run: its clusters' (R - I), rest centres and shifts (and motions) read once, then each
-  // vertex the mean of its clusters' moves, in the order of its memberships.
+  // A run: its clusters' frames read once, then each vertex in the order of its memberships.
 #pragma omp parallel for schedule(static) if (parallel)
   for (size_t r = 0; r < runs_.size(); ++r) {
     const VertexRun& run = runs_[r];
-    Eigen::Matrix3d turned[kMaxRunClusters];
-    Eigen::Vector3d centre[kMaxRunClusters], shift[kMaxRunClusters], velocity[kMaxRunClusters], spin[kMaxRunClusters];
-    for (uint32_t j = 0; j < run.count; ++j) {
-      const long c = run.cluster[j];
-      turned[j] = Eigen::Map<const Eigen::Matrix3d>(&turn(0, c));
-      centre[j] = rest_centre_.col(c);
-      shift[j] = frames.shift.col(c);
-      if (!velocities) continue;
-      velocity[j] = frames.velocity.col(c);
-      spin[j] = frames.spin.col(c);
-    }
+    PlacedFrame cluster[kMaxRunClusters];
+    for (uint32_t j = 0; j < run.count; ++j) cluster[j] = frame_of(run.cluster[j]);
     for (uint32_t v = run.begin; v < run.end; ++v) {
       const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
       Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
-      for (uint32_t j = 0; j < run.count; ++j) {
-        const Eigen::Vector3d arm = x0 - centre[j];
-        move += turned[j] * arm + shift[j];
-        if (velocities) speed += velocity[j] + spin[j].cross(turned[j] * arm + arm);
-      }
-      if (run.count > 1) {
-        move /= int(run.count);
-        speed /= int(run.count);
-      }
-      out.positions.col(v) = x0 + move;
-      if (velocities) out.velocities.col(v) = speed;
+      for (uint32_t j = 0; j < run.count; ++j) cluster[j].add_move(x0, velocities, move, speed);
+      place(v, x0, move, speed, int(run.count));
     }
   }
 #pragma omp parallel for schedule(static) if (parallel)
@@ -205,18 +218,10 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     for (uint32_t k = mesh_.vertex_cluster_offsets[v]; k < mesh_.vertex_cluster_offsets[v + 1]; ++k) {
       const uint32_t c = mesh_.member_cluster[mesh_.vertex_memberships[k]];
       if (released && (c == mesh_.leaf_cluster[leaf]) != goes_with_leaf) continue;
-      const Eigen::Vector3d arm = x0 - rest_centre_.col(c);
-      const Eigen::Map<const Eigen::Matrix3d> turned(&turn(0, c));
-      move += turned * arm + frames.shift.col(c);
-      if (velocities) speed += frames.velocity.col(c) + frames.spin.col(c).cross(turned * arm + arm);
+      frame_of(c).add_move(x0, velocities, move, speed);
       ++count;
     }
-    if (count > 1) {
-      move /= count;
-      speed /= count;
-    }
-    out.positions.col(v) = x0 + move;
-    if (velocities) out.velocities.col(v) = speed;
+    place(v, x0, move, speed, count);
   }
   out.time = state.time;
   out.leaf_attached = state.leaf_attached;
