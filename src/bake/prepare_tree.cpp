@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "common/seconds_since.h"
+#include "sim/particle_model.h"
 #include "tree/build_tree_model.h"
 
 namespace treeanim {
@@ -59,6 +60,12 @@ Json tree_summary(const Scene& scene, const PreparedTree& tree) {
                       {"anchored_vertices",
                        std::count(model.vertex_anchored.begin(), model.vertex_anchored.end(), 1)},
                       {"mass_kg", mass}};
+  // hsm.particles "samples": what the solver will move instead of the mesh's vertices.
+  if (scene.hsm.particles == ParticleMode::kSamples) {
+    const TreeModel samples = sample_tree_model(model);
+    summary["model"]["samples"] = samples.vertex_count();
+    summary["model"]["sample_memberships"] = samples.membership_count();
+  }
   summary["estimate"] = {{"frames", scene.time.frames},
                          {"substeps_total", scene.time.frames * scene.time.substeps},
                          {"bytes_per_frame", bytes_per_frame},

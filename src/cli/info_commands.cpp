@@ -24,6 +24,9 @@ void print_counts(const Json& summary) {
               summary["model"]["clusters"].get<long long>(),
               summary["model"]["memberships"].get<long long>(),
               summary["model"]["mass_kg"].get<double>());
+  if (summary["model"].contains("samples"))
+    std::printf("simulated as %lld samples, %lld memberships (hsm.particles \"samples\")\n",
+                summary["model"]["samples"].get<long long>(), summary["model"]["sample_memberships"].get<long long>());
 }
 
 // The checked volume (Scene::volume) => its figures, for `info --json`.

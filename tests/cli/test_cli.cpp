@@ -187,7 +187,7 @@ TEST_F(Cli, RunWritesTheBakeAndNoTemporaries) {
     EXPECT_EQ(entry.path().filename(), "bake.h5") << "left over: " << entry.path();
 }
 
-TEST_F(Cli, ASampledBakeSaysHowManySamplesMovedTheMesh) {
+TEST_F(Cli, ASampledBakeAndInfoSayHowManySamplesMoveTheMesh) {
   const fs::path scene = write("line.json", kLine);
   const Result r = run("run " + scene.string() + " -o " + (dir_ / "out").string() +
                        " --set 'hsm.particles=\"samples\"'");
@@ -197,6 +197,10 @@ TEST_F(Cli, ASampledBakeSaysHowManySamplesMovedTheMesh) {
       << r.out;
   EXPECT_LT(std::stoul(m[2]), std::stoul(m[1])) << r.out;
   EXPECT_EQ(run("run " + scene.string() + " -o " + (dir_ / "out2").string()).out.find("samples"), std::string::npos);
+  // `info` says the same before a bake.
+  const auto info = nlohmann::json::parse(run("info --json " + scene.string() + " --set 'hsm.particles=\"samples\"'").out);
+  EXPECT_EQ(info["model"]["samples"].get<unsigned long>(), std::stoul(m[2]));
+  EXPECT_FALSE(nlohmann::json::parse(run("info --json " + scene.string()).out)["model"].contains("samples"));
 }
 
 TEST_F(Cli, QuietPrintsNothing) {
