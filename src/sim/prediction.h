@@ -94,17 +94,69 @@ inline bool block_flagged(const VertexBlock<Real>& block, int n) {
   return !(total - total == 0) || worst > 0;
 }
 
+// The air a cluster's vertices feel and its R (column-major), in Real, as the drag reads them.
+template <typename Real>
+struct DragFrame {
+  Real air[3], R[9];
+};
+
+// Cluster c's frame from the step's air (per axis) and R (9 x C, column-major, double).
+template <typename Real>
+inline DragFrame<Real> drag_frame(const Real* const air[3], const double* rotation, size_t c) {
+  DragFrame<Real> f;
+  for (int i = 0; i < 3; ++i) f.air[i] = air[i][c];
+  for (int i = 0; i < 9; ++i) f.R[i] = static_cast<Real>(rotation[9 * c + i]);
+  return f;
+}
+
+// Corrected lane k with its cluster's frame f => the drag it will feel over the next step
+// (force, damped, drag_damping), as correct_block describes.
+template <typename Real>
+inline void store_drag_lane(const VertexInputs<Real>& in, const CorrectedLane<Real>& lane, const DragFrame<Real>& f,
+                            int k, Real half_inv_h, const Real* compliance, const Real* mass, Real* const force[3],
+                            Real* const damped[3], Real* drag_damping) {
+  const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = lane;
+  // The drag at the step's start, from the velocity there: half a step of damping and of
+  // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
+  // toward the last goal without the part this vertex's velocity took off through its drag,
+  // and that damping is implicit: the velocity is divided by 1 + gamma h / 2, gamma = K c
+  // (docs/solver.md "Aerodynamic damping"): stable at any step, however strong the drag.
+  const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
+  const Real implicit = 1 / (1 + pull_back * compliance[k]);
+  const Real wx = (vx * half - pull_back * (ux - (in.goal[0][k] + damped[0][k])) + shape * px) * implicit;
+  const Real wy = (vy * half - pull_back * (uy - (in.goal[1][k] + damped[1][k])) + shape * py) * implicit;
+  const Real wz = (vz * half - pull_back * (uz - (in.goal[2][k] + damped[2][k])) + shape * pz) * implicit;
+  damped[0][k] = compliance[k] * wx, damped[1][k] = compliance[k] * wy, damped[2][k] = compliance[k] * wz;
+  const Real rx = f.air[0] - wx, ry = f.air[1] - wy, rz = f.air[2] - wz;
+  // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
+  // the free-flight average over the step (drag_share) would understate it ever more as
+  // the step grows (a leaf in a gale at a 0.25 s step: 16x).
+  const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * mass[k];
+  drag_damping[k] = scale;
+  // The chain takes its moments with rest arms, so its load is the air's push and the
+  // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
+  // moves with, a drag that opposes a limb's motion then always opposes it, however far
+  // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
+  const Real bx = f.R[0] * wx + f.R[1] * wy + f.R[2] * wz;
+  const Real by = f.R[3] * wx + f.R[4] * wy + f.R[5] * wz;
+  const Real bz = f.R[6] * wx + f.R[7] * wy + f.R[8] * wz;
+  force[0][k] = (f.air[0] - bx) * scale;
+  force[1][k] = (f.air[1] - by) * scale;
+  force[2][k] = (f.air[2] - bz) * scale;
+}
+
 // Predicted vertices [begin, begin + n) => with kForce, the drag each will feel over the next
 // step from its velocity at the step's start after the correction (prediction.drag_force,
 // damping_offset; scratch.vertex_drag_damping). The corrected u and v are written in place
 // with kEnd (`prediction` then holds the state at the step's end, for the frame's state), and
 // the runaway limit is checked; otherwise predict_block recomputes them, which saves a write
 // of u and v per vertex, and only a flagged block is written (for the caller to find the
-// vertex at fault). Returns block_flagged.
+// vertex at fault). `lane_frames` (SolverModel::lane_frames): each lane reads its cluster's
+// frame itself. Returns block_flagged.
 template <bool kEnd, bool kForce, typename Real>
 inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
-                          const VertexInputs<Real>& in, VertexBlock<Real>& block) {
+                          const VertexInputs<Real>& in, bool lane_frames, VertexBlock<Real>& block) {
   const Real inv_h = static_cast<Real>(1.0 / model.h);
   const Real half_inv_h = static_cast<Real>(0.5 / model.h);
   const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
@@ -125,59 +177,41 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
                      prediction.offset.col(2).data() + begin};
   Real* velocity[3] = {prediction.velocity.col(0).data() + begin, prediction.velocity.col(1).data() + begin,
                        prediction.velocity.col(2).data() + begin};
-  // With the drag, the block runs in segments of consecutive vertices that feel the air of one
-  // cluster and turn with its R (most of a cluster's vertices are consecutive): its twelve
-  // values are read once per segment, not gathered per lane.
-  for (int first = 0; first < n;) {
-    int stop = n;
-    Real air_c[3] = {}, R[9] = {};  // the segment's cluster: its air, its R (column-major) in Real
-    if constexpr (kForce) {
-      const uint32_t c = air_cluster[first];
-      for (stop = first + 1; stop < n && air_cluster[stop] == c;) ++stop;
-      for (int i = 0; i < 3; ++i) air_c[i] = air[i][c];
-      for (int i = 0; i < 9; ++i) R[i] = static_cast<Real>(rotation[9 * size_t(c) + i]);
-    }
+  auto check = [&](int k, const CorrectedLane<Real>& lane) {
+    const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = lane;
+    block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
+    Real excess = 0;  // > 0: an attached vertex ran away
+    if constexpr (kEnd) excess = (1 - in.flying[k]) * (ux * ux + uy * uy + uz * uz) - limit2;
+    block.excess[k] = excess;
+  };
+  if (!kForce || lane_frames) {
 #pragma omp simd
-    for (int k = first; k < stop; ++k) {
+    for (int k = 0; k < n; ++k) {
       const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
       if constexpr (kEnd) store_lane(offset, velocity, k, lane);
-      const auto [ux, uy, uz, vx, vy, vz, px, py, pz, now] = lane;
-      if constexpr (kForce) {
-        // The drag at the step's start, from the velocity there: half a step of damping and of
-        // the pull after the staggered v (second order; docs/solver.md "One step"). The pull is
-        // toward the last goal without the part this vertex's velocity took off through its drag,
-        // and that damping is implicit: the velocity is divided by 1 + gamma h / 2, gamma = K c
-        // (docs/solver.md "Aerodynamic damping"): stable at any step, however strong the drag.
-        const Real half = in.half_damping[k], pull_back = in.global[k] * half_inv_h, shape = (1 - now) * half_inv_h;
-        const Real implicit = 1 / (1 + pull_back * compliance[k]);
-        const Real wx = (vx * half - pull_back * (ux - (in.goal[0][k] + damped[0][k])) + shape * px) * implicit;
-        const Real wy = (vy * half - pull_back * (uy - (in.goal[1][k] + damped[1][k])) + shape * py) * implicit;
-        const Real wz = (vz * half - pull_back * (uz - (in.goal[2][k] + damped[2][k])) + shape * pz) * implicit;
-        damped[0][k] = compliance[k] * wx, damped[1][k] = compliance[k] * wy, damped[2][k] = compliance[k] * wz;
-        const Real rx = air_c[0] - wx, ry = air_c[1] - wy, rz = air_c[2] - wz;
-        // The instantaneous drag: an attached vertex moves with its branch, not with the air, so
-        // the free-flight average over the step (drag_share) would understate it ever more as
-        // the step grows (a leaf in a gale at a 0.25 s step: 16x).
-        const Real scale = in.drag[k] * std::sqrt(rx * rx + ry * ry + rz * rz) * mass[k];
-        drag_damping[k] = scale;
-        // The chain takes its moments with rest arms, so its load is the air's push and the
-        // velocity's drag turned back into the cluster's rest frame, R^T w: with the arm it
-        // moves with, a drag that opposes a limb's motion then always opposes it, however far
-        // the limb has turned (in the world frame a limb past a quarter turn was pushed on).
-        const Real bx = R[0] * wx + R[1] * wy + R[2] * wz;
-        const Real by = R[3] * wx + R[4] * wy + R[5] * wz;
-        const Real bz = R[6] * wx + R[7] * wy + R[8] * wz;
-        force[0][k] = (air_c[0] - bx) * scale;
-        force[1][k] = (air_c[1] - by) * scale;
-        force[2][k] = (air_c[2] - bz) * scale;
-      }
-      block.check[k] = ((ux + vx) + (uy + vy)) + (uz + vz);
-      Real excess = 0;  // > 0: an attached vertex ran away
-      if constexpr (kEnd)
-        excess = (1 - in.flying[k]) * (ux * ux + uy * uy + uz * uz) - limit2;
-      block.excess[k] = excess;
+      if constexpr (kForce)
+        store_drag_lane(in, lane, drag_frame(air, rotation, air_cluster[k]), k, half_inv_h, compliance, mass, force,
+                        damped, drag_damping);
+      check(k, lane);
     }
-    first = stop;
+  } else {
+    // The block runs in segments of consecutive vertices that feel the air of one cluster and
+    // turn with its R (most of a mesh cluster's vertices are consecutive): its twelve values
+    // are read once per segment, not gathered per lane.
+    for (int first = 0; first < n;) {
+      const uint32_t c = air_cluster[first];
+      int stop = first + 1;
+      while (stop < n && air_cluster[stop] == c) ++stop;
+      const DragFrame<Real> f = drag_frame(air, rotation, c);
+#pragma omp simd
+      for (int k = first; k < stop; ++k) {
+        const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
+        if constexpr (kEnd) store_lane(offset, velocity, k, lane);
+        store_drag_lane(in, lane, f, k, half_inv_h, compliance, mass, force, damped, drag_damping);
+        check(k, lane);
+      }
+      first = stop;
+    }
   }
   const bool flagged = block_flagged(block, n);
   if constexpr (!kEnd)

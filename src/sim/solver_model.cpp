@@ -285,7 +285,8 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
       store_drag_force(detach_enabled || beam),
       parallel(t.membership_count() >= kParallelMemberships),
       rotation_newton_stop(o.particles == ParticleMode::kSamples ? kNewtonStopSamples : kNewtonStopRoundOff),
-      quick_chain(o.particles == ParticleMode::kSamples) {
+      quick_chain(o.particles == ParticleMode::kSamples),
+      lane_frames(o.particles == ParticleMode::kSamples) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");
   const double extent = V ? (t.rest_positions.rowwise().maxCoeff() - t.rest_positions.rowwise().minCoeff()).maxCoeff() : 0.0;
   chain = build_bar_chain(t, o);

@@ -125,6 +125,9 @@ struct SolverModel {
   // The chain's turns by their series (beam_statics.cpp, small_rotation_of), and their unscented
   // mean in one cross product where no point reaches the yield turn (mean_yielded_turn)
   bool quick_chain;
+  // The correction pass reads each vertex's cluster frame (air, R) per lane rather than once per
+  // run of a cluster's vertices: a run of three or four samples is too short to fill a vector.
+  bool lane_frames;
   std::vector<double> cluster_alpha;       // (C) local rate per step
   std::vector<uint32_t> cluster_island;    // (C) island id
   std::vector<uint32_t> cluster_pin_own_slot;  // (C) leaf pinned to a branch: membership of the shared vertex in the leaf
