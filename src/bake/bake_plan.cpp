@@ -33,7 +33,9 @@ BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& mo
   info.loop = plan.closes_loop;
   info.loop_end_time = double(plan.last + 1) / scene.time.fps;
   info.materials = surface_materials(scene.tree);
-  info.vertex_colors = leaf_color_factors(model, scene.tree.leaf_color_variation, scene.lsystem.seed);
+  // Only outputs read the colours: a bake that writes none keeps no array of the mesh's size.
+  if (!scene.outputs.empty())
+    info.vertex_colors = leaf_color_factors(model, scene.tree.leaf_color_variation, scene.lsystem.seed);
   info.wind = scene.wind;
   if (placement) info.placement = *placement;
   return info;

@@ -71,7 +71,7 @@ void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& re
 void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
-  if (frames.skin && frames.output_count == 0 && plan.checkpoints.every <= 0 && !frames.info.loop) {
+  if (frames.sampled && !frames.reads_mesh) {
     // Nothing reads the mesh: no vertex is placed; the bounds are the samples'.
     for (long s = 0; s < start.state.positions.cols(); ++s) {
       const Eigen::Vector3d x = start.state.positions.col(s);
@@ -105,6 +105,7 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
                        const TreePlacement* placement)
     : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
+      reads_mesh(output_count > 0 || plan.checkpoints.every > 0 || info.loop),
       outputs(scene.outputs, config.out_dir, model, info) {}
 
 void BakeFrames::push(FrameData data) {
@@ -199,9 +200,12 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
   const TreeModel& mesh = placed ? *placed : tree.model;
   // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
-  const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
-  const std::optional<TreeModel> samples = sampled ? std::optional<TreeModel>(sample_tree_model(mesh)) : std::nullopt;
-  const std::optional<SampleSkin> skin = sampled ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
+  frames.sampled = scene.hsm.particles == ParticleMode::kSamples;
+  const std::optional<TreeModel> samples =
+      frames.sampled ? std::optional<TreeModel>(sample_tree_model(mesh)) : std::nullopt;
+  const std::optional<SampleSkin> skin = frames.sampled && frames.reads_mesh
+                                             ? std::optional<SampleSkin>(std::in_place, mesh, *samples)
+                                             : std::nullopt;
   if (skin) frames.skin = &*skin;
   Simulator simulator(samples ? *samples : mesh, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),

@@ -32,8 +32,11 @@ struct BakeFrames {
 
   const BakeInfo info;
   const size_t output_count;
-  // hsm.particles "samples": the mesh placed from the simulated samples' clusters (null: the
-  // state is the mesh's), and its scratch.
+  // Something reads each frame's mesh: an output, the checkpoints' journal or a loop's seam.
+  const bool reads_mesh;
+  // hsm.particles "samples": the mesh placed from the simulated samples' clusters when it is
+  // read (null: the state is the mesh's, or nothing reads it), and its scratch.
+  bool sampled = false;
   const SampleSkin* skin = nullptr;
   ClusterFrames skin_frames;
   SimState skinned;
