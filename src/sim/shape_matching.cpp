@@ -160,7 +160,7 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
   {
     // Named, not a structured binding: the lambda below captures them (clang before 16 cannot).
     const std::pair<size_t, size_t> range =
-        balanced_range(model.tree.cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
+        balanced_range(model.match_work_offsets, omp_get_thread_num(), omp_get_num_threads());
     const size_t first = range.first, last = range.second;
     with_kernel_isa([&] {
       for (size_t c = first; c < last; ++c) {

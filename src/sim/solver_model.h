@@ -135,6 +135,10 @@ struct SolverModel {
   // cluster feels is a function of its world position
   std::vector<double> cluster_phase_sin, cluster_phase_cos;
   std::vector<uint32_t> pinned_leaf_clusters;  // clusters of the leaves that start attached to a branch
+  // (C + 1) prefix sums of each cluster's work in match_clusters' first pass, which its threads
+  // split evenly (balanced_range): a cluster's memberships weigh less than its fit, and a pinned
+  // leaf's fit comes after the pass
+  std::vector<uint32_t> match_work_offsets;
   std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step (the step's damping is two)
   // (V) 1: a branch vertex with the beam, whose mean correction is a kick of the next step;
   // 0: a projection (leaves, the per_step stiffness)
