@@ -120,7 +120,7 @@ JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool 
           cluster_motions ? model.cluster_count() : 0};
 }
 
-void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
+void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& simulated, const JournalLayout& layout,
                 const BakeFrames& frames) {
   std::vector<SpaceNeed> needs;
   for (const auto& [path, bytes] : frames.outputs.estimated_bytes()) needs.push_back({path, bytes});
@@ -129,8 +129,8 @@ void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& m
     const long long checkpoints = (plan.written.last - plan.first) / every - (start.frame - plan.first) / every;
     const long long records = plan.written.last - std::max(start.frame, plan.written.first) + 1;
     needs.push_back({journal_path(plan.checkpoints.dir, plan.written.first),
-                     double(checkpoints) * estimated_checkpoint_bytes(model.vertex_count(), model.cluster_count(),
-                                                                      model.leaf_count()) +
+                     double(checkpoints) * estimated_checkpoint_bytes(simulated.vertex_count(), simulated.cluster_count(),
+                                                                      simulated.leaf_count()) +
                          double(records) * double(journal_record_bytes(layout))});
   }
   check_free_space(needs);
@@ -192,11 +192,12 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const auto began = std::chrono::steady_clock::now();
   if (config.threads > 0) omp_set_num_threads(config.threads);
   const BakePlan plan = plan_bake(scene, config);
-  const PreparedTree tree = prepare_tree(scene);
+  PreparedTree tree = prepare_tree(scene);
+  tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
   BakeFrames frames(scene, config, plan, tree.model, placement);
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
-  const std::optional<TreeModel> placed =
+  std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
   const TreeModel& mesh = placed ? *placed : tree.model;
   // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
@@ -207,12 +208,20 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
                                              ? std::optional<SampleSkin>(std::in_place, mesh, *samples)
                                              : std::nullopt;
   if (skin) frames.skin = &*skin;
-  Simulator simulator(samples ? *samples : mesh, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
                                               frames.skin && frames.outputs.wants_cluster_motions());
+  const size_t vertices = tree.model.vertex_count(), clusters = tree.model.cluster_count();
+  const TreeModel& simulated = samples ? *samples : mesh;
+  // Nothing reads the mesh of a samples bake that writes nothing (BakeFrames::reads_mesh): its
+  // model goes back before the solver's arrays are made, so the bake holds the samples alone.
+  if (frames.sampled && !frames.reads_mesh) {
+    tree.model = TreeModel();
+    placed.reset();
+  }
+  Simulator simulator(simulated, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);
-  if (config.space_check) check_room(plan, start, tree.model, layout, frames);
+  if (config.space_check) check_room(plan, start, simulated, layout, frames);
   const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes);
   replay_journal(plan, layout, start, frames, log.notes);
   const auto run_began = std::chrono::steady_clock::now();
@@ -220,9 +229,9 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   result.exit_code = run_frames(plan, simulator, start, frames, placement, log);
   if (result.exit_code != 0) return result;
   result = finish_bake(plan, start, warmup, frames, placement, log);
-  result.vertices = tree.model.vertex_count();
+  result.vertices = vertices;
   result.samples = samples ? samples->vertex_count() : 0;
-  result.clusters = tree.model.cluster_count();
+  result.clusters = clusters;
   result.seconds = seconds_since(began);
   result.run_seconds = seconds_since(run_began);
   log.baked(result);

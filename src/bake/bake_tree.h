@@ -75,10 +75,11 @@ struct TreeBakeResult {
 JournalLayout journal_layout(const BakePlan& plan, const TreeModel& model, bool velocities,
                              bool cluster_motions = false);
 
-// Room: the bytes that the outputs and, with checkpoints, the checkpoints and journal records
-// still to write from `start` will take, against the free space of each filesystem they go to
-// (files/free_space.h). Throws OutputError when some filesystem lacks room.
-void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& model, const JournalLayout& layout,
+// Room: the bytes that the outputs and, with checkpoints, the checkpoints (each the state of
+// `simulated`, the model the solver steps) and journal records still to write from `start` will
+// take, against the free space of each filesystem they go to (files/free_space.h). Throws
+// OutputError when some filesystem lacks room.
+void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& simulated, const JournalLayout& layout,
                 const BakeFrames& frames);
 
 // Warm up: a loop that starts afresh (not from a checkpoint, which lies past the warm-up) runs
