@@ -34,9 +34,9 @@ struct BakeFrames {
   const size_t output_count;
   // Something reads each frame's mesh: an output, the checkpoints' journal or a loop's seam.
   const bool reads_mesh;
-  // hsm.particles "samples": the mesh placed from the simulated samples' clusters when it is
-  // read (null: the state is the mesh's, or nothing reads it), and its scratch.
-  bool sampled = false;
+  bool sampled = false;  // hsm.particles "samples": the solver steps samples, not the mesh
+  // The mesh placed from the samples' clusters when something reads it (null: the state is the
+  // mesh's, or nothing reads it), and its scratch.
   const SampleSkin* skin = nullptr;
   ClusterFrames skin_frames;
   SimState skinned;
