@@ -159,12 +159,11 @@ std::pair<uint32_t, uint32_t> correct_vertices(const SolverModel<Real>& model, c
     return for_vertex_blocks(
         model, attachment, state, scratch, first, last, pass, nothing,
         [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-          const bool lanes = model.lane_frames;
           if (model.store_drag_force)
-            return mode.last ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, lanes, block)
-                             : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, lanes, block);
-          return mode.last ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, lanes, block)
-                           : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, lanes, block);
+            return mode.last ? correct_block<true, true>(model, attachment, scratch, prediction, begin, n, in, block)
+                             : correct_block<false, true>(model, attachment, scratch, prediction, begin, n, in, block);
+          return mode.last ? correct_block<true, false>(model, attachment, scratch, prediction, begin, n, in, block)
+                           : correct_block<false, false>(model, attachment, scratch, prediction, begin, n, in, block);
         });
   });
 }

@@ -151,12 +151,12 @@ inline void store_drag_lane(const VertexInputs<Real>& in, const CorrectedLane<Re
 // with kEnd (`prediction` then holds the state at the step's end, for the frame's state), and
 // the runaway limit is checked; otherwise predict_block recomputes them, which saves a write
 // of u and v per vertex, and only a flagged block is written (for the caller to find the
-// vertex at fault). `lane_frames` (SolverModel::lane_frames): each lane reads its cluster's
-// frame itself. Returns block_flagged.
+// vertex at fault). With SolverModel::lane_frames each lane reads its cluster's frame itself.
+// Returns block_flagged.
 template <bool kEnd, bool kForce, typename Real>
 inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
-                          const VertexInputs<Real>& in, bool lane_frames, VertexBlock<Real>& block) {
+                          const VertexInputs<Real>& in, VertexBlock<Real>& block) {
   const Real inv_h = static_cast<Real>(1.0 / model.h);
   const Real half_inv_h = static_cast<Real>(0.5 / model.h);
   const Real* air[3] = {scratch.cluster_air.col(0).data(), scratch.cluster_air.col(1).data(),
@@ -184,7 +184,7 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
     if constexpr (kEnd) excess = (1 - in.flying[k]) * (ux * ux + uy * uy + uz * uz) - limit2;
     block.excess[k] = excess;
   };
-  if (!kForce || lane_frames) {
+  if (!kForce || model.lane_frames) {
 #pragma omp simd
     for (int k = 0; k < n; ++k) {
       const CorrectedLane<Real> lane = correct_lane(in, offset, velocity, k, inv_h);
