@@ -16,6 +16,7 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
   plan.use_checkpoints = config.checkpoints.resume || config.frames.has_value();
   plan.checkpoints = config.checkpoints;
   plan.key = {bake_key(scene, config.generator), config.generator, scene.hsm.precision == Precision::kFloat};
+  plan.reads_mesh = !scene.outputs.empty() || plan.checkpoints.every > 0 || plan.closes_loop;
   return plan;
 }
 

@@ -20,6 +20,8 @@ struct BakePlan {
   bool use_checkpoints = false;  // --resume or --frames: look for a checkpoint at all
   CheckpointPolicy checkpoints;
   CheckpointKey key;
+  // Something reads each frame's mesh: an output, the checkpoints' journal or a loop's seam.
+  bool reads_mesh = false;
 };
 
 // scene, config => the plan. --frames only chooses what is written: the simulation starts at

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <utility>
 
 #include "bake/checkpoint.h"
 #include "bake/prepare_tree.h"
@@ -71,7 +72,7 @@ void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& re
 void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
-  if (frames.sampled && !frames.reads_mesh) {
+  if (frames.sampled && !plan.reads_mesh) {
     // Nothing reads the mesh: no vertex is placed; the bounds are the samples'.
     for (long s = 0; s < start.state.positions.cols(); ++s) {
       const Eigen::Vector3d x = start.state.positions.col(s);
@@ -105,7 +106,6 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
                        const TreePlacement* placement)
     : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
-      reads_mesh(output_count > 0 || plan.checkpoints.every > 0 || info.loop),
       outputs(scene.outputs, config.out_dir, model, info) {}
 
 void BakeFrames::push(FrameData data) {
@@ -192,32 +192,31 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const auto began = std::chrono::steady_clock::now();
   if (config.threads > 0) omp_set_num_threads(config.threads);
   const BakePlan plan = plan_bake(scene, config);
-  PreparedTree tree = prepare_tree(scene);
+  // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
+  const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
+  // Nothing reads the surface (triangles, UVs) of a samples bake that writes nothing.
+  PreparedTree tree = prepare_tree(scene, sampled && !plan.reads_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt);
   tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
   BakeFrames frames(scene, config, plan, tree.model, placement);
+  frames.sampled = sampled;
+  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
+                                              sampled && frames.outputs.wants_cluster_motions());
+  const size_t vertices = tree.model.vertex_count(), clusters = tree.model.cluster_count();
+  // Nothing reads the mesh of a samples bake that writes nothing (BakePlan::reads_mesh): its
+  // model goes back as the samples are drawn, so the bake holds the samples alone.
+  const bool give_up_mesh = sampled && !plan.reads_mesh;
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
   std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
-  const TreeModel& mesh = placed ? *placed : tree.model;
-  // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
-  frames.sampled = scene.hsm.particles == ParticleMode::kSamples;
-  const std::optional<TreeModel> samples =
-      frames.sampled ? std::optional<TreeModel>(sample_tree_model(mesh)) : std::nullopt;
-  const std::optional<SampleSkin> skin = frames.sampled && frames.reads_mesh
-                                             ? std::optional<SampleSkin>(std::in_place, mesh, *samples)
-                                             : std::nullopt;
+  if (placed && give_up_mesh) tree.model = TreeModel();
+  TreeModel& mesh = placed ? *placed : tree.model;
+  std::optional<TreeModel> samples;
+  if (sampled) samples = give_up_mesh ? sample_tree_model(std::move(mesh)) : sample_tree_model(std::as_const(mesh));
+  const std::optional<SampleSkin> skin =
+      sampled && plan.reads_mesh ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
   if (skin) frames.skin = &*skin;
-  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
-                                              frames.skin && frames.outputs.wants_cluster_motions());
-  const size_t vertices = tree.model.vertex_count(), clusters = tree.model.cluster_count();
   const TreeModel& simulated = samples ? *samples : mesh;
-  // Nothing reads the mesh of a samples bake that writes nothing (BakeFrames::reads_mesh): its
-  // model goes back before the solver's arrays are made, so the bake holds the samples alone.
-  if (frames.sampled && !frames.reads_mesh) {
-    tree.model = TreeModel();
-    placed.reset();
-  }
   Simulator simulator(simulated, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);

@@ -32,8 +32,6 @@ struct BakeFrames {
 
   const BakeInfo info;
   const size_t output_count;
-  // Something reads each frame's mesh: an output, the checkpoints' journal or a loop's seam.
-  const bool reads_mesh;
   bool sampled = false;  // hsm.particles "samples": the solver steps samples, not the mesh
   // The mesh placed from the samples' clusters when something reads it (null: the state is the
   // mesh's, or nothing reads it), and its scratch.

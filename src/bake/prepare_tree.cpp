@@ -15,13 +15,13 @@ Json to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()
 
 }  // namespace
 
-PreparedTree prepare_tree(const Scene& scene) {
+PreparedTree prepare_tree(const Scene& scene, MeshSurface surface) {
   PreparedTree tree;
   auto start = std::chrono::steady_clock::now();
   tree.skeleton = grow_skeleton(scene.lsystem, &tree.growth);
   tree.grow_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
-  tree.model = build_tree_model(tree.skeleton, scene.tree);
+  tree.model = build_tree_model(tree.skeleton, scene.tree, surface);
   tree.model_seconds = seconds_since(start);
   return tree;
 }

@@ -14,8 +14,8 @@ struct PreparedTree {
   double model_seconds = 0;  // mesh, clusters, masses
 };
 
-// scene => derived skeleton and validated TreeModel. Throws InputError.
-PreparedTree prepare_tree(const Scene& scene);
+// scene => derived skeleton and validated TreeModel, with or without its surface. Throws InputError.
+PreparedTree prepare_tree(const Scene& scene, MeshSurface surface = MeshSurface::kBuilt);
 
 // Counts and estimates of `info --json` (DESIGN keys: derivation.*, skeleton.*, mesh.*, model.*,
 // estimate.*).

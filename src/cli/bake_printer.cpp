@@ -36,7 +36,7 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
 }
 
 void BakePrinter::print_summary(const TreeBakeResult& result) const {
-  const std::string samples = result.samples ? " placed from " + std::to_string(result.samples) + " samples" : "";
+  const std::string samples = result.samples ? " simulated as " + std::to_string(result.samples) + " samples" : "";
   std::printf("baked %lld frames: %zu vertices%s, %zu clusters, %lld substeps in %.2f s (simulation + writing %.2f s)\n",
               result.written.count(), result.vertices, samples.c_str(), result.clusters, result.substeps,
               result.seconds, result.run_seconds);

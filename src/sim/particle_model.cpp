@@ -7,17 +7,14 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <numeric>
+#include <span>
+#include <type_traits>
 #include <vector>
 
 namespace treeanim {
 
 namespace {
-
-// Vertices of one group, in mesh order, and its samples' first id and count.
-struct VertexGroup {
-  std::vector<uint32_t> vertices;
-  uint32_t first_sample = 0, samples = 0;
-};
 
 // Vertex v => what makes two vertices exchangeable: its clusters (ascending), its anchor, its
 // leaf, the cluster of the segment it was built for (the chain reads whether a cluster's
@@ -53,7 +50,7 @@ std::vector<uint8_t> kept_vertices(const TreeModel& mesh) {
 // second moments about it are the group's. Planar groups (a ring) take three points at thirds
 // of an ellipse in the plane, the others four at the corners of a tetrahedron stretched along
 // the principal axes; a group of no more vertices than that keeps its vertices.
-Eigen::Matrix3Xd sample_points(const TreeModel& mesh, const std::vector<uint32_t>& vertices) {
+Eigen::Matrix3Xd sample_points(const TreeModel& mesh, std::span<const uint32_t> vertices) {
   const size_t n = vertices.size();
   double mass = 0;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -98,61 +95,106 @@ Eigen::Matrix3Xd sample_points(const TreeModel& mesh, const std::vector<uint32_t
   return points;
 }
 
-}  // namespace
+// The mesh's vertices in groups, each group's vertices in mesh order, the groups in the order
+// of their first vertex; a kept vertex is a group of its own.
+struct VertexGroups {
+  std::vector<uint32_t> of_vertex;  // (V) the group of each vertex
+  std::vector<uint32_t> offsets;    // (G+1) into vertices
+  std::vector<uint32_t> vertices;   // (V)
+  size_t count() const { return offsets.size() - 1; }
+  std::span<const uint32_t> operator[](size_t g) const {
+    return {vertices.data() + offsets[g], offsets[g + 1] - offsets[g]};
+  }
+};
 
-TreeModel sample_tree_model(const TreeModel& mesh) {
-  const size_t V = mesh.vertex_count(), C = mesh.cluster_count();
-  // Groups in the order of their first vertex; a kept vertex is a group of its own.
+VertexGroups group_vertices(const TreeModel& mesh) {
+  const size_t V = mesh.vertex_count();
   const std::vector<uint8_t> kept = kept_vertices(mesh);
+  VertexGroups groups;
+  groups.of_vertex.resize(V);
+  uint32_t G = 0;
   std::map<std::vector<uint32_t>, uint32_t> group_of_key;
-  std::vector<VertexGroup> groups;
   for (uint32_t v = 0; v < V; ++v) {
     if (kept[v]) {
-      groups.push_back({{v}, 0, 0});
+      groups.of_vertex[v] = G++;
       continue;
     }
-    const auto [it, added] = group_of_key.emplace(group_key(mesh, v), uint32_t(groups.size()));
-    if (added) groups.emplace_back();
-    groups[it->second].vertices.push_back(v);
+    const auto [it, added] = group_of_key.emplace(group_key(mesh, v), G);
+    G += uint32_t(added);
+    groups.of_vertex[v] = it->second;
   }
+  groups.offsets.assign(size_t(G) + 1, 0);
+  for (uint32_t g : groups.of_vertex) ++groups.offsets[g + 1];
+  std::partial_sum(groups.offsets.begin(), groups.offsets.end(), groups.offsets.begin());
+  std::vector<uint32_t> next(groups.offsets.begin(), groups.offsets.end() - 1);
+  groups.vertices.resize(V);
+  for (uint32_t v = 0; v < V; ++v) groups.vertices[next[groups.of_vertex[v]]++] = v;
+  return groups;
+}
 
-  std::vector<Eigen::Matrix3Xd> points(groups.size());
-  uint32_t S = 0;
-  for (size_t g = 0; g < groups.size(); ++g) {
-    points[g] = sample_points(mesh, groups[g].vertices);
-    groups[g].first_sample = S;
-    groups[g].samples = uint32_t(points[g].cols());
-    S += groups[g].samples;
+// An array of the mesh that the samples copy, or take when the mesh is given up.
+template <class T>
+T take(const T& kept) {
+  return kept;
+}
+template <class T>
+T take(T& given_up) {
+  return std::move(given_up);
+}
+
+// Mesh: const TreeModel (kept), or TreeModel, whose arrays go back once the samples have read them.
+template <class Mesh>
+TreeModel draw_samples(Mesh& mesh) {
+  constexpr bool give_up = !std::is_const_v<Mesh>;
+  const auto release = [](auto& array) {
+    if constexpr (give_up) array = std::decay_t<decltype(array)>();
+  };
+  const size_t C = mesh.cluster_count();
+  VertexGroups groups = group_vertices(mesh);
+  const size_t G = groups.count();
+  release(mesh.vertex_cluster_offsets), release(mesh.vertex_memberships), release(mesh.member_cluster);
+
+  // Each group's samples, from first_sample[g] on; a group of its vertices' own count keeps them.
+  std::vector<uint32_t> first_sample(G + 1, 0);
+  std::vector<double> points;  // (3 x S)
+  points.reserve(12 * G);
+  for (size_t g = 0; g < G; ++g) {
+    const Eigen::Matrix3Xd group_points = sample_points(mesh, groups[g]);
+    points.insert(points.end(), group_points.data(), group_points.data() + group_points.size());
+    first_sample[g + 1] = uint32_t(points.size() / 3);
   }
+  const size_t S = points.size() / 3;
+  release(mesh.rest_positions);
 
   TreeModel out;
-  out.rest_positions.resize(3, S);
-  out.uvs.setZero(2, S);
+  out.rest_positions = Eigen::Map<const Eigen::Matrix3Xd>(points.data(), 3, Eigen::Index(S));
+  points = {};
   out.vertex_segment.resize(S);
   out.vertex_leaf.resize(S);
   out.vertex_mass.resize(S);
   out.vertex_anchored.resize(S);
   out.vertex_drag_area.resize(S);
-  std::vector<uint32_t> vertex_group(V);
-  for (size_t g = 0; g < groups.size(); ++g) {
-    const VertexGroup& group = groups[g];
+  for (size_t g = 0; g < G; ++g) {
+    const std::span<const uint32_t> vertices = groups[g];
     double mass = 0, area = 0;
-    for (uint32_t v : group.vertices) {
+    for (uint32_t v : vertices) {
       mass += mesh.vertex_mass[v];
       area += mesh.vertex_drag_area[v];
-      vertex_group[v] = uint32_t(g);
     }
-    const bool own = group.samples == group.vertices.size();  // the vertices themselves
-    for (uint32_t k = 0; k < group.samples; ++k) {
-      const uint32_t s = group.first_sample + k, v = group.vertices[own ? k : 0];
-      out.rest_positions.col(s) = points[g].col(k);
+    const uint32_t samples = first_sample[g + 1] - first_sample[g];
+    const bool own = samples == vertices.size();  // the vertices themselves
+    for (uint32_t k = 0; k < samples; ++k) {
+      const uint32_t s = first_sample[g] + k, v = vertices[own ? k : 0];
       out.vertex_segment[s] = mesh.vertex_segment[v];
       out.vertex_leaf[s] = mesh.vertex_leaf[v];
       out.vertex_anchored[s] = mesh.vertex_anchored[v];
-      out.vertex_mass[s] = own ? mesh.vertex_mass[v] : mass / group.samples;
-      out.vertex_drag_area[s] = own ? mesh.vertex_drag_area[v] : area / group.samples;
+      out.vertex_mass[s] = own ? mesh.vertex_mass[v] : mass / samples;
+      out.vertex_drag_area[s] = own ? mesh.vertex_drag_area[v] : area / samples;
     }
   }
+  groups.vertices = {};
+  release(mesh.vertex_mass), release(mesh.vertex_drag_area), release(mesh.vertex_anchored);
+  release(mesh.vertex_segment), release(mesh.vertex_leaf);
 
   // The clusters: every sample of each group of a member vertex (a group's vertices share
   // their clusters), ascending as the groups are.
@@ -161,25 +203,35 @@ TreeModel sample_tree_model(const TreeModel& mesh) {
   for (size_t c = 0; c < C; ++c) {
     member_groups.clear();
     for (uint32_t i = mesh.cluster_offsets[c]; i < mesh.cluster_offsets[c + 1]; ++i)
-      member_groups.push_back(vertex_group[mesh.cluster_members[i]]);
+      member_groups.push_back(groups.of_vertex[mesh.cluster_members[i]]);
     std::sort(member_groups.begin(), member_groups.end());
     member_groups.erase(std::unique(member_groups.begin(), member_groups.end()), member_groups.end());
     for (uint32_t g : member_groups)
-      for (uint32_t k = 0; k < groups[g].samples; ++k) out.cluster_members.push_back(groups[g].first_sample + k);
+      for (uint32_t s = first_sample[g]; s < first_sample[g + 1]; ++s) out.cluster_members.push_back(s);
     out.cluster_offsets[c + 1] = uint32_t(out.cluster_members.size());
   }
-  out.cluster_kind = mesh.cluster_kind, out.cluster_leaf = mesh.cluster_leaf, out.cluster_parent = mesh.cluster_parent;
-  out.cluster_length = mesh.cluster_length, out.cluster_radius = mesh.cluster_radius;
+  release(mesh.cluster_members);
+  const size_t L = mesh.leaf_count();
+  out.leaf_attachment_vertex.resize(L);
+  for (size_t l = 0; l < L; ++l)  // kept: a group of one vertex, one sample
+    out.leaf_attachment_vertex[l] = first_sample[groups.of_vertex[mesh.leaf_attachment_vertex[l]]];
+  out.leaf_cluster = take(mesh.leaf_cluster);
+  out.cluster_kind = take(mesh.cluster_kind), out.cluster_leaf = take(mesh.cluster_leaf);
+  out.cluster_parent = take(mesh.cluster_parent);
+  out.cluster_length = take(mesh.cluster_length), out.cluster_radius = take(mesh.cluster_radius);
   index_memberships(out);
-  out.leaf_cluster = mesh.leaf_cluster;
-  out.leaf_attachment_vertex.resize(mesh.leaf_count());
-  for (size_t l = 0; l < mesh.leaf_count(); ++l)  // kept: a group of one vertex, one sample
-    out.leaf_attachment_vertex[l] = groups[vertex_group[mesh.leaf_attachment_vertex[l]]].first_sample;
-  out.segment_start = mesh.segment_start, out.segment_end = mesh.segment_end;
-  out.segment_radius_base = mesh.segment_radius_base, out.segment_radius_top = mesh.segment_radius_top;
-  out.segment_parent = mesh.segment_parent, out.segment_cluster = mesh.segment_cluster;
+  out.segment_start = take(mesh.segment_start), out.segment_end = take(mesh.segment_end);
+  out.segment_radius_base = take(mesh.segment_radius_base), out.segment_radius_top = take(mesh.segment_radius_top);
+  out.segment_parent = take(mesh.segment_parent), out.segment_cluster = take(mesh.segment_cluster);
+  if constexpr (give_up) mesh = TreeModel();
   validate_tree_model(out);
   return out;
 }
+
+}  // namespace
+
+TreeModel sample_tree_model(const TreeModel& mesh) { return draw_samples(mesh); }
+
+TreeModel sample_tree_model(TreeModel&& mesh) { return draw_samples(mesh); }
 
 }  // namespace treeanim

@@ -12,7 +12,10 @@ namespace treeanim {
 // shared vertex and the rest mesh's extreme vertices along each axis kept as they are, so the
 // chain's joints, the tree's height and size are the mesh's. Every cluster then has its
 // vertices' mass, centre and moment matrix A_qq, and its air load's sum and moment. The result
-// has no triangles; it is validated.
+// has no surface (MeshSurface::kOmitted); it is validated.
 TreeModel sample_tree_model(const TreeModel& mesh);
+// The same samples from a mesh nothing reads afterwards: its arrays go back as soon as the
+// samples have read them, so the two models are never whole together. The mesh is left empty.
+TreeModel sample_tree_model(TreeModel&& mesh);
 
 }  // namespace treeanim

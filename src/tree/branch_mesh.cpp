@@ -72,8 +72,9 @@ struct RingAngles {
   }
 };
 
-// ring => sides vertices from `first` on, counter-clockwise about the tangent.
-void write_ring(const Ring& ring, const RingAngles& angles, uint32_t first, int32_t segment,
+// ring => sides vertices from `first` on, counter-clockwise about the tangent (their UVs with
+// the surface).
+void write_ring(const Ring& ring, const RingAngles& angles, uint32_t first, int32_t segment, bool surface,
                 TreeModel& model) {
   const int sides = int(angles.c.size());
   const Eigen::Vector3d binormal = ring.tangent.cross(ring.normal);
@@ -82,7 +83,7 @@ void write_ring(const Ring& ring, const RingAngles& angles, uint32_t first, int3
     o += (ring.stretch - 1.0) * o.dot(ring.bend) * ring.bend;
     const uint32_t v = first + uint32_t(k);
     model.rest_positions.col(v) = ring.centre + o;
-    model.uvs.col(v) = Eigen::Vector2f(float(k) / float(sides), float(ring.v));
+    if (surface) model.uvs.col(v) = Eigen::Vector2f(float(k) / float(sides), float(ring.v));
     model.vertex_segment[v] = segment;
     model.vertex_leaf[v] = -1;
   }
@@ -138,6 +139,7 @@ BranchRings build_branch_mesh(const Skeleton& skeleton, const SegmentTopology& t
   rings.tip_vertex.assign(S, -1);
   std::vector<Ring> top(S);  // the ring at each segment's end, which its continuation starts from
   uint32_t next = 0;
+  const bool surface = model.uvs.cols() != 0;
   uint32_t* tri = model.triangles.data();
   for (size_t s = 0; s < S; ++s) {
     const int32_t seg = int32_t(s);
@@ -150,7 +152,7 @@ BranchRings build_branch_mesh(const Skeleton& skeleton, const SegmentTopology& t
       base.bend.setZero();
       base.radius = model.segment_radius_base[s];
       rings.base_ring[s] = next;
-      write_ring(base, angles, next, seg, model);
+      write_ring(base, angles, next, seg, surface, model);
       next += sides;
     } else {
       const int32_t p = skeleton.segment_parent[s];
@@ -171,16 +173,18 @@ BranchRings build_branch_mesh(const Skeleton& skeleton, const SegmentTopology& t
     end.radius = model.segment_radius_top[s];
     end.v = base.v + topology.length[s];
     rings.top_ring[s] = next;
-    write_ring(end, angles, next, seg, model);
+    write_ring(end, angles, next, seg, surface, model);
     next += sides;
-    tri = write_tube(rings.base_ring[s], rings.top_ring[s], sides, tri);
+    if (surface) tri = write_tube(rings.base_ring[s], rings.top_ring[s], sides, tri);
     if (c < 0) {
       rings.tip_vertex[s] = int32_t(next);
       model.rest_positions.col(next) = end.centre;
-      model.uvs.col(next) = Eigen::Vector2f(0.5f, float(end.v));
+      if (surface) {
+        model.uvs.col(next) = Eigen::Vector2f(0.5f, float(end.v));
+        tri = write_cap(rings.top_ring[s], next, sides, tri);
+      }
       model.vertex_segment[next] = seg;
       model.vertex_leaf[next] = -1;
-      tri = write_cap(rings.top_ring[s], next, sides, tri);
       ++next;
     }
   }

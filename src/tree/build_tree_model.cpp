@@ -97,7 +97,7 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
   anchor(rings, leaves, uint32_t(options.ring_sides), model);
 }
 
-TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options) {
+TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options, MeshSurface surface) {
   check_skeleton(skeleton);
   TreeModel model;
   const SegmentTopology topology = segment_topology(skeleton, options.scale);
@@ -114,15 +114,17 @@ TreeModel build_tree_model(const Skeleton& skeleton, const TreeOptions& options)
   if (V > std::numeric_limits<uint32_t>::max() / 2)  // ids and membership slots are uint32
     throw InputError("tree too large: " + std::to_string(V) + " vertices (at most 2^31)");
   model.rest_positions.resize(3, Eigen::Index(V));
-  model.uvs.resize(2, Eigen::Index(V));
   model.vertex_segment.resize(V);
   model.vertex_leaf.resize(V);
-  model.triangles.resize(3 * (counts.branch_triangles + counts.leaf_triangles));
+  if (surface == MeshSurface::kBuilt) {
+    model.uvs.resize(2, Eigen::Index(V));
+    model.triangles.resize(3 * (counts.branch_triangles + counts.leaf_triangles));
+    model.triangle_material.assign(counts.branch_triangles, kMaterialBark);  // the branch mesh comes first
+    model.triangle_material.resize(counts.branch_triangles + counts.leaf_triangles, kMaterialLeaf);
+  }
 
   const BranchRings rings = build_branch_mesh(skeleton, topology, options, model);
   const LeafMeshes leaves = build_leaf_meshes(skeleton, options, shape, counts, model);
-  model.triangle_material.assign(counts.branch_triangles, kMaterialBark);  // the branch mesh comes first
-  model.triangle_material.resize(counts.branch_triangles + counts.leaf_triangles, kMaterialLeaf);
 
   model.segment_start.resize(skeleton.segment_count());
   model.segment_end.resize(skeleton.segment_count());

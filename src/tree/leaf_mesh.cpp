@@ -149,50 +149,62 @@ Eigen::Matrix3d leaf_frame(const Skeleton& skeleton, size_t l) {
   return r;
 }
 
-// Instance of `shape` at leaf l, from vertex `first` and triangle slot `tri` on.
+// Instance of `shape` at leaf l, from vertex `first` and (with the surface) triangle slot `tri` on.
 void write_instance(const Skeleton& skeleton, const TreeOptions& options, const LeafTemplate& shape,
-                    size_t l, uint32_t first, uint32_t*& tri, TreeModel& model) {
+                    size_t l, uint32_t first, bool surface, uint32_t*& tri, TreeModel& model) {
   const Eigen::Matrix3d frame = leaf_frame(skeleton, l) * skeleton.leaf_scale[l];
   const Eigen::Vector3d origin = skeleton.leaf_position[l] * options.scale;
   const Eigen::Index n = shape.positions.cols();
   model.rest_positions.middleCols(first, n) = (frame * shape.positions).colwise() + origin;
+  if (!surface) return;
   model.uvs.middleCols(first, n) = shape.uvs;
   for (uint32_t i : shape.triangles) *tri++ = first + i;
 }
 
-// The n world points of leaf l (scene units) => vertices from `first` (m), UVs the leaf-plane
-// coordinates (m). => the vertex nearest the leaf position (the attachment).
-uint32_t write_points(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
-                      uint32_t first, TreeModel& model) {
+// What the points of a leaf give its cluster: the vertex nearest the leaf position (the
+// attachment) and the extent of their leaf-plane y (their v; the length, m).
+struct LeafPoints {
+  uint32_t attachment = 0;
+  double length = 0;
+};
+
+// The n world points of leaf l (scene units) => vertices from `first` (m), with the surface
+// their UVs, the leaf-plane coordinates (m).
+LeafPoints write_points(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
+                        uint32_t first, bool surface, TreeModel& model) {
   const uint32_t p0 = skeleton.leaf_polygon_offsets[l];
   const Eigen::Vector3d origin = skeleton.leaf_position[l] * options.scale;
   const Eigen::Matrix3d to_leaf = leaf_frame(skeleton, l).transpose();
   double nearest = std::numeric_limits<double>::infinity();
-  uint32_t attachment = first;
+  float v_lo = std::numeric_limits<float>::infinity(), v_hi = -v_lo;
+  LeafPoints points{first, 0};
   for (uint32_t i = 0; i < n; ++i) {
     const Eigen::Vector3d p = skeleton.polygon_points[p0 + i] * options.scale;
     model.rest_positions.col(first + i) = p;
     const Eigen::Vector3d local = to_leaf * (p - origin);
-    model.uvs.col(first + i) = Eigen::Vector2f(float(local.x()), float(local.y()));
+    const Eigen::Vector2f uv(float(local.x()), float(local.y()));
+    if (surface) model.uvs.col(first + i) = uv;
+    v_lo = std::min(v_lo, uv.y());
+    v_hi = std::max(v_hi, uv.y());
     const double d = (p - origin).squaredNorm();
     if (d < nearest) {
       nearest = d;
-      attachment = first + i;
+      points.attachment = first + i;
     }
   }
-  return attachment;
+  points.length = double(v_hi - v_lo);
+  return points;
 }
 
-// Outline of leaf l (n >= 3 points) fan-triangulated from its first point, wound so that its
-// front faces the turtle's U. => area (m^2); attachment = the point nearest the leaf position.
-double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
-                     uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
-  attachment = write_points(skeleton, options, l, n, first, model);
+// Outline of leaf l (n >= 3 points at `first`) => area (m^2); with the surface its triangles,
+// fanned from its first point, wound so that its front faces the turtle's U.
+double write_outline(const Skeleton& skeleton, size_t l, uint32_t n, uint32_t first, bool surface, uint32_t*& tri,
+                     const TreeModel& model) {
   Eigen::Vector3d newell = Eigen::Vector3d::Zero();
   for (uint32_t i = 0; i < n; ++i)
     newell += model.rest_positions.col(first + i).cross(model.rest_positions.col(first + (i + 1) % n));
   const bool flip = newell.dot(skeleton.leaf_up[l]) < 0;
-  for (uint32_t i = 1; i + 1 < n; ++i) {
+  for (uint32_t i = 1; surface && i + 1 < n; ++i) {
     *tri++ = first;
     *tri++ = first + (flip ? i + 1 : i);
     *tri++ = first + (flip ? i : i + 1);
@@ -200,14 +212,15 @@ double write_outline(const Skeleton& skeleton, const TreeOptions& options, size_
   return 0.5 * newell.norm();
 }
 
-// Mesh of leaf l (n points, its own triangles, wound by the turtle). => area (m^2), the sum of
-// its triangles (a closed shape counts its whole surface); attachment as for an outline.
-double write_mesh(const Skeleton& skeleton, const TreeOptions& options, size_t l, uint32_t n,
-                  uint32_t first, uint32_t*& tri, uint32_t& attachment, TreeModel& model) {
-  attachment = write_points(skeleton, options, l, n, first, model);
+// Mesh of leaf l (n points at `first`, its own triangles, wound by the turtle) => area (m^2),
+// the sum of its triangles (a closed shape counts its whole surface); with the surface, its
+// triangles.
+double write_mesh(const Skeleton& skeleton, size_t l, uint32_t n, uint32_t first, bool surface, uint32_t*& tri,
+                  const TreeModel& model) {
   const std::span<const uint32_t> own(skeleton.leaf_triangles.data() + skeleton.leaf_triangle_offsets[l],
                                       skeleton.leaf_triangle_offsets[l + 1] - skeleton.leaf_triangle_offsets[l]);
-  for (uint32_t i : own) *tri++ = first + i;
+  if (surface)
+    for (uint32_t i : own) *tri++ = first + i;
   return mesh_area(model.rest_positions.middleCols(first, n), own);
 }
 
@@ -222,19 +235,21 @@ LeafMeshes build_leaf_meshes(const Skeleton& skeleton, const TreeOptions& option
   leaves.area.resize(L);
   leaves.length.resize(L);
   uint32_t next = uint32_t(counts.branch_vertices);
-  uint32_t* tri = model.triangles.data() + 3 * counts.branch_triangles;
+  const bool surface = model.uvs.cols() != 0;
+  uint32_t* tri = surface ? model.triangles.data() + 3 * counts.branch_triangles : nullptr;
   for (size_t l = 0; l < L; ++l) {
     leaves.vertex_offsets[l] = next;
     const uint32_t outline = outline_points(skeleton, l);
     if (outline || mesh_triangles(skeleton, l)) {
       const uint32_t n = point_count(skeleton, l);
-      leaves.area[l] = outline ? write_outline(skeleton, options, l, n, next, tri, leaves.attachment[l], model)
-                               : write_mesh(skeleton, options, l, n, next, tri, leaves.attachment[l], model);
-      const Eigen::Matrix2Xf uv = model.uvs.middleCols(next, n);
-      leaves.length[l] = double(uv.row(1).maxCoeff() - uv.row(1).minCoeff());
+      const LeafPoints points = write_points(skeleton, options, l, n, next, surface, model);
+      leaves.area[l] = outline ? write_outline(skeleton, l, n, next, surface, tri, model)
+                               : write_mesh(skeleton, l, n, next, surface, tri, model);
+      leaves.attachment[l] = points.attachment;
+      leaves.length[l] = points.length;
       next += n;
     } else {
-      write_instance(skeleton, options, shape, l, next, tri, model);
+      write_instance(skeleton, options, shape, l, next, surface, tri, model);
       const double s = skeleton.leaf_scale[l];
       leaves.area[l] = shape.area * s * s;
       leaves.length[l] = shape.length * s;

@@ -44,7 +44,8 @@ struct MeshCounts {
 };
 
 // topology + radii => branch vertices [0, branch_vertices) and triangles of the model
-// (rest_positions, uvs, vertex_segment, vertex_leaf, triangles must be sized already).
+// (rest_positions, uvs, vertex_segment, vertex_leaf, triangles must be sized already; uvs and
+// triangles left empty omit the surface, MeshSurface::kOmitted).
 BranchRings build_branch_mesh(const Skeleton& skeleton, const SegmentTopology& topology,
                               const TreeOptions& options, TreeModel& model);
 size_t branch_vertex_count(const SegmentTopology& topology, int ring_sides);
@@ -75,7 +76,8 @@ struct LeafMeshes {
   std::vector<double> length;            // (L) m
 };
 
-// leaves of the skeleton => vertices and triangles after the branch mesh.
+// leaves of the skeleton => vertices and triangles after the branch mesh (the model sized as for
+// build_branch_mesh).
 size_t leaf_vertex_count(const Skeleton& skeleton, const LeafTemplate& shape);
 size_t leaf_triangle_count(const Skeleton& skeleton, const LeafTemplate& shape);
 LeafMeshes build_leaf_meshes(const Skeleton& skeleton, const TreeOptions& options,

@@ -14,8 +14,12 @@ enum TriangleMaterial : uint8_t { kMaterialBark = 0, kMaterialLeaf = 1 };
 inline constexpr size_t kMaterialCount = 2;
 inline constexpr const char* kMaterialNames[kMaterialCount] = {"bark", "leaf"};  // by TriangleMaterial
 
+// Whether a model carries its surface (UVs, triangles and their materials): what writes or
+// shows the mesh reads it; the solver and the samples read none of it.
+enum class MeshSurface : uint8_t { kBuilt, kOmitted };
+
 struct TreeModel {
-  // --- mesh (V vertices, T triangles) ---
+  // --- mesh (V vertices, T triangles; uvs, triangles, triangle_material empty without the surface) ---
   Eigen::Matrix3Xd rest_positions;                // (3 x V) m
   Eigen::Matrix2Xf uvs;                           // (2 x V) u around the branch, v along it (m)
   std::vector<uint32_t> triangles;                // (T*3) vertex ids, counter-clockwise seen from outside

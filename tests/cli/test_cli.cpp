@@ -193,7 +193,7 @@ TEST_F(Cli, ASampledBakeAndInfoSayHowManySamplesMoveTheMesh) {
                        " --set 'hsm.particles=\"samples\"'");
   ASSERT_EQ(r.code, 0) << r.err;
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(baked 5 frames: (\d+) vertices placed from (\d+) samples, )")))
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(baked 5 frames: (\d+) vertices simulated as (\d+) samples, )")))
       << r.out;
   EXPECT_LT(std::stoul(m[2]), std::stoul(m[1])) << r.out;
   EXPECT_EQ(run("run " + scene.string() + " -o " + (dir_ / "out2").string()).out.find("samples"), std::string::npos);

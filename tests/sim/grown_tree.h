@@ -10,7 +10,8 @@
 namespace treeanim::testing {
 
 // The Table-1 monopodial grammar grown `iterations` seasons with `leaves` per node.
-inline TreeModel grown_tree(int iterations, int leaves, int segments_per_cluster) {
+inline TreeModel grown_tree(int iterations, int leaves, int segments_per_cluster,
+                            MeshSurface surface = MeshSurface::kBuilt) {
   LsystemOptions lsystem;
   lsystem.grammar = std::filesystem::path(TREEANIM_SOURCE_DIR) / "grammars/table1-monopodial.lsys";
   lsystem.iterations = iterations;
@@ -21,7 +22,7 @@ inline TreeModel grown_tree(int iterations, int leaves, int segments_per_cluster
   TreeOptions tree;
   tree.trunk_radius = 0.1;
   tree.cluster.segments_per_cluster = segments_per_cluster;
-  return build_tree_model(skeleton, tree);
+  return build_tree_model(skeleton, tree, surface);
 }
 
 // Gusts of `speed` (m/s) until blow_until (s), calm from calm_from (s).

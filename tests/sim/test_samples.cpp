@@ -74,6 +74,43 @@ TEST(SampleModel, KeepsEachClustersMassCentreMomentsAndDragArea) {
   EXPECT_EQ(samples.rest_positions.rowwise().minCoeff(), mesh.rest_positions.rowwise().minCoeff());
 }
 
+// The samples of a mesh built without its surface, or of a mesh given up as they are drawn (a
+// samples bake that writes nothing), are those of the whole mesh kept, to the bit.
+TEST(SampleModel, AreTheSameFromABareMeshAndFromAMeshGivenUp) {
+  const TreeModel mesh = grown_tree(5, 1, 4);
+  const TreeModel kept = sample_tree_model(mesh);
+  TreeModel given = mesh;
+  const TreeModel from_given = sample_tree_model(std::move(given));
+  EXPECT_EQ(given.vertex_count(), 0u);
+  EXPECT_EQ(given.cluster_count(), 0u);
+  EXPECT_TRUE(given.vertex_mass.empty() && given.cluster_members.empty() && given.segment_start.empty());
+  TreeModel bare = grown_tree(5, 1, 4, MeshSurface::kOmitted);
+  ASSERT_TRUE(bare.triangles.empty());
+  const TreeModel from_bare = sample_tree_model(std::move(bare));
+  EXPECT_EQ(kept.uvs.cols(), 0);
+  EXPECT_TRUE(kept.triangles.empty());
+  for (const TreeModel* other : {&from_given, &from_bare}) {
+    EXPECT_TRUE(same_bytes(other->rest_positions, kept.rest_positions));
+    EXPECT_EQ(other->vertex_mass, kept.vertex_mass);
+    EXPECT_EQ(other->vertex_drag_area, kept.vertex_drag_area);
+    EXPECT_EQ(other->vertex_anchored, kept.vertex_anchored);
+    EXPECT_EQ(other->vertex_segment, kept.vertex_segment);
+    EXPECT_EQ(other->vertex_leaf, kept.vertex_leaf);
+    EXPECT_EQ(other->cluster_offsets, kept.cluster_offsets);
+    EXPECT_EQ(other->cluster_members, kept.cluster_members);
+    EXPECT_EQ(other->member_cluster, kept.member_cluster);
+    EXPECT_EQ(other->cluster_kind, kept.cluster_kind);
+    EXPECT_EQ(other->cluster_parent, kept.cluster_parent);
+    EXPECT_EQ(other->cluster_length, kept.cluster_length);
+    EXPECT_EQ(other->cluster_radius, kept.cluster_radius);
+    EXPECT_EQ(other->leaf_cluster, kept.leaf_cluster);
+    EXPECT_EQ(other->leaf_attachment_vertex, kept.leaf_attachment_vertex);
+    EXPECT_EQ(other->segment_start, kept.segment_start);
+    EXPECT_EQ(other->segment_radius_top, kept.segment_radius_top);
+    EXPECT_EQ(other->segment_cluster, kept.segment_cluster);
+  }
+}
+
 TEST(SampleSkin, PlacesTheRestMeshExactlyAndARigidMotionExactly) {
   const TreeModel mesh = grown_tree(4, 1, 4);
   const TreeModel samples = sample_tree_model(mesh);

@@ -126,6 +126,55 @@ TEST(TreeLeaves, CustomObjMeshIsInstancedOnEveryLeaf) {
   }
 }
 
+// A model without its surface (a samples bake that writes nothing) has every other array of the
+// model with it, to the bit: the leaves' lengths and attachments too, which the outlines and the
+// turtle's meshes take from the points whose UVs they no longer write.
+TEST(TreeLeaves, WithoutTheSurfaceEveryOtherArrayIsTheSame) {
+  test::SkeletonBuilder b;
+  const int s = b.segment({0, 0, 0}, {0, 1, 0}, -1, false);
+  const int top = b.extend(s, {0.1, 1, 0});
+  const Eigen::Vector3d h(1, 0, 0), left(0, 0, -1);
+  b.leaf(s, {0, 1, 0}, h, left, 1.0, {{0.1, 1, 0}, {0.3, 1, -0.1}, {0.5, 1, 0}, {0.3, 1, 0.1}, {0.2, 1, 0.08}});
+  b.leaf(top, {0.1, 2, 0}, {0, 1, 0}, {-1, 0, 0}, 1.0,
+         {{-0.4, 2, 0}, {0.1, 2, 0}, {0.6, 2, 0}, {0.6, 2.7, 0}, {-0.4, 2.9, 0}}, {0, 2, 3, 0, 3, 4});
+  b.leaf(top, {0.1, 2, 0}, h, left, 0.5);
+  TreeOptions o;
+  o.scale = 0.7;
+  const TreeModel whole = build_tree_model(b.sk, o);
+  const TreeModel bare = build_tree_model(b.sk, o, MeshSurface::kOmitted);
+  ASSERT_EQ(whole.triangle_count(), 5u * uint32_t(o.ring_sides) + 3 + 2 + 2);  // two tubes and a cap; the leaves
+  EXPECT_EQ(bare.uvs.cols(), 0);
+  EXPECT_TRUE(bare.triangles.empty());
+  EXPECT_TRUE(bare.triangle_material.empty());
+  EXPECT_TRUE(bare.rest_positions.cwiseEqual(whole.rest_positions).all());
+  EXPECT_EQ(bare.vertex_segment, whole.vertex_segment);
+  EXPECT_EQ(bare.vertex_leaf, whole.vertex_leaf);
+  EXPECT_EQ(bare.vertex_mass, whole.vertex_mass);
+  EXPECT_EQ(bare.vertex_anchored, whole.vertex_anchored);
+  EXPECT_EQ(bare.vertex_drag_area, whole.vertex_drag_area);
+  EXPECT_EQ(bare.cluster_offsets, whole.cluster_offsets);
+  EXPECT_EQ(bare.cluster_members, whole.cluster_members);
+  EXPECT_EQ(bare.cluster_kind, whole.cluster_kind);
+  EXPECT_EQ(bare.cluster_leaf, whole.cluster_leaf);
+  EXPECT_EQ(bare.cluster_parent, whole.cluster_parent);
+  EXPECT_EQ(bare.cluster_length, whole.cluster_length);
+  EXPECT_EQ(bare.cluster_radius, whole.cluster_radius);
+  EXPECT_EQ(bare.vertex_cluster_offsets, whole.vertex_cluster_offsets);
+  EXPECT_EQ(bare.vertex_memberships, whole.vertex_memberships);
+  EXPECT_EQ(bare.member_cluster, whole.member_cluster);
+  EXPECT_EQ(bare.leaf_cluster, whole.leaf_cluster);
+  EXPECT_EQ(bare.leaf_attachment_vertex, whole.leaf_attachment_vertex);
+  EXPECT_EQ(bare.segment_start, whole.segment_start);
+  EXPECT_EQ(bare.segment_end, whole.segment_end);
+  EXPECT_EQ(bare.segment_radius_base, whole.segment_radius_base);
+  EXPECT_EQ(bare.segment_radius_top, whole.segment_radius_top);
+  EXPECT_EQ(bare.segment_parent, whole.segment_parent);
+  EXPECT_EQ(bare.segment_cluster, whole.segment_cluster);
+  // The lengths the outline and the mesh took from their points' v: 0.4 and 0.9 along H (x 0.7).
+  EXPECT_NEAR(bare.cluster_length[bare.leaf_cluster[0]], 0.7 * 0.4, 1e-7);
+  EXPECT_NEAR(bare.cluster_length[bare.leaf_cluster[1]], 0.7 * 0.9, 1e-7);
+}
+
 TEST(TreeLeaves, UnreadableMeshIsAnInputErrorNamingTheFile) {
   TreeOptions o;
   o.leaf.mesh = std::filesystem::path(TREEANIM_SOURCE_DIR) / "tests/data/no_such_leaf.obj";
