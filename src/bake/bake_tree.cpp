@@ -194,8 +194,11 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const BakePlan plan = plan_bake(scene, config);
   // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
   const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
-  // Nothing reads the surface (triangles, UVs) of a samples bake that writes nothing.
-  PreparedTree tree = prepare_tree(scene, sampled && !plan.reads_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt);
+  // Nothing reads the mesh of a samples bake that writes nothing (BakePlan::reads_mesh): it is
+  // built without its surface, and its model goes back as the samples are drawn, so the bake
+  // holds the samples alone.
+  const bool give_up_mesh = sampled && !plan.reads_mesh;
+  PreparedTree tree = prepare_tree(scene, give_up_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt);
   tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
   BakeFrames frames(scene, config, plan, tree.model, placement);
@@ -203,9 +206,6 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
                                               sampled && frames.outputs.wants_cluster_motions());
   const size_t vertices = tree.model.vertex_count(), clusters = tree.model.cluster_count();
-  // Nothing reads the mesh of a samples bake that writes nothing (BakePlan::reads_mesh): its
-  // model goes back as the samples are drawn, so the bake holds the samples alone.
-  const bool give_up_mesh = sampled && !plan.reads_mesh;
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
   std::optional<TreeModel> placed =
       placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
@@ -214,7 +214,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   std::optional<TreeModel> samples;
   if (sampled) samples = give_up_mesh ? sample_tree_model(std::move(mesh)) : sample_tree_model(std::as_const(mesh));
   const std::optional<SampleSkin> skin =
-      sampled && plan.reads_mesh ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
+      sampled && !give_up_mesh ? std::optional<SampleSkin>(std::in_place, mesh, *samples) : std::nullopt;
   if (skin) frames.skin = &*skin;
   const TreeModel& simulated = samples ? *samples : mesh;
   Simulator simulator(simulated, scene.hsm, scene.wind, plan.frame_dt, scene.time.substeps);

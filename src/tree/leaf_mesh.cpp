@@ -204,11 +204,12 @@ double write_outline(const Skeleton& skeleton, size_t l, uint32_t n, uint32_t fi
   for (uint32_t i = 0; i < n; ++i)
     newell += model.rest_positions.col(first + i).cross(model.rest_positions.col(first + (i + 1) % n));
   const bool flip = newell.dot(skeleton.leaf_up[l]) < 0;
-  for (uint32_t i = 1; surface && i + 1 < n; ++i) {
-    *tri++ = first;
-    *tri++ = first + (flip ? i + 1 : i);
-    *tri++ = first + (flip ? i : i + 1);
-  }
+  if (surface)
+    for (uint32_t i = 1; i + 1 < n; ++i) {
+      *tri++ = first;
+      *tri++ = first + (flip ? i + 1 : i);
+      *tri++ = first + (flip ? i : i + 1);
+    }
   return 0.5 * newell.norm();
 }
 
