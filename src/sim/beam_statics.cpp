@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "sim/kernel_isa.h"
+#include "sim/lanes.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -25,22 +26,20 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
 }
 
 // The same by Rodrigues' formula, R = cos a I + (sin a / a) [theta]x + ((1 - cos a) / a^2) theta theta^T,
-// its factors from their series below 0.05 rad (to a^8: the next term is below 3e-21), as far
-// as a joint of the chain turns in an ordinary wind; rotation_of above it. hsm.particles
-// "samples" takes it: its clusters' fixed costs are its step's, and the library's sine, cosine
-// and matrix were some 4 % of them; "vertices" keeps the paper's set-up byte for byte.
-Eigen::Matrix3d small_rotation_of(const Eigen::Vector3d& theta) {
-  const double a2 = theta.squaredNorm();
-  if (!(a2 < 0.0025)) return rotation_of(theta);
-  const double sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
-  const double versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
-  Eigen::Matrix3d R = versine * theta * theta.transpose();
-  R.diagonal().array() += 1 - versine * a2;
-  const Eigen::Vector3d s = sine * theta;
-  R(0, 1) -= s.z(), R(1, 0) += s.z();
-  R(0, 2) += s.y(), R(2, 0) -= s.y();
-  R(1, 2) -= s.x(), R(2, 1) += s.x();
-  return R;
+// its factors from their series (to a^8: the next term is below 3e-21) for a turn of a2 =
+// |theta|^2 below 0.0025 (0.05 rad), as far as a joint of the chain turns in an ordinary wind;
+// R column-major. hsm.particles "samples" takes it: its clusters' fixed costs are its step's,
+// and the library's sine, cosine and matrix were some 4 % of them; "vertices" keeps the
+// paper's set-up byte for byte. T: a double, or four in lanes (turn_joints_quickly).
+template <typename T>
+inline void series_rotation(const T& tx, const T& ty, const T& tz, const T& a2, T (&R)[9]) {
+  const T sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
+  const T versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
+  const T vx = versine * tx, vy = versine * ty, vz = versine * tz, diagonal = 1 - versine * a2;
+  const T sx = sine * tx, sy = sine * ty, sz = sine * tz;
+  R[0] = vx * tx + diagonal, R[1] = vy * tx + sz, R[2] = vz * tx - sy;
+  R[3] = vx * ty - sz, R[4] = vy * ty + diagonal, R[5] = vz * ty + sx;
+  R[6] = vx * tz + sy, R[7] = vy * tz - sx, R[8] = vz * tz + diagonal;
 }
 
 // A joint's turn => the same turn, at most `largest` long (its yield turn).
@@ -71,29 +70,12 @@ bool unresolved_points(const AirSample& air, Eigen::Vector3d (&point)[6]) {
 // included); each point changes that air and so |u| u, quadratically. A load that swings
 // within the step past the yield turn and across it bends the joint less than its mean
 // would; below yield the mean keeps the quadratic drag's second-order rise.
-// With `linear` (hsm.particles "samples", whose clusters' fixed costs are its step's) and
-// `spread` the farthest point from the air, a joint that no point can turn to its yield takes
-// the mean of the uncapped turns, theta + reach x (mean |a| a - g), in one cross product: the
-// same turn but for round-off, since ||a| a - |u| u| <= (|a| + |u|) |a - u| bounds each point's.
 Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vector3d& load, double area,
-                                  const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double spread,
-                                  double largest, bool linear) {
+                                  const Eigen::Vector3d& reach, const Eigen::Vector3d (&point)[6], double largest) {
   if (!(area > 0)) return capped_turn(theta, largest);
   const Eigen::Vector3d g = load / area;
   const double size = std::sqrt(g.norm());
   const Eigen::Vector3d u = size > 0 ? Eigen::Vector3d(g / size) : Eigen::Vector3d::Zero();
-  if (linear) {
-    Eigen::Vector3d drag = Eigen::Vector3d::Zero();
-    double fastest = 0;
-    for (const Eigen::Vector3d& d : point) {
-      const Eigen::Vector3d air = u + d;
-      const double speed = air.norm();
-      drag += speed * air;
-      fastest = std::max(fastest, speed);
-    }
-    if (theta.norm() + reach.norm() * (fastest + size) * spread <= largest)
-      return theta + reach.cross(drag / 6 - g);
-  }
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& d : point) {
     const Eigen::Vector3d air = u + d;
@@ -250,6 +232,117 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
   });
 }
 
+// What a lane of turn_joints_quickly leaves to the joint's full path.
+constexpr uint8_t kQuickTurn = 0, kFullMean = 1, kFullRotation = 2;
+
+// Step 3 of walk_bar_chain for hsm.particles "samples", whose clusters' fixed costs are its
+// step's: with `point` the unscented points (nullptr: nothing averaged) and `spread` the
+// farthest of them from the air, each joint that no point can turn to its yield takes the mean
+// of its uncapped turns, theta + reach x (mean |a| a - g), in one cross product: the same turn
+// as mean_yielded_turn's but for round-off, since ||a| a - |u| u| <= (|a| + |u|) |a - u|
+// bounds each point's. Its matrix comes from series_rotation below 0.05 rad. Four joints
+// run at once, a lane each (lanes.h), every lane computing both cases of each choice; the
+// joints a point could yield (mean_yielded_turn) and those turned 0.05 rad or more
+// (rotation_of) are then taken one by one.
+template <typename Real>
+void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>& attachment, StepScratch<Real>& scratch,
+                         const Eigen::Vector3d (*point)[6], double spread) {
+  constexpr size_t kBatch = 64;
+  const size_t C = model.C, batches = (C + kBatch - 1) / kBatch;
+  const double *compliance = model.chain.cluster_compliance.data(), *max_turn = model.chain.cluster_max_turn.data();
+  const double *area = attachment.cluster_drag_area.data(), *arm = attachment.cluster_drag_arm.data();
+  const double *moment = scratch.cluster_moment.data(), *load = scratch.cluster_load.data();
+  const double* damping_moment = scratch.cluster_damping_moment.data();
+  double *path = scratch.cluster_damping_path.data(), *rotation = scratch.cluster_static_rotation.data();
+  const Mask4 averaged = Mask4{} + (point != nullptr ? -1 : 0);
+  double d[6][3] = {};
+  for (int k = 0; point && k < 6; ++k)
+    for (int i = 0; i < 3; ++i) d[k][i] = (*point)[k][i];
+#pragma omp for schedule(static)
+  for (size_t b = 0; b < batches; ++b) {
+    const size_t first = b * kBatch, n = std::min(kBatch, C - first);
+    uint8_t full[kBatch];
+    double turn[3][kBatch];
+    with_kernel_isa([&] {
+      for (size_t k = 0; k < n; k += 4) {
+        // Lanes past the last joint repeat it; their results are not stored.
+        const size_t lanes = std::min<size_t>(4, n - k);
+        auto at = [&](const double* values, size_t stride, size_t offset, Double4& v) {
+          for (size_t i = 0; i < 4; ++i) v[i] = values[stride * (first + k + std::min(i, lanes - 1)) + offset];
+        };
+        Double4 j, largest, m[3], drag_area, g[3], r[3], damping[3];
+        at(compliance, 1, 0, j), at(max_turn, 1, 0, largest), at(area, 1, 0, drag_area);
+        for (size_t i = 0; i < 3; ++i) {
+          at(moment, 3, i, m[i]), at(load, 3, i, g[i]), at(arm, 3, i, r[i]), at(damping_moment, 3, i, damping[i]);
+        }
+        const Double4 zero = {}, one = zero + 1;
+        const Double4 lx = j * m[0], ly = j * m[1], lz = j * m[2];
+        Double4 angle = (lx * lx + ly * ly) + lz * lz;
+        sqrt_lanes(angle);
+        // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
+        // for a moment across its turn (none along it): a yielded joint does not move back.
+        const Double4 give = angle > largest ? largest / angle : one;
+        // Without a drag area or unresolved air, the capped turn (capped_turn).
+        const Mask4 mean = averaged & (drag_area > zero);
+        const Double4 gx = g[0] / drag_area, gy = g[1] / drag_area, gz = g[2] / drag_area;
+        Double4 size = (gx * gx + gy * gy) + gz * gz;
+        sqrt_lanes(size);
+        sqrt_lanes(size);
+        const Double4 ux = size > zero ? gx / size : zero, uy = size > zero ? gy / size : zero,
+                      uz = size > zero ? gz / size : zero;
+        Double4 fx = zero, fy = zero, fz = zero, fastest = zero;
+        for (int p = 0; p < 6; ++p) {
+          const Double4 ax = ux + d[p][0], ay = uy + d[p][1], az = uz + d[p][2];
+          Double4 speed = (ax * ax + ay * ay) + az * az;
+          sqrt_lanes(speed);
+          fx += speed * ax, fy += speed * ay, fz += speed * az;
+          fastest = fastest < speed ? speed : fastest;  // std::max
+        }
+        const Double4 rx = j * r[0], ry = j * r[1], rz = j * r[2];
+        const Double4 wx = fx / 6 - gx, wy = fy / 6 - gy, wz = fz / 6 - gz;
+        const Double4 tx = mean ? lx + (ry * wz - rz * wy) : lx * give;
+        const Double4 ty = mean ? ly + (rz * wx - rx * wz) : ly * give;
+        const Double4 tz = mean ? lz + (rx * wy - ry * wx) : lz * give;
+        Double4 reach = (rx * rx + ry * ry) + rz * rz;
+        sqrt_lanes(reach);
+        const Mask4 yields = mean & ~(angle + reach * (fastest + size) * spread <= largest);
+        const Double4 a2 = (tx * tx + ty * ty) + tz * tz;
+        const Mask4 series = a2 < 0.0025;
+        const Double4 share = j * give;
+        const Double4 px = share * damping[0], py = share * damping[1], pz = share * damping[2];
+        Double4 R[9];
+        series_rotation(tx, ty, tz, a2, R);
+        for (size_t i = 0; i < lanes; ++i) {
+          const size_t c = first + k + i;
+          path[3 * c] = px[i], path[3 * c + 1] = py[i], path[3 * c + 2] = pz[i];
+          for (int m = 0; m < 9; ++m) rotation[9 * c + m] = R[m][i];
+          turn[0][k + i] = tx[i], turn[1][k + i] = ty[i], turn[2][k + i] = tz[i];
+          full[k + i] = yields[i] ? kFullMean : series[i] ? kQuickTurn : kFullRotation;
+        }
+      }
+    });
+    for (size_t k = 0; k < n; ++k) {
+      if (full[k] == kQuickTurn) continue;
+      const size_t c = first + k;
+      const double j = compliance[c];
+      Eigen::Vector3d theta;
+      if (full[k] == kFullMean) {
+        theta = mean_yielded_turn(j * scratch.cluster_moment.col(c), scratch.cluster_load.col(c), area[c],
+                                  j * attachment.cluster_drag_arm.col(c), *point, max_turn[c]);
+        double a2 = theta.squaredNorm(), R[9];
+        if (a2 < 0.0025) {
+          series_rotation(theta.x(), theta.y(), theta.z(), a2, R);
+          std::copy_n(R, 9, rotation + 9 * c);
+          continue;
+        }
+      } else {
+        theta = Eigen::Vector3d(turn[0][k], turn[1][k], turn[2][k]);
+      }
+      Eigen::Map<Eigen::Matrix3d>(rotation + 9 * c) = rotation_of(theta);
+    }
+  }
+}
+
 }  // namespace
 
 template <typename Real>
@@ -302,22 +395,22 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
   // parallel: the sines and cosines), and the turns accumulate from the root (the trunk, then
   // the limbs), as do the damping's sums over the joints from the root, C_j S_j and C_j S_j . (j_c - j_j)
   // (about the cluster's own joint: small numbers wherever the tree stands).
+  if (model.quick_chain) {
+    turn_joints_quickly(model, attachment, scratch, averaged ? &unresolved : nullptr, spread);
+  } else {
 #pragma omp for schedule(static)
-  for (size_t c = 0; c < C; ++c) {
-    const double compliance = model.chain.cluster_compliance[c];
-    const Eigen::Vector3d loaded = compliance * scratch.cluster_moment.col(c);
-    const double angle = loaded.norm(), largest = model.chain.cluster_max_turn[c];
-    // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
-    // for a moment across its turn (none along it): a yielded joint does not move back.
-    const double give = angle > largest ? largest / angle : 1.0;
-    const Eigen::Vector3d theta =
-        averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), attachment.cluster_drag_area[c],
-                                     compliance * attachment.cluster_drag_arm.col(c), unresolved, spread, largest,
-                                     model.quick_chain)
-                 : capped_turn(loaded, largest);
-    scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
-    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) =
-        model.quick_chain ? small_rotation_of(theta) : rotation_of(theta);
+    for (size_t c = 0; c < C; ++c) {
+      const double compliance = model.chain.cluster_compliance[c];
+      const Eigen::Vector3d loaded = compliance * scratch.cluster_moment.col(c);
+      const double angle = loaded.norm(), largest = model.chain.cluster_max_turn[c];
+      const double give = angle > largest ? largest / angle : 1.0;  // as turn_joints_quickly's
+      const Eigen::Vector3d theta =
+          averaged ? mean_yielded_turn(loaded, scratch.cluster_load.col(c), attachment.cluster_drag_area[c],
+                                       compliance * attachment.cluster_drag_arm.col(c), unresolved, largest)
+                   : capped_turn(loaded, largest);
+      scratch.cluster_damping_path.col(c) = (compliance * give) * scratch.cluster_damping_moment.col(c);
+      Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_static_rotation(0, c)) = rotation_of(theta);
+    }
   }
   // The trunk on one thread, then the limbs below it in parallel.
   auto carry_down = [&](uint32_t c) {

@@ -2,6 +2,10 @@
 // Short vectors of GCC's vector extension (Clang has it too) for sums that must stay in
 // order: each lane runs the scalar IEEE operation it replaces, so several independent sums
 // share one register with their values unchanged (docs/solver.md, "Instruction sets").
+// Functions take and give them by reference: passed by value, a 32-byte vector's calling
+// convention would depend on the instruction set.
+#include <cmath>
+
 namespace treeanim {
 
 // Four lanes of Real.
@@ -15,5 +19,15 @@ template <>
 struct Lanes4<double> {
   using type = double __attribute__((vector_size(32)));
 };
+
+// Four doubles, e.g. one value of four clusters; a comparison of two gives a Mask4, each lane
+// all ones (true) or zero.
+using Double4 = Lanes4<double>::type;
+using Mask4 = decltype(Double4{} < Double4{});
+
+// Four square roots, each the scalar one.
+inline void sqrt_lanes(Double4& x) {
+  for (int i = 0; i < 4; ++i) x[i] = std::sqrt(x[i]);
+}
 
 }  // namespace treeanim

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "sim/kernel_isa.h"
+
 namespace treeanim {
 
 namespace {
@@ -80,6 +82,80 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
     }
   }
   return iteration;
+}
+
+void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iterations, double newton_stop) {
+  // extract_rotation's arithmetic, written out as the library computes it (the quaternion's
+  // matrix, product and norm), in every lane at once; a lane that extract_rotation would have
+  // left stays as it is.
+  with_kernel_isa([&] {
+    constexpr double kEps = 1e-9;
+    constexpr double kMaxStep = 1.0;
+    const Double4 zero = {};
+    Mask4 active = zero == zero;
+    for (int iteration = 0; iteration < max_iterations; ++iteration) {
+      if ((active[0] | active[1] | active[2] | active[3]) == 0) break;
+      const Double4 &x = q[0], &y = q[1], &z = q[2], &w = q[3];
+      const Double4 tx = 2 * x, ty = 2 * y, tz = 2 * z;
+      const Double4 twx = tx * w, twy = ty * w, twz = tz * w, txx = tx * x, txy = ty * x, txz = tz * x;
+      const Double4 tyy = ty * y, tyz = tz * y, tzz = tz * z;
+      const Double4 R[9] = {1 - (tyy + tzz), txy + twz, txz - twy, txy - twz, 1 - (txx + tzz),
+                            tyz + twx,       txz + twy, tyz - twx, 1 - (txx + tyy)};  // column-major
+      Double4 torque[3] = {zero, zero, zero}, trace = zero;
+      for (int i = 0; i < 3; ++i) {
+        const Double4 *r = R + 3 * i, *a = A + 3 * i;
+        const Double4 cross[3] = {r[1] * a[2] - r[2] * a[1], r[2] * a[0] - r[0] * a[2], r[0] * a[1] - r[1] * a[0]};
+        const Double4 dot = (r[0] * a[0] + r[1] * a[1]) + r[2] * a[2];
+        for (int k = 0; k < 3; ++k) torque[k] = i == 0 ? cross[k] : torque[k] + cross[k];
+        trace = i == 0 ? dot : trace + dot;
+      }
+      const Double4 scale = (trace < zero ? -trace : trace) + kEps;
+      active &= (torque[0] * torque[0] + torque[1] * torque[1]) + torque[2] * torque[2] > 1e-30 * scale * scale;
+      // A R^T, column-major; the library sums the first two rows' terms in order, its last row's
+      // last two first (two rows a vector, the third alone).
+      Double4 M[9];
+      for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 2; ++i) M[i + 3 * j] = (A[i] * R[j] + A[i + 3] * R[j + 3]) + A[i + 6] * R[j + 6];
+        M[2 + 3 * j] = A[2] * R[j] + (A[5] * R[j + 3] + A[8] * R[j + 6]);
+      }
+      const Double4 diagonal = trace * (1 + kEps);
+      const Double4 h00 = diagonal - M[0], h11 = diagonal - M[4], h22 = diagonal - M[8];
+      const Double4 h01 = -0.5 * (M[3] + M[1]), h02 = -0.5 * (M[6] + M[2]), h12 = -0.5 * (M[7] + M[5]);
+      const Double4 c00 = h11 * h22 - h12 * h12, c01 = h02 * h12 - h01 * h22, c02 = h01 * h12 - h02 * h11;
+      const Double4 c11 = h00 * h22 - h02 * h02, c12 = h01 * h02 - h00 * h12, c22 = h00 * h11 - h01 * h01;
+      const Double4 det = (h00 * c00 + h01 * c01) + h02 * c02;
+      const Mask4 newton = (trace > zero) & (h00 > zero) & (c22 > zero) & (det > zero);
+      const Double4 inv_det = 1 / det, inv_scale = 1.0 / scale;
+      Double4 omega[3] = {((c00 * torque[0] + c01 * torque[1]) + c02 * torque[2]) * inv_det,
+                          ((c01 * torque[0] + c11 * torque[1]) + c12 * torque[2]) * inv_det,
+                          ((c02 * torque[0] + c12 * torque[1]) + c22 * torque[2]) * inv_det};
+      for (int k = 0; k < 3; ++k) omega[k] = newton ? omega[k] : torque[k] * inv_scale;
+      Double4 angle = (omega[0] * omega[0] + omega[1] * omega[1]) + omega[2] * omega[2];
+      sqrt_lanes(angle);
+      active &= angle - angle == zero;  // finite
+      const Mask4 capped = angle > kMaxStep;
+      const Double4 cap = kMaxStep / angle;
+      for (int k = 0; k < 3; ++k) omega[k] = capped ? omega[k] * cap : omega[k];
+      angle = capped ? zero + kMaxStep : angle;
+      // increment(omega, angle) * q
+      const Double4 a2 = angle * angle;
+      const Double4 half_sinc = 0.5 - a2 * (1.0 / 48) + a2 * a2 * (1.0 / 3840);
+      Double4 ix = half_sinc * omega[0], iy = half_sinc * omega[1], iz = half_sinc * omega[2];
+      Double4 iw = 1 - a2 * (1.0 / 8) + a2 * a2 * (1.0 / 384);
+      for (int l = 0; l < 4; ++l) {
+        if (!(active[l] && angle[l] >= 1e-2)) continue;
+        const Eigen::Quaterniond big = increment(Eigen::Vector3d(omega[0][l], omega[1][l], omega[2][l]), angle[l]);
+        ix[l] = big.x(), iy[l] = big.y(), iz[l] = big.z(), iw[l] = big.w();
+      }
+      Double4 p[4] = {(iw * x + iy * z) - (iz * y - ix * w), (iw * y + iy * w) + (iz * x - ix * z),
+                      (iw * z - iy * x) + (iz * w + ix * y), (iw * w - iy * y) - (iz * z + ix * x)};
+      Double4 norm = (p[0] * p[0] + p[2] * p[2]) + (p[1] * p[1] + p[3] * p[3]);
+      const Mask4 positive = norm > zero;
+      sqrt_lanes(norm);
+      for (int k = 0; k < 4; ++k) q[k] = active ? (positive ? p[k] / norm : p[k]) : q[k];
+      active &= ~((angle < kEps) | (newton & (angle < newton_stop)));
+    }
+  });
 }
 
 }  // namespace treeanim

@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "sim/lanes.h"
+
 namespace treeanim {
 
 // Where the Newton iterations stop (docs/solver.md, "Rotation"): after a step below 1e-6 rad,
@@ -28,5 +30,10 @@ constexpr double kNewtonStopSamples = 1e-2;
 // so nothing jitters. Returns the iterations used.
 int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations,
                      double newton_stop = kNewtonStopRoundOff);
+
+// The same for four matrices and warm starts at once, lane l of A (column-major) and q (x, y,
+// z, w) one cluster's: each q comes out as extract_rotation would give it, to the bit.
+void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iterations,
+                       double newton_stop = kNewtonStopRoundOff);
 
 }  // namespace treeanim

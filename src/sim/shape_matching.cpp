@@ -17,10 +17,15 @@
 
 namespace treeanim {
 
+namespace {
+
+// Cluster c's rest data + predicted displacements u_p (V x 3); pinned_point: the displacement
+// from rest of the match point o where that point is held (an attached leaf), nullptr where o
+// is the centre and follows the members => A, its A_pq about o, normalised, whose rotation
+// (extract_rotation) is the fit's, and w, the displacement of o.
 template <typename Real>
-bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
-                 const Eigen::Vector3d* pinned_point, int max_iterations, double newton_stop,
-                 Eigen::Quaterniond& rotation, Eigen::Matrix3d& R, Eigen::Vector3d& shift) {
+void fit_matrix(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
+                const Eigen::Vector3d* pinned_point, Eigen::Matrix3d& A, Eigen::Vector3d& point_shift) {
   const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
   // numbers wherever the tree stands and however far it travelled. With the rest terms
@@ -53,19 +58,15 @@ bool fit_cluster(const TreeModel& tree, const Attachment<Real>& a, const Rows3<R
   const Real a20 = row_z[0], a21 = row_z[1], a22 = row_z[2];
   const Eigen::Vector3d centre_shift(row_x[3], row_y[3], row_z[3]);
   const Eigen::Vector3d point = a.cluster_match_point.col(c);
-  const Eigen::Vector3d point_shift = pinned_point ? *pinned_point : centre_shift;
-  Eigen::Matrix3d A;
+  point_shift = pinned_point ? *pinned_point : centre_shift;
   A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
   A -= centre_shift * point.transpose();  // 0 about the centre
   A *= a.cluster_match_scale[c];
   A += Eigen::Map<const Eigen::Matrix3d>(&a.cluster_rest_moment(0, c));
   A -= point_shift * a.cluster_offset_sum.col(c).transpose();
-  extract_rotation(A, rotation, max_iterations, newton_stop);
-  R = rotation.toRotationMatrix();
-  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
-  shift = point_shift - (R * point - point);
-  return R.allFinite() && shift.allFinite();
 }
+
+}  // namespace
 
 template <typename Real>
 void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a, const Rows3<Real>& predicted_offset,
@@ -116,36 +117,63 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
 }
 
 template <typename Real>
-bool match_cluster(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                   StepScratch<Real>& scratch, size_t c, const Eigen::Vector3d* pinned_point) {
+uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
+                        StepScratch<Real>& scratch, std::span<const uint32_t> clusters, bool pinned) {
   const Rows3<Real>& predicted_offset = state.prediction<Real>().offset;
-  Eigen::Quaterniond rotation(state.cluster_rotations.col(c));
-  Eigen::Matrix3d R;
-  Eigen::Vector3d shift;
-  const bool finite = fit_cluster(model.tree, attachment, predicted_offset, c, pinned_point,
-                                  model.options.rotation_iterations, model.rotation_newton_stop, rotation, R, shift);
-  state.cluster_rotations.col(c) = rotation.coeffs();
-  state.cluster_shift.col(c) = shift;
-  Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
-  if (finite) write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
-  return finite;
+  const size_t n = clusters.size();
+  Eigen::Matrix3d A[kMatchLanes];
+  Eigen::Vector3d point_shift[kMatchLanes], held[kMatchLanes];
+  for (size_t l = 0; l < n; ++l) {
+    if (pinned) held[l] = held_point(model, attachment, state, scratch, clusters[l]);
+    fit_matrix(model.tree, attachment, predicted_offset, clusters[l], pinned ? &held[l] : nullptr, A[l],
+               point_shift[l]);
+  }
+  // Lanes without a cluster repeat the first; what they find is not kept.
+  Double4 a[9], q[4];
+  for (size_t l = 0; l < kMatchLanes; ++l) {
+    const size_t from = l < n ? l : 0;
+    for (int i = 0; i < 9; ++i) a[i][l] = A[from](i);
+    for (int k = 0; k < 4; ++k) q[k][l] = state.cluster_rotations(k, clusters[from]);
+  }
+  extract_rotations(a, q, model.options.rotation_iterations, model.rotation_newton_stop);
+  uint32_t bad = kNone;
+  for (size_t l = 0; l < n; ++l) {
+    const uint32_t c = clusters[l];
+    const Eigen::Quaterniond rotation(q[3][l], q[0][l], q[1][l], q[2][l]);
+    const Eigen::Matrix3d R = rotation.toRotationMatrix();
+    const Eigen::Vector3d point = attachment.cluster_match_point.col(c);
+    // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
+    const Eigen::Vector3d shift = point_shift[l] - (R * point - point);
+    state.cluster_rotations.col(c) = rotation.coeffs();
+    state.cluster_shift.col(c) = shift;
+    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
+    if (R.allFinite() && shift.allFinite())
+      write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
+    else
+      bad = std::min(bad, c);
+  }
+  return bad;
 }
 
 template <typename Real>
 uint32_t match_listed_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                                StepScratch<Real>& scratch, std::span<const uint32_t> clusters) {
-  uint32_t bad = kNone;
+  MatchLanes<Real> branches(model, attachment, state, scratch, false, true);
+  MatchLanes<Real> leaves(model, attachment, state, scratch, true, true);
   with_kernel_isa([&] {
     for (const uint32_t c : clusters) {
       if (!cluster_awake(model, attachment, state, c)) continue;
-      const bool fitted = attachment.cluster_pin_slot[c] == kNone
-                              ? match_cluster(model, attachment, state, scratch, c, nullptr)
-                              : match_attached_leaf(model, attachment, state, scratch, c);
-      if (!fitted) bad = std::min(bad, c);
-      sample_cluster_air(model, attachment, state, scratch, c);
+      if (attachment.cluster_pin_slot[c] == kNone) {
+        branches.add(c);
+      } else {
+        branches.flush();  // a leaf's branch is listed before it
+        leaves.add(c);
+      }
     }
+    branches.flush();
+    leaves.flush();
   });
-  return bad;
+  return std::min(branches.bad(), leaves.bad());
 }
 
 // Branches and free leaves first, then the attached leaves, whose translation is pinned to
@@ -162,14 +190,18 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
     const std::pair<size_t, size_t> range =
         balanced_range(model.match_work_offsets, omp_get_thread_num(), omp_get_num_threads());
     const size_t first = range.first, last = range.second;
+    MatchLanes<Real> branches(model, attachment, state, scratch, false, true);
     with_kernel_isa([&] {
       for (size_t c = first; c < last; ++c) {
         if (!cluster_awake(model, attachment, state, c)) continue;
-        if (attachment.cluster_pin_slot[c] == kNone && !match_cluster(model, attachment, state, scratch, c, nullptr))
-          bad = std::min(bad, static_cast<uint32_t>(c));
-        sample_cluster_air(model, attachment, state, scratch, c);
+        if (attachment.cluster_pin_slot[c] == kNone)
+          branches.add(static_cast<uint32_t>(c));
+        else
+          sample_cluster_air(model, attachment, state, scratch, c);  // the leaf is matched after its branch
       }
+      branches.flush();
     });
+    bad = std::min(bad, branches.bad());
     if (!model.pinned_leaf_clusters.empty()) {
 #pragma omp barrier
       match_attached_leaves(model, attachment, state, scratch, bad);
@@ -184,13 +216,10 @@ void throw_match_failure(long long frame, int substep, uint32_t cluster) {
 }
 
 #define TREEANIM_SHAPE_MATCHING(Real)                                                                              \
-  template bool fit_cluster(const TreeModel&, const Attachment<Real>&, const Rows3<Real>&, size_t,                 \
-                            const Eigen::Vector3d*, int, double, Eigen::Quaterniond&, Eigen::Matrix3d&,          \
-                            Eigen::Vector3d&);                                                                     \
   template void write_corrections(const SolverModel<Real>&, const Attachment<Real>&, const Rows3<Real>&, size_t,   \
                                   const Eigen::Matrix3d&, const Eigen::Vector3d&, Rows3<Real>&);                   \
-  template bool match_cluster(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,    \
-                              size_t, const Eigen::Vector3d*);                                                     \
+  template uint32_t match_in_lanes(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&, \
+                                   std::span<const uint32_t>, bool);                                               \
   template void match_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,   \
                                long long, int);                                                                    \
   template uint32_t match_listed_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&,            \

@@ -121,12 +121,6 @@ template <typename Real>
 void match_attached_leaves(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
                            StepScratch<Real>& scratch, uint32_t& bad);
 
-// Attached leaf c, once its branch is matched => its match about its shared vertex held at
-// the branch's goal; false when the fit is not finite.
-template <typename Real>
-bool match_attached_leaf(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
-                         StepScratch<Real>& scratch, uint32_t c);
-
 // --- cache_blocks.cpp ---
 // Where a step in blocks stands in its frame.
 struct BlockStep {

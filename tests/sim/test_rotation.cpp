@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "sim/rotation.h"
@@ -169,6 +171,55 @@ TEST(Rotation, ZeroMatrixKeepsWarmStart) {
   const Eigen::Quaterniond before = q;
   EXPECT_EQ(extract_rotation(Eigen::Matrix3d::Zero(), q, 10), 0);
   EXPECT_EQ(q.coeffs(), before.coeffs());
+}
+
+// The solver finds its clusters' rotations four at a time: each lane must give the bits the
+// scalar extraction gives, whatever the matrix (stretched, flattened, collinear, not finite),
+// the warm start (near, far, cold), the iteration limit and the tolerance, since golden bakes
+// were made with the scalar one and a bake's bytes may not depend on its neighbours.
+TEST(Rotation, FourLanesGiveTheScalarBitsWhateverTheirNeighbours) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> n;
+  std::uniform_real_distribution<double> u(0, 1);
+  int differing = 0, lanes = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int iterations = 1 + int(u(rng) * 12);
+    const double stop = u(rng) < 0.5 ? kNewtonStopSamples : kNewtonStopRoundOff;
+    Double4 A[9], q[4];
+    Eigen::Matrix3d scalar_A[4];
+    Eigen::Quaterniond scalar_q[4];
+    for (int l = 0; l < 4; ++l) {
+      const Eigen::Quaterniond truth = random_rotation(rng);
+      const double kind = u(rng);
+      Eigen::Matrix3d stretch = Eigen::Matrix3d::Identity();
+      for (int i = 0; i < 9; ++i) stretch(i) += n(rng) * (kind < 0.5 ? 0.03 : 0.3);
+      Eigen::Matrix3d M = truth.toRotationMatrix() * stretch;
+      if (kind > 0.9) M.col(2).setZero();  // planar
+      if (kind > 0.95) M = n(rng) * truth.toRotationMatrix() * Eigen::Vector3d(1, 0, 0).asDiagonal();  // collinear
+      if (kind > 0.99) M(1, 1) = std::numeric_limits<double>::quiet_NaN();
+      Eigen::Quaterniond warm = truth;
+      const double away = kind < 0.3 ? 1e-4 : kind < 0.6 ? 1e-2 : 1.0;
+      warm.coeffs() += away * Eigen::Vector4d(n(rng), n(rng), n(rng), n(rng));
+      warm.normalize();
+      if (u(rng) < 0.1) warm = Eigen::Quaterniond::Identity();
+      scalar_A[l] = M;
+      scalar_q[l] = warm;
+      for (int i = 0; i < 9; ++i) A[i][l] = M(i);
+      for (int k = 0; k < 4; ++k) q[k][l] = warm.coeffs()[k];
+    }
+    extract_rotations(A, q, iterations, stop);
+    for (int l = 0; l < 4; ++l, ++lanes) {
+      extract_rotation(scalar_A[l], scalar_q[l], iterations, stop);
+      for (int k = 0; k < 4; ++k) {
+        const double lane = q[k][l], scalar = scalar_q[l].coeffs()[k];
+        if (std::memcmp(&lane, &scalar, sizeof lane) != 0) {
+          ++differing;
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0) << "of " << lanes << " lanes";
 }
 
 }  // namespace
