@@ -95,12 +95,8 @@ void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iteration
     Mask4 active = zero == zero;
     for (int iteration = 0; iteration < max_iterations; ++iteration) {
       if ((active[0] | active[1] | active[2] | active[3]) == 0) break;
-      const Double4 &x = q[0], &y = q[1], &z = q[2], &w = q[3];
-      const Double4 tx = 2 * x, ty = 2 * y, tz = 2 * z;
-      const Double4 twx = tx * w, twy = ty * w, twz = tz * w, txx = tx * x, txy = ty * x, txz = tz * x;
-      const Double4 tyy = ty * y, tyz = tz * y, tzz = tz * z;
-      const Double4 R[9] = {1 - (tyy + tzz), txy + twz, txz - twy, txy - twz, 1 - (txx + tzz),
-                            tyz + twx,       txz + twy, tyz - twx, 1 - (txx + tyy)};  // column-major
+      Double4 R[9];
+      rotation_matrix(q, R);
       Double4 torque[3] = {zero, zero, zero}, trace = zero;
       for (int i = 0; i < 3; ++i) {
         const Double4 *r = R + 3 * i, *a = A + 3 * i;
@@ -147,6 +143,7 @@ void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iteration
         const Eigen::Quaterniond big = increment(Eigen::Vector3d(omega[0][l], omega[1][l], omega[2][l]), angle[l]);
         ix[l] = big.x(), iy[l] = big.y(), iz[l] = big.z(), iw[l] = big.w();
       }
+      const Double4 &x = q[0], &y = q[1], &z = q[2], &w = q[3];
       Double4 p[4] = {(iw * x + iy * z) - (iz * y - ix * w), (iw * y + iy * w) + (iz * x - ix * z),
                       (iw * z - iy * x) + (iz * w + ix * y), (iw * w - iy * y) - (iz * z + ix * x)};
       Double4 norm = (p[0] * p[0] + p[2] * p[2]) + (p[1] * p[1] + p[3] * p[3]);

@@ -31,6 +31,18 @@ constexpr double kNewtonStopSamples = 1e-2;
 int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations,
                      double newton_stop = kNewtonStopRoundOff);
 
+// Four unit quaternions (x, y, z, w), a lane each => their rotation matrices, column-major, as
+// the library's toRotationMatrix computes each.
+inline void rotation_matrix(const Double4 (&q)[4], Double4 (&R)[9]) {
+  const Double4 &x = q[0], &y = q[1], &z = q[2], &w = q[3];
+  const Double4 tx = 2 * x, ty = 2 * y, tz = 2 * z;
+  const Double4 twx = tx * w, twy = ty * w, twz = tz * w, txx = tx * x, txy = ty * x, txz = tz * x;
+  const Double4 tyy = ty * y, tyz = tz * y, tzz = tz * z;
+  R[0] = 1 - (tyy + tzz), R[1] = txy + twz, R[2] = txz - twy;
+  R[3] = txy - twz, R[4] = 1 - (txx + tzz), R[5] = tyz + twx;
+  R[6] = txz + twy, R[7] = tyz - twx, R[8] = 1 - (txx + tyy);
+}
+
 // The same for four matrices and warm starts at once, lane l of A (column-major) and q (x, y,
 // z, w) one cluster's: each q comes out as extract_rotation would give it, to the bit.
 void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iterations,

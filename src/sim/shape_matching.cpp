@@ -19,13 +19,11 @@ namespace treeanim {
 
 namespace {
 
-// Cluster c's rest data + predicted displacements u_p (V x 3); pinned_point: the displacement
-// from rest of the match point o where that point is held (an attached leaf), nullptr where o
-// is the centre and follows the members => A, its A_pq about o, normalised, whose rotation
-// (extract_rotation) is the fit's, and w, the displacement of o.
+// Cluster c's members + predicted displacements u_p (V x 3) => sums[3 i + j] = sum s u_i q_j and
+// sums[9 + i] = the centre shift sum (w / sum w) u_i, s = (w / sum w) k (match_in_lanes).
 template <typename Real>
-void fit_matrix(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
-                const Eigen::Vector3d* pinned_point, Eigen::Matrix3d& A, Eigen::Vector3d& point_shift) {
+void fit_sums(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Real>& predicted_offset, size_t c,
+              double (&sums)[12]) {
   const uint32_t begin = tree.cluster_offsets[c], end = tree.cluster_offsets[c + 1];
   // Cluster-local coordinates: d = p - t0 = u_p + q (x0 - t0 = q for a member), small
   // numbers wherever the tree stands and however far it travelled. With the rest terms
@@ -54,23 +52,18 @@ void fit_matrix(const TreeModel& tree, const Attachment<Real>& a, const Rows3<Re
     const Lanes w = Lanes{qx[s], qy[s], qz[s], 1} * share;
     row_x += x * w, row_y += y * w, row_z += z * w;
   }
-  const Real a00 = row_x[0], a01 = row_x[1], a02 = row_x[2], a10 = row_y[0], a11 = row_y[1], a12 = row_y[2];
-  const Real a20 = row_z[0], a21 = row_z[1], a22 = row_z[2];
-  const Eigen::Vector3d centre_shift(row_x[3], row_y[3], row_z[3]);
-  const Eigen::Vector3d point = a.cluster_match_point.col(c);
-  point_shift = pinned_point ? *pinned_point : centre_shift;
-  A << double(a00), double(a01), double(a02), double(a10), double(a11), double(a12), double(a20), double(a21), double(a22);
-  A -= centre_shift * point.transpose();  // 0 about the centre
-  A *= a.cluster_match_scale[c];
-  A += Eigen::Map<const Eigen::Matrix3d>(&a.cluster_rest_moment(0, c));
-  A -= point_shift * a.cluster_offset_sum.col(c).transpose();
+  for (int j = 0; j < 4; ++j) {
+    sums[j < 3 ? j : 9] = double(row_x[j]);
+    sums[j < 3 ? 3 + j : 10] = double(row_y[j]);
+    sums[j < 3 ? 6 + j : 11] = double(row_z[j]);
+  }
 }
 
 }  // namespace
 
 template <typename Real>
 void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a, const Rows3<Real>& predicted_offset,
-                       size_t c, const Eigen::Matrix3d& R, const Eigen::Vector3d& shift, Rows3<Real>& corrections) {
+                       size_t c, const double (&R)[9], const double (&shift)[3], Rows3<Real>& corrections) {
   const TreeModel& tree = model.tree;
   const Real alpha = static_cast<Real>(model.cluster_alpha[c]);
   const uint32_t* members = tree.cluster_members.data();
@@ -79,10 +72,9 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
   const Real *ux = predicted_offset.col(0).data(), *uy = predicted_offset.col(1).data(),
              *uz = predicted_offset.col(2).data();
   Real *cx = corrections.col(0).data(), *cy = corrections.col(1).data(), *cz = corrections.col(2).data();
-  const Eigen::Matrix<Real, 3, 3> r = R.template cast<Real>();
-  const Eigen::Matrix<Real, 3, 1> t = shift.template cast<Real>();
-  const Real r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2);
-  const Real r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
+  const Real r00 = Real(R[0]), r01 = Real(R[3]), r02 = Real(R[6]), r10 = Real(R[1]), r11 = Real(R[4]), r12 = Real(R[7]);
+  const Real r20 = Real(R[2]), r21 = Real(R[5]), r22 = Real(R[8]);
+  const Real tx = Real(shift[0]), ty = Real(shift[1]), tz = Real(shift[2]);
   // A run of memberships whose rows are consecutive is one loop; where the rows are the member
   // vertices' own (a free vertex in this cluster alone), their u is read in order too. Only a
   // cluster with released memberships reads their flags (Attachment::cluster_released).
@@ -121,34 +113,53 @@ uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& 
                         StepScratch<Real>& scratch, std::span<const uint32_t> clusters, bool pinned) {
   const Rows3<Real>& predicted_offset = state.prediction<Real>().offset;
   const size_t n = clusters.size();
-  Eigen::Matrix3d A[kMatchLanes];
-  Eigen::Vector3d point_shift[kMatchLanes], held[kMatchLanes];
+  double sums[kMatchLanes][12];
+  Eigen::Vector3d held[kMatchLanes];
   for (size_t l = 0; l < n; ++l) {
     if (pinned) held[l] = held_point(model, attachment, state, scratch, clusters[l]);
-    fit_matrix(model.tree, attachment, predicted_offset, clusters[l], pinned ? &held[l] : nullptr, A[l],
-               point_shift[l]);
+    fit_sums(model.tree, attachment, predicted_offset, clusters[l], sums[l]);
   }
-  // Lanes without a cluster repeat the first; what they find is not kept.
-  Double4 a[9], q[4];
+  // Each lane a cluster; lanes without one repeat the first, and what they find is not kept.
+  // About the match point o, displaced by w (the centre shift, or the pin):
+  // A_pq = (sum s u_p q^T - shift o^T) k + sum s (q - o)(q - o)^T - w (sum s (q - o))^T,
+  // each entry in this order (0 about the centre: the shift leaves out the residue of sum s q).
+  Double4 A[9], q[4], point[3], moved[3];
   for (size_t l = 0; l < kMatchLanes; ++l) {
-    const size_t from = l < n ? l : 0;
-    for (int i = 0; i < 9; ++i) a[i][l] = A[from](i);
-    for (int k = 0; k < 4; ++k) q[k][l] = state.cluster_rotations(k, clusters[from]);
+    const size_t from = l < n ? l : 0, c = clusters[from];
+    const double* sum = sums[from];
+    const double* o = &attachment.cluster_match_point(0, c);
+    const double* w = pinned ? held[from].data() : sum + 9;
+    const double* rest = &attachment.cluster_rest_moment(0, c);
+    const double* offset_sum = &attachment.cluster_offset_sum(0, c);
+    const double k = attachment.cluster_match_scale[c];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) A[i + 3 * j][l] = (((sum[3 * i + j] - sum[9 + i] * o[j]) * k) + rest[i + 3 * j]) - w[i] * offset_sum[j];
+    for (int i = 0; i < 3; ++i) point[i][l] = o[i], moved[i][l] = w[i];
+    for (int i = 0; i < 4; ++i) q[i][l] = state.cluster_rotations(i, c);
   }
-  extract_rotations(a, q, model.options.rotation_iterations, model.rotation_newton_stop);
+  extract_rotations(A, q, model.options.rotation_iterations, model.rotation_newton_stop);
+  Double4 R[9];
+  rotation_matrix(q, R);
+  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre);
+  // R o summed as the library sums a 3 x 3 matrix times a vector.
+  const Double4 turned[3] = {(R[0] * point[0] + R[3] * point[1]) + R[6] * point[2],
+                             (R[1] * point[0] + R[4] * point[1]) + R[7] * point[2],
+                             R[2] * point[0] + (R[5] * point[1] + R[8] * point[2])};
+  Double4 shift[3], check = {};
+  for (int i = 0; i < 3; ++i) {
+    shift[i] = moved[i] - (turned[i] - point[i]);
+    check += shift[i] - shift[i];
+  }
+  for (int i = 0; i < 9; ++i) check += R[i] - R[i];
   uint32_t bad = kNone;
   for (size_t l = 0; l < n; ++l) {
     const uint32_t c = clusters[l];
-    const Eigen::Quaterniond rotation(q[3][l], q[0][l], q[1][l], q[2][l]);
-    const Eigen::Matrix3d R = rotation.toRotationMatrix();
-    const Eigen::Vector3d point = attachment.cluster_match_point.col(c);
-    // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
-    const Eigen::Vector3d shift = point_shift[l] - (R * point - point);
-    state.cluster_rotations.col(c) = rotation.coeffs();
-    state.cluster_shift.col(c) = shift;
-    Eigen::Map<Eigen::Matrix3d>(&scratch.cluster_rotation_matrix(0, c)) = R;
-    if (R.allFinite() && shift.allFinite())
-      write_corrections(model, attachment, predicted_offset, c, R, shift, scratch.member_correction);
+    double r[9], t[3];
+    for (int i = 0; i < 9; ++i) r[i] = scratch.cluster_rotation_matrix(i, c) = R[i][l];
+    for (int i = 0; i < 3; ++i) t[i] = state.cluster_shift(i, c) = shift[i][l];
+    for (int i = 0; i < 4; ++i) state.cluster_rotations(i, c) = q[i][l];
+    if (check[l] == 0)  // R and the shift finite
+      write_corrections(model, attachment, predicted_offset, c, r, t, scratch.member_correction);
     else
       bad = std::min(bad, c);
   }
@@ -217,7 +228,7 @@ void throw_match_failure(long long frame, int substep, uint32_t cluster) {
 
 #define TREEANIM_SHAPE_MATCHING(Real)                                                                              \
   template void write_corrections(const SolverModel<Real>&, const Attachment<Real>&, const Rows3<Real>&, size_t,   \
-                                  const Eigen::Matrix3d&, const Eigen::Vector3d&, Rows3<Real>&);                   \
+                                  const double(&)[9], const double(&)[3], Rows3<Real>&);                           \
   template uint32_t match_in_lanes(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&, \
                                    std::span<const uint32_t>, bool);                                               \
   template void match_clusters(const SolverModel<Real>&, const Attachment<Real>&, SimState&, StepScratch<Real>&,   \

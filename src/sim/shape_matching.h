@@ -14,13 +14,13 @@ namespace treeanim {
 // Clusters matched at once: one a lane of Double4 (extract_rotations).
 constexpr size_t kMatchLanes = 4;
 
-// Goals g = R q + t of cluster c, with t given as t - t0 => per-membership corrections
-// alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p) in `corrections` (0 for a released
-// membership).
+// Goals g = R q + t of cluster c (R column-major), with t given as t - t0 => per-membership
+// corrections alpha_c (g - p) = alpha_c ((R q - q) + (t - t0) - u_p) in `corrections` (0 for
+// a released membership).
 template <typename Real>
 void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& attachment,
-                       const Rows3<Real>& predicted_offset, size_t c, const Eigen::Matrix3d& R,
-                       const Eigen::Vector3d& shift, Rows3<Real>& corrections);
+                       const Rows3<Real>& predicted_offset, size_t c, const double (&R)[9], const double (&shift)[3],
+                       Rows3<Real>& corrections);
 
 // Up to kMatchLanes awake clusters; `pinned`: attached leaves, each fitted about its shared
 // vertex held at its branch's goal (held_point), the branches matched already; else each about
