@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstring>
 #include <type_traits>
 
 #include "sim/kernel_isa.h"
@@ -133,10 +134,15 @@ inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Rea
   sum.lane[7][l] += ax * d, sum.lane[8][l] += ay * d, sum.lane[9][l] += az * d;
 }
 
-// Eight lanes => their sum in a fixed order, in double.
+// Eight lanes => their sum in a fixed order, ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)),
+// in double; the first four sums in one vector.
 template <typename Real>
 inline double sum_lanes(const Real (&lane)[kLoadLanes]) {
-  return double(((lane[0] + lane[4]) + (lane[2] + lane[6])) + ((lane[1] + lane[5]) + (lane[3] + lane[7])));
+  typename Lanes4<Real>::type low, high;
+  std::memcpy(&low, lane, sizeof low);
+  std::memcpy(&high, lane + 4, sizeof high);
+  const typename Lanes4<Real>::type pairs = low + high;
+  return double((pairs[0] + pairs[2]) + (pairs[1] + pairs[3]));
 }
 // The first four of them, the others +0: the same sum, since y + (+0) is y for every y but -0,
 // and no lane or partial sum is -0 (each lane starts at +0, and x + y is -0 only for two -0).
@@ -214,12 +220,14 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
       else
         add_loads(std::false_type{});
     }
-    scratch.cluster_load.col(c) = Eigen::Vector3d(sum_lanes(sum.lane[0]), sum_lanes(sum.lane[1]), sum_lanes(sum.lane[2]));
-    scratch.cluster_moment.col(c) =
-        Eigen::Vector3d(sum_lanes(sum.lane[3]), sum_lanes(sum.lane[4]), sum_lanes(sum.lane[5]));
+    double *load = &scratch.cluster_load(0, c), *moment = &scratch.cluster_moment(0, c);
+    double* damping_moment = &scratch.cluster_damping_moment(0, c);
+    for (int i = 0; i < 3; ++i) {
+      load[i] = sum_lanes(sum.lane[i]);
+      moment[i] = sum_lanes(sum.lane[3 + i]);
+      damping_moment[i] = sum_lanes(sum.lane[7 + i]);
+    }
     scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
-    scratch.cluster_damping_moment.col(c) =
-        Eigen::Vector3d(sum_lanes(sum.lane[7]), sum_lanes(sum.lane[8]), sum_lanes(sum.lane[9]));
   };
   with_kernel_isa([&] {
     for (size_t i = 0; i < n; ++i) {
@@ -376,13 +384,23 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
   for (const Eigen::Vector3d& d : unresolved) spread = averaged ? std::max(spread, d.norm()) : 0.0;
   // 2. Children before parents: a joint carries the moment of everything beyond it. The
   // limbs below the trunk in parallel, then the trunk (BarChain::walk_trunk).
+  // In plain doubles, each sum in the order the library's vector expressions took it.
+  const double* j = joint.data();
+  double *load = scratch.cluster_load.data(), *moment = scratch.cluster_moment.data();
+  double *damping = scratch.cluster_damping.data(), *damping_moment = scratch.cluster_damping_moment.data();
   auto carry_up = [&](uint32_t c) {
     const int32_t p = tree.cluster_parent[c];
     if (p < 0 || attachment.cluster_flying[c]) return;
-    scratch.cluster_load.col(p) += scratch.cluster_load.col(c);
-    scratch.cluster_moment.col(p) += scratch.cluster_moment.col(c) + (joint.col(c) - joint.col(p)).cross(scratch.cluster_load.col(c));
-    carry_moment(scratch.cluster_damping[c], scratch.cluster_damping_moment.col(c), joint.col(c) - joint.col(p),
-                 scratch.cluster_damping[p], scratch.cluster_damping_moment.col(p));
+    const double d[3] = {j[3 * c] - j[3 * p], j[3 * c + 1] - j[3 * p + 1], j[3 * c + 2] - j[3 * p + 2]};
+    const double* f = load + 3 * c;
+    const double arm[3] = {d[1] * f[2] - d[2] * f[1], d[2] * f[0] - d[0] * f[2], d[0] * f[1] - d[1] * f[0]};
+    for (int i = 0; i < 3; ++i) {
+      load[3 * p + i] += f[i];
+      moment[3 * p + i] += moment[3 * c + i] + arm[i];
+    }
+    // The damping and its moment, as carry_moment carries them.
+    damping[p] += damping[c];
+    for (int i = 0; i < 3; ++i) damping_moment[3 * p + i] += damping_moment[3 * c + i] + d[i] * damping[c];
   };
   const BarChain& chain = model.chain;
   const size_t groups = chain.walk_group_offsets.size() - 1;
@@ -413,22 +431,34 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
     }
   }
   // The trunk on one thread, then the limbs below it in parallel.
+  double *rotation = scratch.cluster_static_rotation.data(), *moved_joint = scratch.cluster_static_joint.data();
+  double *path = scratch.cluster_damping_path.data(), *lever = scratch.cluster_damping_lever.data();
   auto carry_down = [&](uint32_t c) {
     const int32_t p = tree.cluster_parent[c];
-    Eigen::Map<Eigen::Matrix3d> R(&scratch.cluster_static_rotation(0, c));
     if (p < 0 || attachment.cluster_flying[c]) {
-      scratch.cluster_static_joint.col(c) = joint.col(c);
-      scratch.cluster_damping_lever[c] = 0;
+      for (int i = 0; i < 3; ++i) moved_joint[3 * c + i] = j[3 * c + i];
+      lever[c] = 0;
       return;
     }
-    scratch.cluster_damping_path.col(c) += scratch.cluster_damping_path.col(p);
-    scratch.cluster_damping_lever[c] =
-        scratch.cluster_damping_lever[p] + scratch.cluster_damping_path.col(p).dot(joint.col(c) - joint.col(p));
-    const Eigen::Matrix3d turn = R;
-    const Eigen::Map<const Eigen::Matrix3d> parent(&scratch.cluster_static_rotation(0, p));
-    scratch.cluster_static_joint.col(c) =
-        scratch.cluster_static_joint.col(p) + parent * (joint.col(c) - joint.col(p));
-    R = turn * parent;
+    const double d[3] = {j[3 * c] - j[3 * p], j[3 * c + 1] - j[3 * p + 1], j[3 * c + 2] - j[3 * p + 2]};
+    for (int i = 0; i < 3; ++i) path[3 * c + i] += path[3 * p + i];
+    lever[c] = lever[p] + ((path[3 * p] * d[0] + path[3 * p + 1] * d[1]) + path[3 * p + 2] * d[2]);
+    // The library's 3 x 3 products sum a row's terms in order, but the last row's last two first.
+    const double* parent = rotation + 9 * p;
+    double* R = rotation + 9 * c;
+    for (int i = 0; i < 3; ++i) {
+      const double turned = i < 2 ? (parent[i] * d[0] + parent[i + 3] * d[1]) + parent[i + 6] * d[2]
+                                  : parent[i] * d[0] + (parent[i + 3] * d[1] + parent[i + 6] * d[2]);
+      moved_joint[3 * c + i] = moved_joint[3 * p + i] + turned;
+    }
+    double product[9];
+    for (int col = 0; col < 3; ++col)
+      for (int i = 0; i < 3; ++i) {
+        const double *row = R + i, *column = parent + 3 * col;
+        product[i + 3 * col] = i < 2 ? (row[0] * column[0] + row[3] * column[1]) + row[6] * column[2]
+                                     : row[0] * column[0] + (row[3] * column[1] + row[6] * column[2]);
+      }
+    std::copy_n(product, 9, R);
   };
 #pragma omp single
   for (uint32_t c : chain.walk_trunk) carry_down(c);
