@@ -276,7 +276,9 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         // Lanes past the last joint repeat it; their results are not stored.
         const size_t lanes = std::min<size_t>(4, n - k);
         auto at = [&](const double* values, size_t stride, size_t offset, Double4& v) {
-          for (size_t i = 0; i < 4; ++i) v[i] = values[stride * (first + k + std::min(i, lanes - 1)) + offset];
+          double lane[4];  // loaded as one vector: an element written into a vector goes through memory
+          for (size_t i = 0; i < 4; ++i) lane[i] = values[stride * (first + k + std::min(i, lanes - 1)) + offset];
+          std::memcpy(&v, lane, sizeof v);
         };
         Double4 j, largest, m[3], drag_area, g[3], r[3], damping[3];
         at(compliance, 1, 0, j), at(max_turn, 1, 0, largest), at(area, 1, 0, drag_area);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <string>
 #include <type_traits>
 
@@ -123,7 +124,9 @@ uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& 
   // About the match point o, displaced by w (the centre shift, or the pin):
   // A_pq = (sum s u_p q^T - shift o^T) k + sum s (q - o)(q - o)^T - w (sum s (q - o))^T,
   // each entry in this order (0 about the centre: the shift leaves out the residue of sum s q).
-  Double4 A[9], q[4], point[3], moved[3];
+  // Written lane by lane into plain arrays, then loaded as vectors: an element written into a
+  // vector goes through memory one at a time.
+  double a_lanes[9][kMatchLanes], q_lanes[4][kMatchLanes], point_lanes[3][kMatchLanes], moved_lanes[3][kMatchLanes];
   for (size_t l = 0; l < kMatchLanes; ++l) {
     const size_t from = l < n ? l : 0, c = clusters[from];
     const double* sum = sums[from];
@@ -133,10 +136,16 @@ uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& 
     const double* offset_sum = &attachment.cluster_offset_sum(0, c);
     const double k = attachment.cluster_match_scale[c];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) A[i + 3 * j][l] = (((sum[3 * i + j] - sum[9 + i] * o[j]) * k) + rest[i + 3 * j]) - w[i] * offset_sum[j];
-    for (int i = 0; i < 3; ++i) point[i][l] = o[i], moved[i][l] = w[i];
-    for (int i = 0; i < 4; ++i) q[i][l] = state.cluster_rotations(i, c);
+      for (int j = 0; j < 3; ++j)
+        a_lanes[i + 3 * j][l] = (((sum[3 * i + j] - sum[9 + i] * o[j]) * k) + rest[i + 3 * j]) - w[i] * offset_sum[j];
+    for (int i = 0; i < 3; ++i) point_lanes[i][l] = o[i], moved_lanes[i][l] = w[i];
+    for (int i = 0; i < 4; ++i) q_lanes[i][l] = state.cluster_rotations(i, c);
   }
+  Double4 A[9], q[4], point[3], moved[3];
+  std::memcpy(A, a_lanes, sizeof A);
+  std::memcpy(q, q_lanes, sizeof q);
+  std::memcpy(point, point_lanes, sizeof point);
+  std::memcpy(moved, moved_lanes, sizeof moved);
   extract_rotations(A, q, model.options.rotation_iterations, model.rotation_newton_stop);
   Double4 R[9];
   rotation_matrix(q, R);
