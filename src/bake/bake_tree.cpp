@@ -73,12 +73,16 @@ void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, lon
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
   if (frames.sampled && !plan.reads_mesh) {
-    // Nothing reads the mesh: no vertex is placed; the bounds are the samples'.
+    // Nothing reads the mesh: no vertex is placed; the bounds are the samples', extended one
+    // by one as AlignedBox::extend does (std::min and std::max per axis), in plain doubles.
+    Eigen::Vector3d low = frames.bounds.min(), high = frames.bounds.max();
     for (long s = 0; s < start.state.positions.cols(); ++s) {
       const Eigen::Vector3d x = start.state.positions.col(s);
-      frames.bounds.extend(placement ? Eigen::Vector3d(placement->rotation.transpose() * (x - placement->translation))
-                                     : x);
+      const Eigen::Vector3d own =
+          placement ? Eigen::Vector3d(placement->rotation.transpose() * (x - placement->translation)) : x;
+      for (int i = 0; i < 3; ++i) low[i] = std::min(low[i], own[i]), high[i] = std::max(high[i], own[i]);
     }
+    frames.bounds = Eigen::AlignedBox3d(low, high);
     return;
   }
   if (frames.skin) frames.skin->pose(start.state, velocities, frames.skin_frames, frames.skinned);
