@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 
+#include "sim/kernel_isa.h"
 #include "sim/rotation.h"
 #include "sim/solver_model.h"
 
@@ -27,6 +28,37 @@ struct PlacedFrame {
     if (velocities) speed += velocity + spin.cross(turned * arm + arm);
   }
 };
+
+// Vertices [begin, end) at rest (3 x V, column-major), in the N clusters of `cluster` => their
+// places (3 x V), x0 + the mean of R (x0 - t0) + t0 + shift - x0 over the clusters: PlacedFrame::
+// add_move's arithmetic in plain doubles, the library's order kept (a 3 x 3 matrix times a
+// vector sums a row's terms in order, but the last row's last two first), so that the loop
+// runs in vector lanes.
+template <int N>
+void place_run(const PlacedFrame (&cluster)[kMaxRunClusters], const double* rest, uint32_t begin, uint32_t end,
+               double* positions) {
+  double t[N][9], centre[N][3], shift[N][3];
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) t[j][i + 3 * k] = cluster[j].turned(i, k);
+      centre[j][i] = cluster[j].centre[i];
+      shift[j][i] = cluster[j].shift[i];
+    }
+#pragma omp simd
+  for (uint32_t v = begin; v < end; ++v) {
+    const double x = rest[3 * v], y = rest[3 * v + 1], z = rest[3 * v + 2];
+    double mx = 0, my = 0, mz = 0;
+    for (int j = 0; j < N; ++j) {
+      const double* T = t[j];
+      const double ax = x - centre[j][0], ay = y - centre[j][1], az = z - centre[j][2];
+      mx += ((T[0] * ax + T[3] * ay) + T[6] * az) + shift[j][0];
+      my += ((T[1] * ax + T[4] * ay) + T[7] * az) + shift[j][1];
+      mz += (T[2] * ax + (T[5] * ay + T[8] * az)) + shift[j][2];
+    }
+    if constexpr (N > 1) mx /= N, my /= N, mz /= N;
+    positions[3 * v] = x + mx, positions[3 * v + 1] = y + my, positions[3 * v + 2] = z + mz;
+  }
+}
 
 // Iterations of the frame's rotation: warm-started from the solver's last fit of the same
 // samples, it converges in one or two.
@@ -115,24 +147,32 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
     for (long c = first; c < last; ++c) {
       // A = sum s (d - shift) q^T with d = u + q, u = x - x0: sum s u q^T + the rest moment
       // sum s q q^T - shift (sum s q)^T, s = w k; at rest exactly the symmetric rest moment.
-      Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-      Eigen::Matrix3d moved = Eigen::Matrix3d::Zero();
+      // In plain doubles, each sum as the library's expressions took it.
+      double shift[3] = {}, moved[9] = {};  // moved column-major
       bool at_rest = true;
       for (uint32_t k = fit_offsets_[c]; k < fit_offsets_[c + 1]; ++k) {
         const uint32_t s = fit_samples_[k];
-        const Eigen::Vector3d u = state.positions.col(s) - samples_.rest_positions.col(s);
-        const Eigen::Vector3d q = fit_offset_.col(k);
+        const double* q = &fit_offset_(0, k);
         const double w = fit_weight_[k];
-        at_rest = at_rest && u.isZero(0);
-        shift += w * u;
-        moved += (w * u) * q.transpose();
+        double wu[3];
+        for (int i = 0; i < 3; ++i) {
+          const double u = state.positions(i, s) - samples_.rest_positions(i, s);
+          at_rest = at_rest && u == 0;
+          wu[i] = w * u;
+          shift[i] += wu[i];
+        }
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) moved[i + 3 * j] += wu[i] * q[j];
       }
-      frames.shift.col(c) = shift;
+      for (int i = 0; i < 3; ++i) frames.shift(i, c) = shift[i];
       frames.rotation.col(c) = Eigen::Quaterniond::Identity().coeffs();
       if (at_rest) continue;
-      const Eigen::Vector3d offset_sum = offset_sum_.col(c);
-      const Eigen::Map<const Eigen::Matrix3d> rest(&rest_moment_(0, c));
-      const Eigen::Matrix3d fit = (moved + rest - shift * offset_sum.transpose()) * match_scale_[c];
+      const double* offset_sum = &offset_sum_(0, c);
+      const double* rest = &rest_moment_(0, c);
+      Eigen::Matrix3d fit;
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+          fit(i, j) = ((moved[i + 3 * j] + rest[i + 3 * j]) - shift[i] * offset_sum[j]) * match_scale_[c];
       const Eigen::Vector4d warm = state.cluster_rotations.col(c);
       Eigen::Quaterniond rotation(warm[3], warm[0], warm[1], warm[2]);
       if (!(rotation.norm() > 0.5)) rotation = Eigen::Quaterniond::Identity();
@@ -208,12 +248,25 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     if (velocities) out.velocities.col(v) = speed;
   };
   const bool parallel = mesh_.membership_count() >= kParallelMemberships;
-  // A run: its clusters' frames read once, then each vertex in the order of its memberships.
+  // A run: its clusters' frames read once, then each vertex in the order of its memberships;
+  // without velocities in vector lanes (place_run).
 #pragma omp parallel for schedule(static) if (parallel)
   for (size_t r = 0; r < runs_.size(); ++r) {
     const VertexRun& run = runs_[r];
     PlacedFrame cluster[kMaxRunClusters];
     for (uint32_t j = 0; j < run.count; ++j) cluster[j] = frame_of(run.cluster[j]);
+    if (!velocities) {
+      with_kernel_isa([&] {
+        switch (run.count) {
+          case 1: place_run<1>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
+          case 2: place_run<2>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
+          case 3: place_run<3>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
+          default:
+            place_run<kMaxRunClusters>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data());
+        }
+      });
+      continue;
+    }
     for (uint32_t v = run.begin; v < run.end; ++v) {
       const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
       Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
