@@ -122,8 +122,8 @@ struct SolverModel {
   // hsm.particles "samples", whose clusters' fixed costs are its step's, takes cheaper choices
   // of the same accuracy (docs/solver.md, "Particles"); "vertices" keeps the paper's set-up byte for byte.
   double rotation_newton_stop;             // rad, the Newton step that ends a rotation's iterations (rotation.h)
-  // The chain's turns by their series (beam_statics.cpp, small_rotation_of), and their unscented
-  // mean in one cross product where no point reaches the yield turn (mean_yielded_turn)
+  // The chain's turns by their series (beam_statics.cpp, series_rotation), and their unscented
+  // mean in one cross product where no point reaches the yield turn (turn_joints_quickly)
   bool quick_chain;
   // The correction pass reads each vertex's cluster frame (air, R) per lane rather than once per
   // run of a cluster's vertices: a run of three or four samples is too short to fill a vector.
