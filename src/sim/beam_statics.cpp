@@ -87,10 +87,9 @@ Eigen::Vector3d mean_yielded_turn(const Eigen::Vector3d& theta, const Eigen::Vec
 
 // A child's weight w and its first moment about its own joint, offset = j_child - j_parent
 // => added to its parent's weight and moment about the parent's joint: m_p += m + offset w.
-inline void carry_moment(double w, const Eigen::Vector3d& m, const Eigen::Vector3d& offset, double& parent_w,
-                         Eigen::Ref<Eigen::Vector3d> parent_m) {
+inline void carry_moment(double w, const double* m, const double (&offset)[3], double& parent_w, double* parent_m) {
   parent_w += w;
-  parent_m += m + offset * w;
+  for (int i = 0; i < 3; ++i) parent_m[i] += m[i] + offset[i] * w;
 }
 
 // A cluster's load sums run in eight fixed lanes: its k-th member is added in lane k % 8, and
@@ -172,8 +171,9 @@ void sum_drag_areas(const SolverModel<Real>& model, Attachment<Real>& attachment
   for (size_t c = model.C; c-- > 0;) {
     const int32_t p = tree.cluster_parent[c];
     if (p < 0 || attachment.cluster_flying[c]) continue;
-    carry_moment(attachment.cluster_drag_area[c], attachment.cluster_drag_arm.col(c), joint.col(c) - joint.col(p),
-                 attachment.cluster_drag_area[p], attachment.cluster_drag_arm.col(p));
+    const double offset[3] = {joint(0, c) - joint(0, p), joint(1, c) - joint(1, p), joint(2, c) - joint(2, p)};
+    carry_moment(attachment.cluster_drag_area[c], &attachment.cluster_drag_arm(0, c), offset,
+                 attachment.cluster_drag_area[p], &attachment.cluster_drag_arm(0, p));
   }
 }
 
@@ -400,9 +400,7 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
       load[3 * p + i] += f[i];
       moment[3 * p + i] += moment[3 * c + i] + arm[i];
     }
-    // The damping and its moment, as carry_moment carries them.
-    damping[p] += damping[c];
-    for (int i = 0; i < 3; ++i) damping_moment[3 * p + i] += damping_moment[3 * c + i] + d[i] * damping[c];
+    carry_moment(damping[c], damping_moment + 3 * c, d, damping[p], damping_moment + 3 * p);
   };
   const BarChain& chain = model.chain;
   const size_t groups = chain.walk_group_offsets.size() - 1;
@@ -445,20 +443,19 @@ void walk_bar_chain(const SolverModel<Real>& model, const Attachment<Real>& atta
     const double d[3] = {j[3 * c] - j[3 * p], j[3 * c + 1] - j[3 * p + 1], j[3 * c + 2] - j[3 * p + 2]};
     for (int i = 0; i < 3; ++i) path[3 * c + i] += path[3 * p + i];
     lever[c] = lever[p] + ((path[3 * p] * d[0] + path[3 * p + 1] * d[1]) + path[3 * p + 2] * d[2]);
-    // The library's 3 x 3 products sum a row's terms in order, but the last row's last two first.
+    // The joint's move, parent d, and the turn down the chain, R parent, as the library sums them.
     const double* parent = rotation + 9 * p;
     double* R = rotation + 9 * c;
     for (int i = 0; i < 3; ++i) {
-      const double turned = i < 2 ? (parent[i] * d[0] + parent[i + 3] * d[1]) + parent[i + 6] * d[2]
-                                  : parent[i] * d[0] + (parent[i + 3] * d[1] + parent[i + 6] * d[2]);
+      double turned;
+      matrix_row_sum(i, parent[i] * d[0], parent[i + 3] * d[1], parent[i + 6] * d[2], turned);
       moved_joint[3 * c + i] = moved_joint[3 * p + i] + turned;
     }
     double product[9];
     for (int col = 0; col < 3; ++col)
       for (int i = 0; i < 3; ++i) {
-        const double *row = R + i, *column = parent + 3 * col;
-        product[i + 3 * col] = i < 2 ? (row[0] * column[0] + row[3] * column[1]) + row[6] * column[2]
-                                     : row[0] * column[0] + (row[3] * column[1] + row[6] * column[2]);
+        const double* column = parent + 3 * col;
+        matrix_row_sum(i, R[i] * column[0], R[i + 3] * column[1], R[i + 6] * column[2], product[i + 3 * col]);
       }
     std::copy_n(product, 9, R);
   };

@@ -107,13 +107,9 @@ void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iteration
       }
       const Double4 scale = (trace < zero ? -trace : trace) + kEps;
       active &= (torque[0] * torque[0] + torque[1] * torque[1]) + torque[2] * torque[2] > 1e-30 * scale * scale;
-      // A R^T, column-major; the library sums the first two rows' terms in order, its last row's
-      // last two first (two rows a vector, the third alone).
-      Double4 M[9];
-      for (int j = 0; j < 3; ++j) {
-        for (int i = 0; i < 2; ++i) M[i + 3 * j] = (A[i] * R[j] + A[i + 3] * R[j + 3]) + A[i + 6] * R[j + 6];
-        M[2 + 3 * j] = A[2] * R[j] + (A[5] * R[j + 3] + A[8] * R[j + 6]);
-      }
+      Double4 M[9];  // A R^T, column-major
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) matrix_row_sum(i, A[i] * R[j], A[i + 3] * R[j + 3], A[i + 6] * R[j + 6], M[i + 3 * j]);
       const Double4 diagonal = trace * (1 + kEps);
       const Double4 h00 = diagonal - M[0], h11 = diagonal - M[4], h22 = diagonal - M[8];
       const Double4 h01 = -0.5 * (M[3] + M[1]), h02 = -0.5 * (M[6] + M[2]), h12 = -0.5 * (M[7] + M[5]);

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <cstring>
 
 #include "sim/kernel_isa.h"
 #include "sim/rotation.h"
@@ -31,9 +32,8 @@ struct PlacedFrame {
 
 // Vertices [begin, end) at rest (3 x V, column-major), in the N clusters of `cluster` => their
 // places (3 x V), x0 + the mean of R (x0 - t0) + t0 + shift - x0 over the clusters: PlacedFrame::
-// add_move's arithmetic in plain doubles, the library's order kept (a 3 x 3 matrix times a
-// vector sums a row's terms in order, but the last row's last two first), so that the loop
-// runs in vector lanes.
+// add_move's arithmetic in plain doubles, the library's order kept (matrix_row_sum), so that
+// the loop runs in vector lanes.
 template <int N>
 void place_run(const PlacedFrame (&cluster)[kMaxRunClusters], const double* rest, uint32_t begin, uint32_t end,
                double* positions) {
@@ -46,17 +46,21 @@ void place_run(const PlacedFrame (&cluster)[kMaxRunClusters], const double* rest
     }
 #pragma omp simd
   for (uint32_t v = begin; v < end; ++v) {
-    const double x = rest[3 * v], y = rest[3 * v + 1], z = rest[3 * v + 2];
-    double mx = 0, my = 0, mz = 0;
+    const double x0[3] = {rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]};
+    double move[3] = {0, 0, 0};
     for (int j = 0; j < N; ++j) {
       const double* T = t[j];
-      const double ax = x - centre[j][0], ay = y - centre[j][1], az = z - centre[j][2];
-      mx += ((T[0] * ax + T[3] * ay) + T[6] * az) + shift[j][0];
-      my += ((T[1] * ax + T[4] * ay) + T[7] * az) + shift[j][1];
-      mz += (T[2] * ax + (T[5] * ay + T[8] * az)) + shift[j][2];
+      const double arm[3] = {x0[0] - centre[j][0], x0[1] - centre[j][1], x0[2] - centre[j][2]};
+      for (int i = 0; i < 3; ++i) {
+        double turned;
+        matrix_row_sum(i, T[i] * arm[0], T[i + 3] * arm[1], T[i + 6] * arm[2], turned);
+        move[i] += turned + shift[j][i];
+      }
     }
-    if constexpr (N > 1) mx /= N, my /= N, mz /= N;
-    positions[3 * v] = x + mx, positions[3 * v + 1] = y + my, positions[3 * v + 2] = z + mz;
+    for (int i = 0; i < 3; ++i) {
+      if constexpr (N > 1) move[i] /= N;
+      positions[3 * v + i] = x0[i] + move[i];
+    }
   }
 }
 
@@ -141,7 +145,7 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
 #pragma omp parallel for schedule(static) if (fit_samples_.size() >= kParallelMemberships)
   for (long g = 0; g < groups; ++g) {
     const long first = 4 * g, last = std::min(C, first + 4);
-    Double4 A[9], q[4];
+    double a_lanes[9][4], q_lanes[4][4];  // loaded as vectors whole, below
     long moving[4];
     int lanes = 0;
     for (long c = first; c < last; ++c) {
@@ -169,23 +173,24 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
       if (at_rest) continue;
       const double* offset_sum = &offset_sum_(0, c);
       const double* rest = &rest_moment_(0, c);
-      Eigen::Matrix3d fit;
       for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i)
-          fit(i, j) = ((moved[i + 3 * j] + rest[i + 3 * j]) - shift[i] * offset_sum[j]) * match_scale_[c];
+          a_lanes[i + 3 * j][lanes] = ((moved[i + 3 * j] + rest[i + 3 * j]) - shift[i] * offset_sum[j]) * match_scale_[c];
       const Eigen::Vector4d warm = state.cluster_rotations.col(c);
       Eigen::Quaterniond rotation(warm[3], warm[0], warm[1], warm[2]);
       if (!(rotation.norm() > 0.5)) rotation = Eigen::Quaterniond::Identity();
       rotation.normalize();
-      for (int i = 0; i < 9; ++i) A[i][lanes] = fit(i);
-      for (int k = 0; k < 4; ++k) q[k][lanes] = rotation.coeffs()[k];
+      for (int k = 0; k < 4; ++k) q_lanes[k][lanes] = rotation.coeffs()[k];
       moving[lanes++] = c;
     }
     if (lanes > 0) {
       for (int l = lanes; l < 4; ++l) {  // lanes without a cluster repeat the first
-        for (int i = 0; i < 9; ++i) A[i][l] = A[i][0];
-        for (int k = 0; k < 4; ++k) q[k][l] = q[k][0];
+        for (int i = 0; i < 9; ++i) a_lanes[i][l] = a_lanes[i][0];
+        for (int k = 0; k < 4; ++k) q_lanes[k][l] = q_lanes[k][0];
       }
+      Double4 A[9], q[4];
+      std::memcpy(A, a_lanes, sizeof A);
+      std::memcpy(q, q_lanes, sizeof q);
       extract_rotations(A, q, kFrameIterations);
       for (int l = 0; l < lanes; ++l)
         for (int k = 0; k < 4; ++k) frames.rotation(k, moving[l]) = q[k][l];

@@ -149,14 +149,12 @@ uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& 
   extract_rotations(A, q, model.options.rotation_iterations, model.rotation_newton_stop);
   Double4 R[9];
   rotation_matrix(q, R);
-  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre);
-  // R o summed as the library sums a 3 x 3 matrix times a vector.
-  const Double4 turned[3] = {(R[0] * point[0] + R[3] * point[1]) + R[6] * point[2],
-                             (R[1] * point[0] + R[4] * point[1]) + R[7] * point[2],
-                             R[2] * point[0] + (R[5] * point[1] + R[8] * point[2])};
+  // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).
   Double4 shift[3], check = {};
   for (int i = 0; i < 3; ++i) {
-    shift[i] = moved[i] - (turned[i] - point[i]);
+    Double4 turned;
+    matrix_row_sum(i, R[i] * point[0], R[i + 3] * point[1], R[i + 6] * point[2], turned);
+    shift[i] = moved[i] - (turned - point[i]);
     check += shift[i] - shift[i];
   }
   for (int i = 0; i < 9; ++i) check += R[i] - R[i];
