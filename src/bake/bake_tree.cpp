@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "bake/checkpoint.h"
+#include "bake/frame_thread.h"
 #include "bake/prepare_tree.h"
 #include "bake/signals.h"
 #include "common/errors.h"
@@ -68,10 +69,24 @@ void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& re
   }
 }
 
-// The frame `start.state` holds, converted, journalled when the bake writes checkpoints, pushed.
-void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
+// The mesh of frame `frame` of `state` (placed from the samples when the bake has a skin),
+// converted, journalled when the bake writes checkpoints, pushed.
+void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, const SimState& state, long long frame,
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
+  if (frames.skin) frames.skin->pose(state, velocities, frames.skin_frames, frames.skinned);
+  FrameData data = output_frame(frames.skin ? frames.skinned : state, frame, velocities, placement);
+  if (frames.skin && frames.outputs.wants_cluster_motions())
+    add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
+  if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
+  if (plan.checkpoints.every > 0) start.journal->append(data);
+  frames.push(std::move(data));
+}
+
+// The frame `start.state` holds, written: a skinned mesh on the frame thread (when there is
+// one), else here.
+void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
+                 const TreePlacement* placement, FrameThread* frame_thread) {
   if (frames.sampled && !plan.reads_mesh) {
     // Nothing reads the mesh: no vertex is placed; the bounds are the samples', extended one
     // by one as AlignedBox::extend does (std::min and std::max per axis), in plain doubles.
@@ -85,13 +100,8 @@ void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, lon
     frames.bounds = Eigen::AlignedBox3d(low, high);
     return;
   }
-  if (frames.skin) frames.skin->pose(start.state, velocities, frames.skin_frames, frames.skinned);
-  FrameData data = output_frame(frames.skin ? frames.skinned : start.state, frame, velocities, placement);
-  if (frames.skin && frames.outputs.wants_cluster_motions())
-    add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
-  if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
-  if (plan.checkpoints.every > 0) start.journal->append(data);
-  frames.push(std::move(data));
+  if (frame_thread) frame_thread->submit(start.state, frames.outputs.wants_velocities(), frame);
+  else place_frame(plan, start, frames, start.state, frame, placement);
 }
 
 // A box in the tree's own frame => the world box holding it.
@@ -155,23 +165,36 @@ void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart
 
 int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
                const TreePlacement* placement, const BakeLog& log) {
+  // A skinned mesh is placed on a thread of its own while the solver steps on, when the
+  // solver's team leaves a core free for it; on every core, a thread more would preempt a member
+  // of the team and stall it at each barrier, so the team places the mesh between frames. The
+  // state of the vertices themselves is the mesh, converted where it is.
+  std::optional<FrameThread> frame_thread;
+  if (frames.skin && omp_get_max_threads() < omp_get_num_procs())
+    frame_thread.emplace([&](const SimState& state, long long frame) {
+      place_frame(plan, start, frames, state, frame, placement);
+    });
+  FrameThread* const thread = frame_thread ? &*frame_thread : nullptr;
   log.frames_begin(plan.written.last - start.frame + 1);
   for (long long frame = start.frame; frame <= plan.written.last; ++frame) {
     if (frame > start.frame) simulator.advance_frame(start.state, frame);
     if (const int signal_number = pending_signal()) {
+      frame_thread.reset();
       frames.outputs.abort();
       log.frames_end();
       log.interrupted(signal_number, frame);
       return signal_number == SIGINT ? kExitSigint : kExitSigterm;
     }
-    if (frame >= plan.written.first) write_frame(plan, start, frames, frame, placement);
+    if (frame >= plan.written.first) write_frame(plan, start, frames, frame, placement, thread);
     // The journal reaches the disk before the checkpoint that names its frames as written.
     if (plan.checkpoints.every > 0 && frame > start.frame && (frame - plan.first) % plan.checkpoints.every == 0) {
+      if (thread) thread->finish();
       start.journal->sync();
       write_checkpoint(checkpoint_path(plan.checkpoints.dir, frame), start.state, frame, plan.key);
     }
     log.frame_done(frame - start.frame + 1);
   }
+  if (thread) thread->finish();
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // The stages of one tree's bake (bake/bake_tree.h): plan, start, warm up, replay, run, finish.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cstdio>
 #include <fstream>
@@ -218,6 +219,28 @@ TEST_F(BakeStages, ASampledBakeResumedFromAnEarlierCheckpointWritesTheSameBytes)
   ASSERT_EQ(bake_tree(mesh, vertices, nullptr, BakeLog{}).exit_code, 0);
   EXPECT_LT(fs::file_size(checkpoint_path(dir_ / "checkpoints", 12)),
             fs::file_size(checkpoint_path(dir_ / "vertex-checkpoints", 12)));
+}
+
+TEST_F(BakeStages, ASampledBakePlacesItsMeshBesideTheSolverWithTheSameBytes) {
+  // One solver thread leaves a core to the frame thread (on a machine of two or more); every
+  // core taken, the mesh is placed between frames. Checkpoints make the frame thread finish.
+  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"},
+                                        {"format": "skinned_glb", "path": "bake.glb"}])",
+                            R"(hsm.particles="samples")", "lsystem.axiom=\"FFF[+FF]FF\""});
+  std::vector<std::string> pc2, glb;
+  for (const int threads : {1, omp_get_num_procs()}) {
+    BakeConfig beside = config();
+    beside.threads = threads;
+    beside.checkpoints.every = 2;
+    beside.checkpoints.dir = dir_ / ("checkpoints-" + std::to_string(threads));
+    ASSERT_EQ(bake_tree(line, beside, nullptr, BakeLog{}).exit_code, 0);
+    pc2.push_back(slurp(dir_ / "out" / "bake.pc2"));
+    glb.push_back(slurp(dir_ / "out" / "bake.glb"));
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_FALSE(pc2[0].empty());
+  EXPECT_EQ(pc2[0], pc2[1]);
+  EXPECT_EQ(glb[0], glb[1]);
 }
 
 TEST_F(BakeStages, ASampledBakeWithoutOutputsStillSimulates) {
