@@ -5,15 +5,13 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <condition_variable>
-#include <deque>
-#include <mutex>
+#include <memory>
 #include <stdexcept>
-#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "common/errors.h"
+#include "common/ordered_worker.h"
 #include "files/output_lock.h"
 #include "files/staged_files.h"
 #include "formats/frame_sink.h"
@@ -38,60 +36,26 @@ constexpr int kWriterNice = 5;
 // a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
 constexpr size_t kQueueFrames = 8;
 
-// One sink, its thread and its queue of frames still to write.
+// One sink and, from begin() on, its writer: a thread that writes the queued frames in order.
 struct Worker {
   std::unique_ptr<FrameSink> sink;
   FrameSelection selection;
   fs::path first_path;  // for messages about failures that do not name a path themselves
   double estimated_bytes = 0;  // of the frames it will write (estimated_output_bytes)
-  std::thread thread;
-  std::mutex mutex;
-  std::condition_variable changed;  // queue, closing, stopping or error changed
-  std::deque<std::shared_ptr<const FrameData>> queue;
-  bool closing = false;              // no more frames will come: drain and return
-  bool stopping = false;             // abort: return without writing the rest
-  std::exception_ptr error;          // the sink's failure, rethrown by push() or finish()
+  std::unique_ptr<OrderedWorker<std::shared_ptr<const FrameData>>> writer;
 
-  // Writer thread: writes queued frames in order until closed, stopped or failed.
-  void run() {
-    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWriterNice);  // best effort
-    for (;;) {
-      std::shared_ptr<const FrameData> frame;
-      {
-        std::unique_lock lock(mutex);
-        changed.wait(lock, [&] { return stopping || closing || !queue.empty(); });
-        if (stopping || queue.empty()) return;
-        frame = std::move(queue.front());
-        queue.pop_front();
-      }
-      changed.notify_all();
-      try {
-        sink->write(*frame);
-      } catch (...) {
-        fail(std::current_exception());
-        return;
-      }
-    }
-  }
-
-  // Records the first failure as an OutputError that names a path.
-  void fail(std::exception_ptr failure) {
-    try {
-      std::rethrow_exception(failure);
-    } catch (const OutputError&) {
-    } catch (const std::exception& e) {
-      failure = std::make_exception_ptr(OutputError(first_path.string() + ": " + e.what()));
-    }
-    {
-      std::lock_guard lock(mutex);
-      if (!error) error = failure;
-    }
-    changed.notify_all();
-  }
-
-  void rethrow_error() {
-    std::lock_guard lock(mutex);
-    if (error) std::rethrow_exception(error);
+  void start_writer() {
+    writer = std::make_unique<OrderedWorker<std::shared_ptr<const FrameData>>>(
+        kQueueFrames, [] { setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWriterNice); },  // best effort
+        [this](const std::shared_ptr<const FrameData>& frame) {
+          try {
+            sink->write(*frame);
+          } catch (const OutputError&) {
+            throw;
+          } catch (const std::exception& e) {  // named by the output's path
+            throw OutputError(first_path.string() + ": " + e.what());
+          }
+        });
   }
 };
 
@@ -206,7 +170,7 @@ void OutputSet::begin() {
     abort();
     throw;
   }
-  for (auto& worker : impl_->workers) worker->thread = std::thread(&Worker::run, worker.get());
+  for (auto& worker : impl_->workers) worker->start_writer();
 }
 
 void OutputSet::push(FrameData frame) {
@@ -223,30 +187,15 @@ void OutputSet::push(FrameData frame) {
   // share the frame read-only.
   if (impl_->normals) vertex_normals(impl_->model, frame.positions.data(), impl_->rest_normals, frame.normals);
   const auto shared = std::make_shared<const FrameData>(std::move(frame));
-  for (auto& worker : impl_->workers) {
-    if (!worker->selection.wants(shared->frame)) continue;
-    {
-      std::unique_lock lock(worker->mutex);
-      worker->changed.wait(lock, [&] { return worker->error || worker->queue.size() < kQueueFrames; });
-      if (!worker->error) worker->queue.push_back(shared);
-    }
-    worker->changed.notify_all();
-    worker->rethrow_error();
-  }
+  for (auto& worker : impl_->workers)
+    if (worker->selection.wants(shared->frame)) worker->writer->push(shared);
 }
 
 void OutputSet::finish() {
   try {
-    for (auto& worker : impl_->workers) {
-      {
-        std::lock_guard lock(worker->mutex);
-        worker->closing = true;
-      }
-      worker->changed.notify_all();
-    }
-    for (auto& worker : impl_->workers)
-      if (worker->thread.joinable()) worker->thread.join();
-    for (auto& worker : impl_->workers) worker->rethrow_error();
+    // Each writer drains its queue (all at once, on their threads); the first failure in
+    // the outputs' order is the one reported.
+    for (auto& worker : impl_->workers) worker->writer->close();
     // Every file complete before any is renamed: a failure here still leaves no output.
     for (auto& worker : impl_->workers) worker->sink->finish();
     for (auto& worker : impl_->workers) worker->sink->commit();
@@ -260,14 +209,7 @@ void OutputSet::finish() {
 
 void OutputSet::abort() noexcept {
   for (auto& worker : impl_->workers) {
-    {
-      std::lock_guard lock(worker->mutex);
-      worker->stopping = true;
-    }
-    worker->changed.notify_all();
-  }
-  for (auto& worker : impl_->workers) {
-    if (worker->thread.joinable()) worker->thread.join();
+    if (worker->writer) worker->writer->stop();
     worker->sink->abort();
   }
   impl_->undo();

@@ -1,15 +1,10 @@
-// The frame thread (bake/frame_thread.h): every frame in order, on a copy of the state, and
-// the work's first error given back to the solver's side.
+// The frame thread (bake/frame_thread.h): every frame in order, on a copy of the state. Its
+// queue, its errors and its end are OrderedWorker's (tests/common/test_ordered_worker.cpp).
 #include "bake/frame_thread.h"
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <chrono>
-#include <thread>
 #include <vector>
-
-#include "common/errors.h"
 
 namespace treeanim {
 namespace {
@@ -49,43 +44,6 @@ TEST(FrameThread, WorksEveryFrameInOrderOnACopyOfItsState) {
     EXPECT_EQ(seen[k].time, double(frame));
     EXPECT_EQ(seen[k].velocity_columns, frame % 2 == 0 ? 5.0 : 0.0);  // velocities only when asked
   }
-}
-
-TEST(FrameThread, GivesBackTheFirstErrorAndWorksNoFrameAfterIt) {
-  std::vector<long long> worked;
-  FrameThread thread([&](const SimState&, long long frame) {
-    worked.push_back(frame);
-    if (frame == 3) throw OutputError("disk full at frame 3");
-  });
-  const SimState state = state_of(1);
-  bool thrown = false;
-  try {
-    for (long long frame = 1; frame <= 10; ++frame) thread.submit(state, false, frame);
-    thread.finish();
-  } catch (const OutputError& e) {
-    thrown = true;
-    EXPECT_STREQ(e.what(), "disk full at frame 3");
-  }
-  EXPECT_TRUE(thrown);
-  EXPECT_THROW(thread.finish(), OutputError);
-  EXPECT_THROW(thread.submit(state, false, 11), OutputError);
-  ASSERT_GE(worked.size(), 3u);
-  EXPECT_EQ(worked.back(), 3);  // frames queued behind the failed one are dropped
-}
-
-TEST(FrameThread, EndsTheFrameInHandWhenDestroyed) {
-  std::atomic<int> worked = 0;
-  {
-    FrameThread thread([&](const SimState&, long long) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      ++worked;
-    });
-    const SimState state = state_of(1);
-    thread.submit(state, false, 1);
-    thread.submit(state, false, 2);  // returns once frame 1 is in the thread's hands
-  }  // as a bake unwinding from an error: frame 1 ends, frame 2 may be dropped
-  EXPECT_GE(worked, 1);
-  EXPECT_LE(worked, 2);
 }
 
 }  // namespace
