@@ -76,8 +76,7 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
   const bool velocities = frames.outputs.wants_velocities();
   if (frames.skin) frames.skin->pose(state, velocities, frames.skin_frames, frames.skinned);
   FrameData data = output_frame(frames.skin ? frames.skinned : state, frame, velocities, placement);
-  if (frames.skin && frames.outputs.wants_cluster_motions())
-    add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
+  if (frames.cluster_motions) add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
   if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
   if (plan.checkpoints.every > 0) start.journal->append(data);
   frames.push(std::move(data));
@@ -230,13 +229,16 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   log.prepared(tree);
   BakeFrames frames(scene, config, plan, tree.model, placement);
   frames.sampled = sampled;
-  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(),
-                                              sampled && frames.outputs.wants_cluster_motions());
+  frames.cluster_motions = sampled && frames.outputs.wants_cluster_motions();
+  const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities(), frames.cluster_motions);
   const size_t vertices = tree.model.vertex_count(), clusters = tree.model.cluster_count();
   // A placed tree moves in the world's wind: its simulation runs on the model where it stands.
-  std::optional<TreeModel> placed =
-      placement ? std::optional<TreeModel>(placed_tree_model(tree.model, *placement)) : std::nullopt;
-  if (placed && give_up_mesh) tree.model = TreeModel();
+  // A model given up is moved there, not copied: the bake never holds two.
+  std::optional<TreeModel> placed;
+  if (placement) {
+    placed = give_up_mesh ? placed_tree_model(std::move(tree.model), *placement) : placed_tree_model(tree.model, *placement);
+    if (give_up_mesh) tree.model = TreeModel();
+  }
   TreeModel& mesh = placed ? *placed : tree.model;
   std::optional<TreeModel> samples;
   if (sampled) samples = give_up_mesh ? sample_tree_model(std::move(mesh)) : sample_tree_model(std::as_const(mesh));

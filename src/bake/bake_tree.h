@@ -33,6 +33,9 @@ struct BakeFrames {
   const BakeInfo info;
   const size_t output_count;
   bool sampled = false;  // hsm.particles "samples": the solver steps samples, not the mesh
+  // Each frame carries its clusters' motions (FrameData::cluster_motions), journalled with it:
+  // a samples bake with an output that keys them.
+  bool cluster_motions = false;
   // The mesh placed from the samples' clusters when something reads it (null: the state is the
   // mesh's, or nothing reads it), and its scratch.
   const SampleSkin* skin = nullptr;

@@ -1,6 +1,6 @@
-// Journal layout (little-endian, docs/checkpoint.md): a 64-byte header, magic "TAJOURN1",
+// Journal layout (little-endian, docs/checkpoint.md): a 96-byte header, magic "TAJOURN1",
 // u64 record bytes, i64 first frame, u64 V, u64 L, u8 velocities, padding, u64 motion clusters
-// C, padding, then the FNV-1a scene hash as 24 bytes of text; then fixed-size records: i64 frame,
+// C, padding, then the FNV-1a scene hash as 32 bytes of text, zero-padded; then fixed-size records: i64 frame,
 // f64 time, f32 positions (V x 3), f32 velocities (V x 3, when recorded), u8 leaf flags (L),
 // f32 cluster motions (C x 7, when recorded).
 #include "bake/frame_journal.h"
@@ -9,6 +9,8 @@
 
 #include <bit>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "common/errors.h"
@@ -125,14 +127,14 @@ void FrameJournal::truncate(long long count) {
 void FrameJournal::append(const FrameData& frame) {
   const int64_t number = frame.frame;
   const size_t n = 3 * layout_.vertices, motions = 7 * layout_.motion_clusters;
+  if (frame.positions.size() != n || (layout_.velocities && frame.velocities.size() != n) ||
+      frame.leaf_attached.size() != layout_.leaves || frame.cluster_motions.size() != motions)
+    throw std::logic_error("FrameJournal::append: frame " + std::to_string(frame.frame) +
+                           " does not match the journal's layout");
   const bool ok = std::fseek(file_, 0, SEEK_END) == 0 && std::fwrite(&number, 8, 1, file_) == 1 &&
-                  std::fwrite(&frame.time, 8, 1, file_) == 1 && frame.positions.size() == n &&
-                  std::fwrite(frame.positions.data(), 4, n, file_) == n &&
-                  (!layout_.velocities || (frame.velocities.size() == n &&
-                                           std::fwrite(frame.velocities.data(), 4, n, file_) == n)) &&
-                  frame.leaf_attached.size() == layout_.leaves &&
+                  std::fwrite(&frame.time, 8, 1, file_) == 1 && std::fwrite(frame.positions.data(), 4, n, file_) == n &&
+                  (!layout_.velocities || std::fwrite(frame.velocities.data(), 4, n, file_) == n) &&
                   std::fwrite(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves &&
-                  frame.cluster_motions.size() == motions &&
                   std::fwrite(frame.cluster_motions.data(), 4, motions, file_) == motions;
   if (!ok) throw OutputError(io_failure(path_, "cannot append to the frame journal"));
   ++records_;

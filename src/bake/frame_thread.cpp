@@ -6,7 +6,7 @@
 
 namespace treeanim {
 
-// One frame waits while another is in hand: the solver is at most a frame ahead.
+// One frame waits while another is in hand: the solver steps at most two frames ahead.
 FrameThread::FrameThread(Work work)
     : worker_(1, [] { omp_set_num_threads(1); },
               [work = std::move(work)](Frame& frame) { work(frame.state, frame.frame); }) {}

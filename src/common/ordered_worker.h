@@ -10,6 +10,7 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 
@@ -19,20 +20,26 @@ template <typename Item>
 class OrderedWorker {
  public:
   // Starts the thread: `start` runs there first (its priority, its thread count), then
-  // `handle` for each item. At most `capacity` items wait beside the one in hand.
+  // `handle` for each item. At most `capacity` (> 0) items wait beside the one in hand. An
+  // exception from `start` is the worker's first, as one from `handle` is.
   OrderedWorker(size_t capacity, std::function<void()> start, std::function<void(Item&)> handle)
-      : capacity_(capacity), start_(std::move(start)), handle_(std::move(handle)), thread_(&OrderedWorker::run, this) {}
+      : capacity_(capacity > 0 ? capacity : throw std::logic_error("OrderedWorker: a queue of no item")),
+        start_(std::move(start)),
+        handle_(std::move(handle)),
+        thread_(&OrderedWorker::run, this) {}
   // stop(): a producer unwinding from an error has its own to report.
   ~OrderedWorker() { stop(); }
   OrderedWorker(const OrderedWorker&) = delete;
   OrderedWorker& operator=(const OrderedWorker&) = delete;
 
-  // Waits for room, then queues `item`. Rethrows the first exception of the handler.
+  // Waits for room, then queues `item`. Rethrows the first exception of the handler; after
+  // close() or stop(), nothing would handle the item: a logic_error.
   void push(Item item) {
     {
       std::unique_lock lock(mutex_);
       changed_.wait(lock, [&] { return error_ || queue_.size() < capacity_; });
       if (error_) std::rethrow_exception(error_);
+      if (closing_ || stopping_) throw std::logic_error("OrderedWorker::push after close() or stop()");
       queue_.push_back(std::move(item));
     }
     changed_.notify_all();
@@ -70,13 +77,20 @@ class OrderedWorker {
 
  private:
   void run() {
-    if (start_) start_();
+    try {
+      if (start_) start_();
+    } catch (...) {
+      std::lock_guard lock(mutex_);
+      error_ = std::current_exception();
+      queue_.clear();
+    }
+    changed_.notify_all();
     for (;;) {
       Item item;
       {
         std::unique_lock lock(mutex_);
-        changed_.wait(lock, [&] { return stopping_ || closing_ || !queue_.empty(); });
-        if (stopping_ || queue_.empty()) return;
+        changed_.wait(lock, [&] { return error_ || stopping_ || closing_ || !queue_.empty(); });
+        if (error_ || stopping_ || queue_.empty()) return;
         item = std::move(queue_.front());
         queue_.pop_front();
         busy_ = true;

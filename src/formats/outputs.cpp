@@ -44,6 +44,10 @@ struct Worker {
   double estimated_bytes = 0;  // of the frames it will write (estimated_output_bytes)
   std::unique_ptr<OrderedWorker<std::shared_ptr<const FrameData>>> writer;
 
+  Worker() = default;
+  Worker(const Worker&) = delete;  // the writer's handler holds `this`
+  Worker& operator=(const Worker&) = delete;
+
   void start_writer() {
     writer = std::make_unique<OrderedWorker<std::shared_ptr<const FrameData>>>(
         kQueueFrames, [] { setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWriterNice); },  // best effort
@@ -182,7 +186,8 @@ void OutputSet::push(FrameData frame) {
     throw std::logic_error("OutputSet::push: frame " + std::to_string(frame.frame) +
                            " does not match the model (positions " + std::to_string(frame.positions.size()) +
                            ", velocities " + std::to_string(frame.velocities.size()) + ", leaf flags " +
-                           std::to_string(frame.leaf_attached.size()) + ")");
+                           std::to_string(frame.leaf_attached.size()) + ", cluster motions " + std::to_string(motions) +
+                           ")");
   // Once per frame for every output that carries them, on the caller's thread: the writers
   // share the frame read-only.
   if (impl_->normals) vertex_normals(impl_->model, frame.positions.data(), impl_->rest_normals, frame.normals);

@@ -21,14 +21,13 @@ TreePlacement make_tree_placement(const Eigen::Vector3d& position, double rotati
   return placement;
 }
 
-TreeModel placed_tree_model(const TreeModel& model, const TreePlacement& placement) {
-  TreeModel placed = model;
-  placed.rest_positions = (placement.rotation * model.rest_positions).colwise() + placement.translation;
+TreeModel placed_tree_model(TreeModel model, const TreePlacement& placement) {
+  model.rest_positions = (placement.rotation * model.rest_positions).colwise() + placement.translation;
   for (size_t s = 0; s < model.segment_count(); ++s) {
-    placed.segment_start[s] = placement.rotation * model.segment_start[s] + placement.translation;
-    placed.segment_end[s] = placement.rotation * model.segment_end[s] + placement.translation;
+    model.segment_start[s] = placement.rotation * model.segment_start[s] + placement.translation;
+    model.segment_end[s] = placement.rotation * model.segment_end[s] + placement.translation;
   }
-  return placed;
+  return model;
 }
 
 }  // namespace treeanim

@@ -19,6 +19,6 @@ TreePlacement make_tree_placement(const Eigen::Vector3d& position, double rotati
 
 // The model moved to where it stands: rest positions and skeleton turned and translated;
 // masses, areas, clusters and everything else as they are.
-TreeModel placed_tree_model(const TreeModel& model, const TreePlacement& placement);
+TreeModel placed_tree_model(TreeModel model, const TreePlacement& placement);
 
 }  // namespace treeanim

@@ -36,19 +36,20 @@ TEST(OrderedWorker, HandlesEveryItemInOrderOnItsOwnThreadAfterItsStart) {
 }
 
 TEST(OrderedWorker, KeepsAtMostItsCapacityWaiting) {
-  std::atomic<int> taken = 0;
+  std::atomic<int> taken = 0, pushed = 0;
   std::atomic<bool> release = false;
   OrderedWorker<int> worker(2, nullptr, [&](int&) {
     ++taken;
     while (!release) std::this_thread::sleep_for(1ms);
   });
-  std::atomic<int> pushed = 0;
   std::thread producer([&] {
     for (int i = 0; i < 5; ++i, ++pushed) worker.push(i);
   });
-  std::this_thread::sleep_for(100ms);
+  // One item in hand and two waiting: the fourth push waits for room, however long.
+  while (taken < 1 || pushed < 3) std::this_thread::sleep_for(1ms);
+  std::this_thread::sleep_for(50ms);
   EXPECT_EQ(taken, 1);
-  EXPECT_EQ(pushed, 3);  // one in hand, two waiting; the fourth push waits for room
+  EXPECT_EQ(pushed, 3);
   release = true;
   producer.join();
   worker.drain();
@@ -78,17 +79,37 @@ TEST(OrderedWorker, GivesBackTheFirstErrorAndHandlesNothingAfterIt) {
 }
 
 TEST(OrderedWorker, StoppedItEndsTheItemInHandAndDropsTheRest) {
-  std::atomic<int> handled = 0;
+  std::atomic<int> begun = 0, handled = 0;
   {
     OrderedWorker<int> worker(4, nullptr, [&](int&) {
+      ++begun;
       std::this_thread::sleep_for(20ms);
       ++handled;
     });
     for (int i = 0; i < 4; ++i) worker.push(i);
-    std::this_thread::sleep_for(5ms);
+    while (begun < 1) std::this_thread::sleep_for(1ms);
   }  // destroyed, as by a producer unwinding from an error: it stops
-  EXPECT_GE(handled, 1);
-  EXPECT_LE(handled, 2);
+  EXPECT_EQ(handled, begun);  // the item in hand ended
+  EXPECT_LE(handled, 2);      // the rest, but perhaps one taken meanwhile, dropped
+}
+
+TEST(OrderedWorker, AStartThatFailsIsItsFirstError) {
+  OrderedWorker<int> worker(
+      1, [] { throw std::runtime_error("no such priority"); }, [](int&) { FAIL() << "handled"; });
+  EXPECT_THROW(
+      {
+        worker.push(1);  // queued if the thread has not started yet, and then dropped
+        worker.drain();
+      },
+      std::runtime_error);
+  EXPECT_THROW(worker.push(2), std::runtime_error);
+}
+
+TEST(OrderedWorker, RefusesAnItemAfterItIsClosed) {
+  OrderedWorker<int> worker(1, nullptr, [](int&) {});
+  worker.close();
+  EXPECT_THROW(worker.push(1), std::logic_error);
+  EXPECT_THROW(OrderedWorker<int>(0, nullptr, [](int&) {}), std::logic_error);
 }
 
 }  // namespace
