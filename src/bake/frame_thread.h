@@ -1,9 +1,10 @@
 #pragma once
 // FrameThread: a written frame's mesh work on a thread of its own, behind the solver
 // (docs/solver.md, "Particles"). While the solver's threads step frames k + 1 and k + 2 (one
-// frame waits beside the one in hand), this thread handles frame k: the mesh placed from the samples' state (the skin), converted to floats,
-// journalled and handed to the outputs. It works on a copy of what it reads of the state, so
-// the solver goes on with its own; the same work on the same state gives the same bytes.
+// frame waits beside the one in hand), this thread handles frame k: the mesh placed from the
+// samples' state (the skin), converted to floats, journalled and handed to the outputs. It
+// works on a copy of what it reads of the state, so the solver goes on with its own; the same
+// work on the same state gives the same bytes.
 #include <functional>
 
 #include "common/ordered_worker.h"
