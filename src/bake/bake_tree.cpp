@@ -21,16 +21,17 @@ namespace treeanim {
 
 namespace {
 
-// Solver state (double) => the float frame the outputs write; a placed tree's in its own frame.
-FrameData output_frame(const SimState& state, long long frame, bool with_velocities, const TreePlacement* placement) {
-  FrameData data;
+// Solver state (double) => the float frame the outputs write, into `data` (its arrays reused);
+// a placed tree's in its own frame.
+void output_frame(const SimState& state, long long frame, bool with_velocities, const TreePlacement* placement,
+                  FrameData& data) {
   data.frame = frame;
   data.time = state.time;
+  const size_t V = size_t(state.positions.cols());
+  data.velocities.resize(with_velocities ? 3 * V : 0);
   if (placement) {
     const Eigen::Matrix3d back = placement->rotation.transpose();
-    const size_t V = size_t(state.positions.cols());
     data.positions.resize(3 * V);
-    if (with_velocities) data.velocities.resize(3 * V);
     for (size_t v = 0; v < V; ++v) {
       const Eigen::Vector3d p = back * (state.positions.col(v) - placement->translation);
       for (int k = 0; k < 3; ++k) data.positions[3 * v + k] = static_cast<float>(p[k]);
@@ -44,7 +45,6 @@ FrameData output_frame(const SimState& state, long long frame, bool with_velocit
       data.velocities.assign(state.velocities.data(), state.velocities.data() + state.velocities.size());
   }
   data.leaf_attached = state.leaf_attached;
-  return data;
 }
 
 // Each cluster's frame (x = R (x0 - t0) + t0 + shift, where the tree stands) => the motion
@@ -74,9 +74,21 @@ void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& re
 void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, const SimState& state, long long frame,
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
-  if (frames.skin) frames.skin->pose(state, velocities, frames.skin_frames, frames.skinned);
-  FrameData data = output_frame(frames.skin ? frames.skinned : state, frame, velocities, placement);
+  FrameData data = frames.outputs.spare_frame();
+  if (frames.skin && !placement) {
+    // Each vertex rounded to float as the skin places it, on the solver's threads.
+    data.frame = frame;
+    data.time = state.time;
+    data.positions.resize(3 * frames.skin->vertex_count());
+    data.velocities.resize(velocities ? data.positions.size() : 0);
+    frames.skin->pose(state, frames.skin_frames, data.positions.data(), velocities ? data.velocities.data() : nullptr);
+    data.leaf_attached = state.leaf_attached;
+  } else {
+    if (frames.skin) frames.skin->pose(state, velocities, frames.skin_frames, frames.skinned);
+    output_frame(frames.skin ? frames.skinned : state, frame, velocities, placement, data);
+  }
   if (frames.cluster_motions) add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
+  else data.cluster_motions.clear();
   if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
   if (plan.checkpoints.every > 0) start.journal->append(data);
   frames.push(std::move(data));
@@ -89,6 +101,7 @@ void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, lon
   if (frames.sampled && !plan.reads_mesh) {
     // Nothing reads the mesh: no vertex is placed; the bounds are the samples', extended one
     // by one as AlignedBox::extend does (std::min and std::max per axis), in plain doubles.
+    if (!frames.measures_bounds) return;
     Eigen::Vector3d low = frames.bounds.min(), high = frames.bounds.max();
     for (long s = 0; s < start.state.positions.cols(); ++s) {
       const Eigen::Vector3d x = start.state.positions.col(s);
@@ -119,11 +132,12 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
                        const TreePlacement* placement)
     : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
+      measures_bounds(placement != nullptr),
       outputs(scene.outputs, config.out_dir, model, info) {}
 
 void BakeFrames::push(FrameData data) {
   if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
-  for (size_t i = 0; i + 2 < data.positions.size(); i += 3)
+  for (size_t i = 0; measures_bounds && i + 2 < data.positions.size(); i += 3)
     bounds.extend(Eigen::Vector3d(data.positions[i], data.positions[i + 1], data.positions[i + 2]));
   outputs.push(std::move(data));
 }
@@ -209,7 +223,7 @@ TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const L
   for (size_t k = 0; k < frames.output_count; ++k) result.files.push_back(frames.outputs.files(k));
   if (plan.closes_loop)
     result.loop = LoopSummary{warmup, !start.checkpoint.empty(), frames.seam.seam(), frames.seam.median_step()};
-  result.bounds = world_bounds(frames.bounds, placement);
+  if (frames.measures_bounds) result.bounds = world_bounds(frames.bounds, placement);
   return result;
 }
 

@@ -27,11 +27,13 @@ struct BakeFrames {
   // placement: where the tree stands (null: a lone tree at the origin).
   BakeFrames(const Scene& scene, const BakeConfig& config, const BakePlan& plan, const TreeModel& model,
              const TreePlacement* placement);
-  // A frame measured (bounds, a whole loop's seam), then queued to the outputs.
+  // A frame measured (a placed tree's bounds, a whole loop's seam), then queued to the outputs.
   void push(FrameData data);
 
   const BakeInfo info;
   const size_t output_count;
+  // A placed tree reports the box of its frames to the forest's manifest; a lone tree has no use for it.
+  const bool measures_bounds;
   bool sampled = false;  // hsm.particles "samples": the solver steps samples, not the mesh
   // Each frame carries its clusters' motions (FrameData::cluster_motions), journalled with it:
   // a samples bake with an output that keys them.
@@ -43,7 +45,7 @@ struct BakeFrames {
   SimState skinned;
   OutputSet outputs;
   SeamMeter seam;              // a loop baked whole: every frame
-  Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame
+  Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame (measures_bounds)
 };
 
 // A loop baked whole: how it was brought to repeat and how well it closes.
@@ -68,7 +70,7 @@ struct TreeBakeResult {
   std::vector<std::pair<std::filesystem::path, std::string>> reports;  // (path, what its output says)
   std::vector<std::vector<std::filesystem::path>> files;  // (outputs) every file of each output
   std::optional<LoopSummary> loop;                        // a loop baked whole
-  Eigen::AlignedBox3d bounds;                             // m, world box of every written frame's vertices
+  Eigen::AlignedBox3d bounds;                             // m, world box of a placed tree's written frames
 };
 
 // The journal of `plan` for a model whose outputs want velocities or not, and the clusters'

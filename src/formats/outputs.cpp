@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
@@ -63,11 +64,21 @@ struct Worker {
   }
 };
 
+// Frames every writer is done with, kept for the next ones: a frame's arrays (2.5 MB of
+// positions on the 211,864-vertex tree) are allocated, and their pages touched, once for each
+// frame in flight rather than once a frame. Shared with the frames' deleters, which may run on a
+// writer's thread after the set is gone.
+struct SpareFrames {
+  std::mutex mutex;
+  std::vector<FrameData> frames;
+};
+
 }  // namespace
 
 struct OutputSet::Impl {
   const TreeModel& model;
   std::vector<std::unique_ptr<Worker>> workers;
+  std::shared_ptr<SpareFrames> spares = std::make_shared<SpareFrames>();
   bool velocities = false;
   bool normals = false;
   bool cluster_motions = false;
@@ -177,6 +188,14 @@ void OutputSet::begin() {
   for (auto& worker : impl_->workers) worker->start_writer();
 }
 
+FrameData OutputSet::spare_frame() {
+  const std::lock_guard lock(impl_->spares->mutex);
+  if (impl_->spares->frames.empty()) return {};
+  FrameData frame = std::move(impl_->spares->frames.back());
+  impl_->spares->frames.pop_back();
+  return frame;
+}
+
 void OutputSet::push(FrameData frame) {
   const size_t n = 3 * impl_->model.vertex_count();
   const size_t motions = frame.cluster_motions.size();
@@ -191,7 +210,16 @@ void OutputSet::push(FrameData frame) {
   // Once per frame for every output that carries them, on the caller's thread: the writers
   // share the frame read-only.
   if (impl_->normals) vertex_normals(impl_->model, frame.positions.data(), impl_->rest_normals, frame.normals);
-  const auto shared = std::make_shared<const FrameData>(std::move(frame));
+  // The last writer done with it hands it back (at most what the queues hold and one more).
+  const std::shared_ptr<const FrameData> shared(
+      new FrameData(std::move(frame)), [spares = impl_->spares, limit = kQueueFrames + 1](FrameData* done) noexcept {
+        const std::unique_ptr<FrameData> owned(done);
+        try {
+          const std::lock_guard lock(spares->mutex);
+          if (spares->frames.size() < limit) spares->frames.push_back(std::move(*owned));
+        } catch (...) {  // no room to keep it: it is freed
+        }
+      });
   for (auto& worker : impl_->workers)
     if (worker->selection.wants(shared->frame)) worker->writer->push(shared);
 }

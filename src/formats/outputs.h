@@ -74,6 +74,9 @@ class OutputSet {
   bool wants_cluster_motions() const;
   // Opens temporaries, writes headers and the rest mesh; starts each sink's writer thread.
   void begin();
+  // A frame to fill for push(): one that every writer is done with when there is one, its
+  // arrays still allocated (a bake's frames all have the same sizes), else an empty one.
+  FrameData spare_frame();
   // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.
   void push(FrameData frame);
   // Drains the queue, closes files, renames temporaries to their final names.

@@ -31,12 +31,12 @@ struct PlacedFrame {
 };
 
 // Vertices [begin, end) at rest (3 x V, column-major), in the N clusters of `cluster` => their
-// places (3 x V), x0 + the mean of R (x0 - t0) + t0 + shift - x0 over the clusters: PlacedFrame::
-// add_move's arithmetic in plain doubles, the library's order kept (matrix_row_sum), so that
-// the loop runs in vector lanes.
-template <int N>
+// places (3 x V, in Out), x0 + the mean of R (x0 - t0) + t0 + shift - x0 over the clusters:
+// PlacedFrame::add_move's arithmetic in plain doubles, the library's order kept
+// (matrix_row_sum), so that the loop runs in vector lanes.
+template <int N, typename Out>
 void place_run(const PlacedFrame (&cluster)[kMaxRunClusters], const double* rest, uint32_t begin, uint32_t end,
-               double* positions) {
+               Out* positions) {
   double t[N][9], centre[N][3], shift[N][3];
   for (int j = 0; j < N; ++j)
     for (int i = 0; i < 3; ++i) {
@@ -59,7 +59,7 @@ void place_run(const PlacedFrame (&cluster)[kMaxRunClusters], const double* rest
     }
     for (int i = 0; i < 3; ++i) {
       if constexpr (N > 1) move[i] /= N;
-      positions[3 * v + i] = x0[i] + move[i];
+      positions[3 * v + i] = static_cast<Out>(x0[i] + move[i]);
     }
   }
 }
@@ -221,8 +221,23 @@ void SampleSkin::fit_frames(const SimState& state, bool velocities, ClusterFrame
 }
 
 void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& frames, SimState& out) const {
-  fit_frames(state, velocities, frames);
-  const long V = long(mesh_.vertex_count()), C = long(samples_.cluster_count());
+  const long V = long(mesh_.vertex_count());
+  out.positions.resize(3, V);
+  out.velocities.resize(3, velocities ? V : 0);
+  place(state, frames, out.positions.data(), velocities ? out.velocities.data() : nullptr);
+  out.time = state.time;
+  out.leaf_attached = state.leaf_attached;
+}
+
+void SampleSkin::pose(const SimState& state, ClusterFrames& frames, float* positions, float* velocities) const {
+  place(state, frames, positions, velocities);
+}
+
+template <typename Out>
+void SampleSkin::place(const SimState& state, ClusterFrames& frames, Out* positions, Out* velocities) const {
+  const bool with_velocities = velocities != nullptr;
+  fit_frames(state, with_velocities, frames);
+  const long C = long(samples_.cluster_count());
   // (R - I) per cluster, column-major, so each vertex reads nine numbers.
   Eigen::Matrix<double, 9, Eigen::Dynamic> turn(9, C);
   for (long c = 0; c < C; ++c) {
@@ -232,25 +247,23 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     R -= Eigen::Matrix3d::Identity();
     turn.col(c) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());
   }
-  out.positions.resize(3, V);
-  if (velocities) out.velocities.resize(3, V);
-  else out.velocities.resize(3, 0);
   // Cluster c's frame as a vertex reads it: (R - I), rest centre, shift, and the motion.
   auto frame_of = [&](uint32_t c) {
     PlacedFrame f{Eigen::Map<const Eigen::Matrix3d>(&turn(0, c)), rest_centre_.col(c), frames.shift.col(c), {}, {}};
-    if (!velocities) return f;
+    if (!with_velocities) return f;
     f.velocity = frames.velocity.col(c);
     f.spin = frames.spin.col(c);
     return f;
   };
   // Vertex v at rest x0 and the sums of its `count` clusters' moves => its place, their mean.
-  auto place = [&](uint32_t v, const Eigen::Vector3d& x0, Eigen::Vector3d move, Eigen::Vector3d speed, int count) {
+  auto put = [&](uint32_t v, const Eigen::Vector3d& x0, Eigen::Vector3d move, Eigen::Vector3d speed, int count) {
     if (count > 1) {
       move /= count;
       speed /= count;
     }
-    out.positions.col(v) = x0 + move;
-    if (velocities) out.velocities.col(v) = speed;
+    for (int a = 0; a < 3; ++a) positions[3 * v + a] = static_cast<Out>(x0[a] + move[a]);
+    if (velocities)
+      for (int a = 0; a < 3; ++a) velocities[3 * v + a] = static_cast<Out>(speed[a]);
   };
   const bool parallel = mesh_.membership_count() >= kParallelMemberships;
   // A run: its clusters' frames read once, then each vertex in the order of its memberships;
@@ -263,11 +276,11 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     if (!velocities) {
       with_kernel_isa([&] {
         switch (run.count) {
-          case 1: place_run<1>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
-          case 2: place_run<2>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
-          case 3: place_run<3>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data()); break;
+          case 1: place_run<1>(cluster, mesh_.rest_positions.data(), run.begin, run.end, positions); break;
+          case 2: place_run<2>(cluster, mesh_.rest_positions.data(), run.begin, run.end, positions); break;
+          case 3: place_run<3>(cluster, mesh_.rest_positions.data(), run.begin, run.end, positions); break;
           default:
-            place_run<kMaxRunClusters>(cluster, mesh_.rest_positions.data(), run.begin, run.end, out.positions.data());
+            place_run<kMaxRunClusters>(cluster, mesh_.rest_positions.data(), run.begin, run.end, positions);
         }
       });
       continue;
@@ -275,8 +288,8 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     for (uint32_t v = run.begin; v < run.end; ++v) {
       const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
       Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
-      for (uint32_t j = 0; j < run.count; ++j) cluster[j].add_move(x0, velocities, move, speed);
-      place(v, x0, move, speed, int(run.count));
+      for (uint32_t j = 0; j < run.count; ++j) cluster[j].add_move(x0, with_velocities, move, speed);
+      put(v, x0, move, speed, int(run.count));
     }
   }
 #pragma omp parallel for schedule(static) if (parallel)
@@ -284,8 +297,9 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     const uint32_t v = single_vertices_[i];
     const Eigen::Vector3d x0 = mesh_.rest_positions.col(v);
     if (mesh_.vertex_anchored[v]) {  // fixed to the ground, as the solver holds it
-      out.positions.col(v) = x0;
-      if (velocities) out.velocities.col(v).setZero();
+      for (int a = 0; a < 3; ++a) positions[3 * v + a] = static_cast<Out>(x0[a]);
+      if (velocities)
+        for (int a = 0; a < 3; ++a) velocities[3 * v + a] = 0;
       continue;
     }
     Eigen::Vector3d move = Eigen::Vector3d::Zero(), speed = Eigen::Vector3d::Zero();
@@ -297,13 +311,11 @@ void SampleSkin::pose(const SimState& state, bool velocities, ClusterFrames& fra
     for (uint32_t k = mesh_.vertex_cluster_offsets[v]; k < mesh_.vertex_cluster_offsets[v + 1]; ++k) {
       const uint32_t c = mesh_.member_cluster[mesh_.vertex_memberships[k]];
       if (released && (c == mesh_.leaf_cluster[leaf]) != goes_with_leaf) continue;
-      frame_of(c).add_move(x0, velocities, move, speed);
+      frame_of(c).add_move(x0, with_velocities, move, speed);
       ++count;
     }
-    place(v, x0, move, speed, count);
+    put(v, x0, move, speed, count);
   }
-  out.time = state.time;
-  out.leaf_attached = state.leaf_attached;
 }
 
 }  // namespace treeanim

@@ -34,11 +34,21 @@ class SampleSkin {
   // vertex from its clusters' frames, the mean over the memberships the leaves' flags leave
   // active; time and leaf flags copied. `frames` is scratch (its fit is left there).
   void pose(const SimState& samples_state, bool velocities, ClusterFrames& frames, SimState& mesh_state) const;
+  // The same places and velocities (null: none), each double rounded to float as it is placed,
+  // in (3 x V) arrays: the frame an output writes, without the mesh's state in doubles.
+  void pose(const SimState& samples_state, ClusterFrames& frames, float* positions, float* velocities) const;
+
+  // The mesh's vertices.
+  size_t vertex_count() const { return mesh_.vertex_count(); }
 
   // The rest centre of each cluster's fit, t0 (3 x C) m.
   const Eigen::Matrix3Xd& rest_centres() const { return rest_centre_; }
 
  private:
+  // pose's work, into arrays of doubles or floats.
+  template <typename Out>
+  void place(const SimState& samples_state, ClusterFrames& frames, Out* positions, Out* velocities) const;
+
   const TreeModel& mesh_;
   const TreeModel& samples_;
   // The fit's samples of cluster c: fit_samples_[fit_offsets_[c], fit_offsets_[c + 1]), their

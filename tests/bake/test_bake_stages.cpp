@@ -136,7 +136,9 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   const BakeConfig whole = config();
   const BakePlan plan = plan_bake(line, whole);
   const PreparedTree tree = prepare_tree(line);
-  BakeFrames frames(line, whole, plan, tree.model, nullptr);
+  // Placed (at the origin): a placed tree measures its bounds for the forest's manifest.
+  const TreePlacement origin = make_tree_placement(Eigen::Vector3d::Zero(), 0);
+  BakeFrames frames(line, whole, plan, tree.model, &origin);
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
   BakeStart start = start_bake(plan, layout, simulator, nullptr);
@@ -145,9 +147,9 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   std::vector<long long> done;
   BakeLog log;
   log.frame_done = [&](long long frames_done) { done.push_back(frames_done); };
-  ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log), 0);
+  ASSERT_EQ(run_frames(plan, simulator, start, frames, &origin, log), 0);
   EXPECT_EQ(done, (std::vector<long long>{1, 2, 3, 4, 5}));
-  const TreeBakeResult result = finish_bake(plan, start, {}, frames, nullptr, log);
+  const TreeBakeResult result = finish_bake(plan, start, {}, frames, &origin, log);
   EXPECT_EQ(result.written.first, 10);
   EXPECT_EQ(result.written.count(), 5);
   EXPECT_EQ(result.substeps, 4 * 2);
@@ -162,9 +164,12 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
 
 TEST_F(BakeStages, FinishGivesTheBoundsInTheWorld) {
   const Scene line = scene();
-  const TreeBakeResult own = bake_tree(line, config(), nullptr, BakeLog{});
+  const TreePlacement origin = make_tree_placement(Eigen::Vector3d::Zero(), 0);
+  const TreeBakeResult own = bake_tree(line, config(), &origin, BakeLog{});
   const TreePlacement placement = make_tree_placement(Eigen::Vector3d(5, 0, -2), 0);
   const TreeBakeResult placed = bake_tree(line, config(), &placement, BakeLog{});
+  // A lone tree reports none: nothing reads them.
+  EXPECT_TRUE(bake_tree(line, config(), nullptr, BakeLog{}).bounds.isEmpty());
   EXPECT_NEAR(placed.bounds.min().x(), own.bounds.min().x() + 5, 1e-4);
   EXPECT_NEAR(placed.bounds.max().z(), own.bounds.max().z() - 2, 1e-4);
   EXPECT_NEAR(placed.bounds.max().y(), own.bounds.max().y(), 1e-4);
@@ -250,7 +255,8 @@ TEST_F(BakeStages, ASampledBakePlacesItsMeshBesideTheSolverWithTheSameBytes) {
 
 TEST_F(BakeStages, ASampledBakeWithoutOutputsStillSimulates) {
   const Scene line = scene({"outputs=[]", R"(hsm.particles="samples")"});
-  const TreeBakeResult result = bake_tree(line, config(), nullptr, BakeLog{});
+  const TreePlacement origin = make_tree_placement(Eigen::Vector3d::Zero(), 0);
+  const TreeBakeResult result = bake_tree(line, config(), &origin, BakeLog{});
   EXPECT_EQ(result.exit_code, 0);
   EXPECT_EQ(result.substeps, 4 * 2);
   EXPECT_GT(result.bounds.max().y(), 2.9);  // the samples' own bounds

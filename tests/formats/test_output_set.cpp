@@ -114,6 +114,29 @@ TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {
   EXPECT_EQ(paths[3], dir_ / "gltf/tree.0000.glb");
 }
 
+TEST_F(OutputSetTest, AFrameEveryWriterIsDoneWithComesBackToBeFilledAgain) {
+  const TreeModel m = small_model();
+  OutputSet set(every_format(), dir_, m, small_info(2, 0));
+  set.begin();
+  EXPECT_TRUE(set.spare_frame().positions.empty());  // none written yet
+  const FrameData first = small_frame(m, 0);
+  FrameData pushed = first;
+  const float* const pushed_arrays[2] = {pushed.positions.data(), pushed.velocities.data()};
+  set.push(std::move(pushed));
+  set.push(small_frame(m, 1));
+  set.finish();  // every writer done with both frames
+  FrameData spare = set.spare_frame();
+  // The arrays themselves come back (frame 1's, the last handed back), with their sizes.
+  EXPECT_EQ(spare.frame, 1);
+  EXPECT_EQ(spare.positions.size(), first.positions.size());
+  EXPECT_EQ(spare.velocities.size(), first.velocities.size());
+  FrameData older = set.spare_frame();
+  EXPECT_EQ(older.frame, 0);
+  EXPECT_EQ(older.positions.data(), pushed_arrays[0]);
+  EXPECT_EQ(older.velocities.data(), pushed_arrays[1]);
+  EXPECT_TRUE(set.spare_frame().positions.empty());  // each comes back once
+}
+
 // The message of the error that refuses `outputs`, "input: " before a bad-input one.
 std::string output_error(const std::vector<OutputOptions>& outputs, const std::filesystem::path& dir,
                          const TreeModel& m, const BakeInfo& info) {
