@@ -76,7 +76,7 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
   const bool velocities = frames.outputs.wants_velocities();
   FrameData data = frames.outputs.spare_frame();
   if (frames.skin && !placement) {
-    // Each vertex rounded to float as the skin places it, on the solver's threads.
+    // Each vertex rounded to float as the skin places it, in its parallel loops.
     data.frame = frame;
     data.time = state.time;
     data.positions.resize(3 * frames.skin->vertex_count());

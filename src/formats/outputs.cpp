@@ -217,7 +217,7 @@ void OutputSet::push(FrameData frame) {
         try {
           const std::lock_guard lock(spares->mutex);
           if (spares->frames.size() < limit) spares->frames.push_back(std::move(*owned));
-        } catch (...) {  // no room to keep it: it is freed
+        } catch (...) {  // the lock or the room failed: it is freed
         }
       });
   for (auto& worker : impl_->workers)

@@ -136,9 +136,7 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   const BakeConfig whole = config();
   const BakePlan plan = plan_bake(line, whole);
   const PreparedTree tree = prepare_tree(line);
-  // Placed (at the origin): a placed tree measures its bounds for the forest's manifest.
-  const TreePlacement origin = make_tree_placement(Eigen::Vector3d::Zero(), 0);
-  BakeFrames frames(line, whole, plan, tree.model, &origin);
+  BakeFrames frames(line, whole, plan, tree.model, nullptr);
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
   BakeStart start = start_bake(plan, layout, simulator, nullptr);
@@ -147,9 +145,9 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   std::vector<long long> done;
   BakeLog log;
   log.frame_done = [&](long long frames_done) { done.push_back(frames_done); };
-  ASSERT_EQ(run_frames(plan, simulator, start, frames, &origin, log), 0);
+  ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log), 0);
   EXPECT_EQ(done, (std::vector<long long>{1, 2, 3, 4, 5}));
-  const TreeBakeResult result = finish_bake(plan, start, {}, frames, &origin, log);
+  const TreeBakeResult result = finish_bake(plan, start, {}, frames, nullptr, log);
   EXPECT_EQ(result.written.first, 10);
   EXPECT_EQ(result.written.count(), 5);
   EXPECT_EQ(result.substeps, 4 * 2);
@@ -157,9 +155,7 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   EXPECT_EQ(result.files[0], std::vector<fs::path>{dir_ / "out" / "bake.h5"});
   EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / "bake.h5"));
   EXPECT_FALSE(result.loop);
-  // The stem stands at the origin, three units tall.
-  EXPECT_NEAR(result.bounds.min().y(), 0.0, 1e-3);
-  EXPECT_GT(result.bounds.max().y(), 2.9);
+  EXPECT_TRUE(result.bounds.isEmpty());  // a lone tree's: nothing reads them
 }
 
 TEST_F(BakeStages, FinishGivesTheBoundsInTheWorld) {
@@ -168,8 +164,9 @@ TEST_F(BakeStages, FinishGivesTheBoundsInTheWorld) {
   const TreeBakeResult own = bake_tree(line, config(), &origin, BakeLog{});
   const TreePlacement placement = make_tree_placement(Eigen::Vector3d(5, 0, -2), 0);
   const TreeBakeResult placed = bake_tree(line, config(), &placement, BakeLog{});
-  // A lone tree reports none: nothing reads them.
-  EXPECT_TRUE(bake_tree(line, config(), nullptr, BakeLog{}).bounds.isEmpty());
+  // The stem stands at the origin, three units tall.
+  EXPECT_NEAR(own.bounds.min().y(), 0.0, 1e-3);
+  EXPECT_GT(own.bounds.max().y(), 2.9);
   EXPECT_NEAR(placed.bounds.min().x(), own.bounds.min().x() + 5, 1e-4);
   EXPECT_NEAR(placed.bounds.max().z(), own.bounds.max().z() - 2, 1e-4);
   EXPECT_NEAR(placed.bounds.max().y(), own.bounds.max().y(), 1e-4);

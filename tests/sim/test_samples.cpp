@@ -205,6 +205,15 @@ Eigen::Matrix3Xd sampled_bake(int threads, int resume_at) {
     }
     skin.pose(state, true, frames, skinned);
     EXPECT_TRUE(skinned.positions.allFinite() && skinned.velocities.allFinite());
+    // The frame an output writes, placed straight in float: each of these doubles rounded.
+    const Eigen::Matrix3Xf rounded = skinned.positions.cast<float>(), speeds = skinned.velocities.cast<float>();
+    Eigen::Matrix3Xf positions(3, rounded.cols()), velocities(3, rounded.cols());
+    ClusterFrames again;
+    skin.pose(state, again, positions.data(), velocities.data());
+    EXPECT_TRUE(same_bytes(positions, rounded) && same_bytes(velocities, speeds)) << "frame " << frame;
+    positions.setConstant(-1);
+    skin.pose(state, again, positions.data(), nullptr);
+    EXPECT_TRUE(same_bytes(positions, rounded)) << "frame " << frame << ", no velocities";
     Eigen::Matrix3Xd grown(3, all.cols() + skinned.positions.cols());
     grown << all, skinned.positions;
     all = grown;
