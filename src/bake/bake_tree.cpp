@@ -21,12 +21,9 @@ namespace treeanim {
 
 namespace {
 
-// Solver state (double) => the float frame the outputs write, into `data` (its arrays reused);
-// a placed tree's in its own frame.
-void output_frame(const SimState& state, long long frame, bool with_velocities, const TreePlacement* placement,
-                  FrameData& data) {
-  data.frame = frame;
-  data.time = state.time;
+// Mesh state (double) => the positions and velocities of the float frame the outputs write,
+// into `data` (its arrays reused); a placed tree's in its own frame.
+void output_vertices(const SimState& state, bool with_velocities, const TreePlacement* placement, FrameData& data) {
   const size_t V = size_t(state.positions.cols());
   data.velocities.resize(with_velocities ? 3 * V : 0);
   if (placement) {
@@ -44,7 +41,6 @@ void output_frame(const SimState& state, long long frame, bool with_velocities, 
     if (with_velocities)
       data.velocities.assign(state.velocities.data(), state.velocities.data() + state.velocities.size());
   }
-  data.leaf_attached = state.leaf_attached;
 }
 
 // Each cluster's frame (x = R (x0 - t0) + t0 + shift, where the tree stands) => the motion
@@ -75,17 +71,17 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
   FrameData data = frames.outputs.spare_frame();
+  data.frame = frame;
+  data.time = state.time;
+  data.leaf_attached = state.leaf_attached;
   if (frames.skin && !placement) {
     // Each vertex rounded to float as the skin places it, in its parallel loops.
-    data.frame = frame;
-    data.time = state.time;
     data.positions.resize(3 * frames.skin->vertex_count());
     data.velocities.resize(velocities ? data.positions.size() : 0);
     frames.skin->pose(state, frames.skin_frames, data.positions.data(), velocities ? data.velocities.data() : nullptr);
-    data.leaf_attached = state.leaf_attached;
   } else {
     if (frames.skin) frames.skin->pose(state, velocities, frames.skin_frames, frames.skinned);
-    output_frame(frames.skin ? frames.skinned : state, frame, velocities, placement, data);
+    output_vertices(frames.skin ? frames.skinned : state, velocities, placement, data);
   }
   if (frames.cluster_motions) add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
   else data.cluster_motions.clear();
@@ -137,8 +133,9 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
 
 void BakeFrames::push(FrameData data) {
   if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
-  for (size_t i = 0; measures_bounds && i + 2 < data.positions.size(); i += 3)
-    bounds.extend(Eigen::Vector3d(data.positions[i], data.positions[i + 1], data.positions[i + 2]));
+  if (measures_bounds)
+    for (size_t i = 0; i + 2 < data.positions.size(); i += 3)
+      bounds.extend(Eigen::Vector3d(data.positions[i], data.positions[i + 1], data.positions[i + 2]));
   outputs.push(std::move(data));
 }
 
