@@ -1,6 +1,7 @@
 // Attached leaves (docs/solver.md, "Leaves"): a leaf is a rigid body pinned at its shared
-// (petiole) vertex, which is held at its branch's goal for it; the leaf turns by the torque
-// about that vertex and does not load its branch.
+// (petiole) vertex, which is held at its branch's goal for it; the leaf turns about that
+// vertex, its joint in the bar chain, and its drag loads its branch through the chain
+// (beam_statics.cpp), not through the branch's fit.
 #include "sim/kernel_isa.h"
 #include "sim/shape_matching.h"
 

@@ -1,7 +1,7 @@
 // The per-vertex pass, in displacements from rest (u = x - x0): the correction of the step
 // just matched (Eq. 7: each vertex takes the mean of its clusters' corrections), fused with
 // the prediction of the next step (prediction.h), so a vertex is loaded once per substep
-// (docs/solver.md, "One step" 4 and 1).
+// (docs/solver.md, "One step" 5, 1 and 3).
 #include <omp.h>
 
 #include <Eigen/Geometry>
@@ -238,7 +238,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
   {
     const auto [first, last] =
         balanced_range(model.tree.vertex_cluster_offsets, omp_get_thread_num(), omp_get_num_threads());
-    // 4. Correct the matched step (or load the state), and measure the drag of the next one.
+    // 5. Correct the matched step (or load the state), and 1. measure the drag of the next one.
     const auto [my_bad, my_runaway] = correct_vertices(model, attachment, state, scratch, mode, first, last);
     if (my_bad != kNone || my_runaway != kNone) {
 #pragma omp critical(treeanim_correction_failure)
@@ -247,7 +247,7 @@ bool correct_and_predict(const SolverModel<Real>& model, const Attachment<Real>&
 #pragma omp barrier
     if (bad == kNone && runaway == kNone) {
       if (mode.last) write_state(model, attachment, state, any_asleep, first, last);
-      // 1. The static deflection under that drag, and the prediction of the next step.
+      // 2. The static deflection under that drag, and 3. the prediction of the next step.
       if (model.beam) deflect_bar_chain(model, attachment, state, scratch);
       const uint32_t my_bad_prediction = predict_vertices(model, attachment, state, scratch, mode, first, last);
       if (my_bad_prediction != kNone) {

@@ -1,6 +1,6 @@
 #pragma once
 // The two per-vertex kernels of a step, for a block of vertices (docs/solver.md, "One step"
-// 1 and 4, "Wind and forces"): correct_block applies the mean correction of the matched step
+// 5 and 1, and 3, "Wind and forces"): correct_block applies the mean correction of the matched step
 // and measures the drag the next step will feel; predict_block predicts the next step:
 // damping, gravity, the global pull toward the static deflection (Eq. 8) and the exact
 // quadratic drag => v* and u_p = u + h v*. Loops without branches, vectorised across

@@ -1,5 +1,5 @@
 // Shape matching of every awake cluster on the predicted positions (docs/solver.md, "One
-// step" 2 and "Local shape matching").
+// step" 4 and "Local shape matching").
 #include "sim/shape_matching.h"
 
 #include <omp.h>
@@ -195,8 +195,8 @@ uint32_t match_listed_clusters(const SolverModel<Real>& model, const Attachment<
 }
 
 // Branches and free leaves first, then the attached leaves, whose translation is pinned to
-// their branch's goal for the shared vertex (hierarchical: a 1 g leaf cannot drag its branch,
-// nor drift off it in a gale). Sampling the next step's air here, per cluster, saves a
+// their branch's goal for the shared vertex (hierarchical: a 1 g leaf's fit cannot pull its
+// branch, nor the leaf drift off it in a gale; its drag reaches the branch through the chain). Sampling the next step's air here, per cluster, saves a
 // parallel region per step.
 template <typename Real>
 void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,

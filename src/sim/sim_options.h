@@ -35,10 +35,10 @@ struct HsmOptions {
   double alpha = 0.5;                    // per-step local rate (kPerStep), [0, 1]
   double k_d = 0.02;                     // per-step global rate (kPerStep), [0, 1]
   double leaf_alpha = 1.0;               // per-step local rate of leaf clusters (both modes), [0, 1]
-  double yield_strain = 0.01;            // bending strain beyond which a joint turns no further (kPhysical)
+  double yield_strain = 0.01;            // bending strain beyond which a joint turns no further (the bar chain)
   double root_flexibility = 1.0;         // the root plate's turn per moment, in units of H / (E I) of the trunk's base
-  double leaf_turn = 0.15;               // rad, a leaf's turn about its petiole in a 10 m/s wind across it (kPhysical)
-  double youngs_modulus = 8e9;           // Pa, wood (kPhysical)
+  double leaf_turn = 0.15;               // rad, a leaf's turn about its petiole in a 10 m/s wind across it (the bar chain)
+  double youngs_modulus = 8e9;           // Pa, wood (the bar chain; with kPhysical the local rates too)
   double global_scale = 1.0;             // multiplies the limb stiffness of the global term (kPhysical)
   double max_frequency = 30;             // rad/s, highest frequency the solver resolves (kPhysical)
   double max_limb_frequency = 20;        // rad/s, highest limb (global) frequency (kPhysical)

@@ -92,23 +92,23 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
   bool complete = false;  // the state ends with the next frame's first prediction
   // Sleeping islands wake as soon as the air moves at any step of this frame.
   if (!model.options.sleep || wake_islands(model, attachment, state, start)) {
-    // 1. Predict the first step, unless the frame that wrote the state did.
+    // 1-3. Load, bend and predict the first step, unless the frame that wrote the state did.
     if (!predicted) predict_from_state(model, attachment, state, scratch, frame);
     bool skipped_sleepers = false;
     for (int k = 0; k < model.substeps; ++k) {
       const bool last = k + 1 == model.substeps;
-      // 5. Detach the leaves whose predicted drag passes the threshold.
+      // 6. Detach the leaves whose predicted drag passes the threshold.
       if (model.detach_enabled) detach_leaves(model, attachment, state, scratch);
-      // 2, 3. Match the clusters on the predicted positions, branches, then attached leaves;
+      // 4. Match the clusters on the predicted positions, branches, then attached leaves;
       // each samples the air of the next step (after the last: the next frame's first).
       set_air_time(model, last ? start + model.frame_dt : start + (k + 1) * model.h, scratch);
       if (model.block_cluster_offsets.empty()) {
         match_clusters(model, attachment, state, scratch, frame, k);
-        // 4, 1. Correct, and predict the next step; the last step writes the frame.
+        // 5, 1, 2, 3. Correct, load, bend and predict the next step; the last step writes the frame.
         skipped_sleepers = correct_and_predict(model, attachment, state, scratch,
                                                last ? VertexPass::kLastStep : VertexPass::kStep, frame, k);
       } else {
-        // The same (1 of this step, 2, 3, 4), block by block while each is in cache.
+        // The same (3 of this step, 4, 5 and 1, then 2), block by block while each is in cache.
         skipped_sleepers =
             step_in_blocks(model, attachment, state, scratch, {.predict = k > 0, .last = last}, frame, k);
       }

@@ -78,7 +78,8 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
 // Leaves => the membership slots that pin each attached leaf to its branch (attached_leaves.cpp).
 // A leaf whose shared vertex is in no other cluster is matched like a branch. The shared
 // vertex, where it is the leaf's own, does not count in its branch's fit: it carries leaf
-// mass and leaf drag, and a leaf does not load its branch (docs/solver.md, "Leaves").
+// mass and drag, and the leaf's drag reaches its branch through the bar chain, not through
+// the branch's fit (docs/solver.md, "Leaves").
 template <typename Real>
 void precompute_pins(SolverModel<Real>& m, Attachment<Real>& a) {
   const TreeModel& tree = m.tree;

@@ -19,7 +19,7 @@ struct StepRates {
   std::vector<double> cluster_compliance_share;
   std::vector<double> vertex_global;          // (V) global (Eq. 8) rate per step; 0 when off or anchored
   std::vector<double> vertex_damping;         // (V) velocity factor per step, exp(-2 zeta w h)
-  double capped_fraction = 0;                 // share of branch clusters whose w h >= pi/2 (alpha = 1)
+  double capped_fraction = 0;                 // share of branch clusters at alpha = 1 (a frequency the step does not resolve, or none finite)
 };
 
 // Natural angular frequency w (rad/s) and step h (s) => per-step rate of the global term
