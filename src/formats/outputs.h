@@ -59,9 +59,8 @@ class OutputSet {
   // exists or can be made, writable, format limits such as 4 GiB GLB) and locks each output
   // against other bakes (files/output_lock.h) before simulation; finish() and abort() unlock. The
   // options are as the scene reader checked them. Throws InputError for a target no output may
-  // write (a directory, one written twice, a GLB past 4 GiB), OutputError naming the path for
-  // unwritable targets
-  // and for an output another bake holds.
+  // write (a directory, one written twice), OutputError naming the path for unwritable
+  // targets, a GLB past 4 GiB and an output another bake holds.
   OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
             const TreeModel& model, const BakeInfo& info);
   ~OutputSet();  // abort()s when finish() was not reached

@@ -15,7 +15,7 @@ struct OutputOptions {
   int frame_step = 1;              // write every k-th frame
   int compression = 0;             // hdf5: 0 none, 1..9 shuffle + deflate level
   bool velocities = false;         // hdf5: also write /frames/velocities
-  bool normals = false;            // hdf5, obj, gltf, glb: per-frame vertex normals (default on for gltf, glb)
+  bool normals = false;            // hdf5, obj, gltf, glb, usd: per-frame vertex normals (default on for gltf, glb)
   double quantize = 0;             // hdf5: m, > 0 stores displacements as integers of this step
   size_t texture_width = 0;        // vat: texels per row; 0 = as many as vertices, at most 8192
   size_t max_joints = 0;           // skinned_glb, skinned usd: joints at most; 0 = one per cluster
