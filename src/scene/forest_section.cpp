@@ -1,5 +1,6 @@
 // /forest => variants and placed trees (docs/scene.md "forest").
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -133,22 +134,37 @@ ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, con
   return tree;
 }
 
+// What /forest/scatter asks for besides its count, read and checked whatever the count (a
+// scatter of 0 trees holds valid keys, as one of more does).
+struct ScatterSettings {
+  ScatterArea area;
+  uint64_t seed = 0;
+  long long attempts = 0;
+  std::array<double, 2> rotation{}, scale{};
+};
+
+ScatterSettings read_scatter(SceneObject& scatter, uint64_t scene_seed) {
+  if (!scatter.has("min") || !scatter.has("max"))
+    scatter.fail(scatter.has("min") ? "max" : "min", "expected the area's corners min and max, each [x, z] in m");
+  ScatterSettings settings;
+  const auto min = scatter.pair("min", {0, 0}, kGround), max = scatter.pair("max", {0, 0}, kGround);
+  settings.area = ScatterArea{{min[0], min[1]}, {max[0], max[1]}};
+  if (!(settings.area.min.array() <= settings.area.max.array()).all())
+    scatter.fail("max", "expected a corner at or beyond min in x and z");
+  settings.seed = static_cast<uint64_t>(scatter.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
+  settings.attempts = scatter.integer("attempts", 1000, 1, 1'000'000);
+  settings.rotation = scatter.pair("rotation", {0, 360}, kTurn);
+  settings.scale = scatter.pair("scale", {1, 1}, kTreeScale);
+  if (settings.rotation[0] > settings.rotation[1]) scatter.fail_expected("rotation", "[lo, hi] degrees with lo <= hi");
+  if (settings.scale[0] > settings.scale[1]) scatter.fail_expected("scale", "[lo, hi] with lo <= hi");
+  return settings;
+}
+
 // Scattered trees after the listed ones: positions by dart throwing, and per tree a variant by
 // weight, a rotation, a scale and a seed drawn from the tree's own stream (scatter seed, index),
 // so that a change of spacing or area moves trees without changing what they are.
-void scatter_trees(SceneObject scatter, long long count, Forest& forest, uint64_t scene_seed) {
-  if (!scatter.has("min") || !scatter.has("max"))
-    scatter.fail(scatter.has("min") ? "max" : "min", "expected the area's corners min and max, each [x, z] in m");
-  const auto min = scatter.pair("min", {0, 0}, kGround), max = scatter.pair("max", {0, 0}, kGround);
-  const ScatterArea area{{min[0], min[1]}, {max[0], max[1]}};
-  if (!(area.min.array() <= area.max.array()).all())
-    scatter.fail("max", "expected a corner at or beyond min in x and z");
-  const auto seed = static_cast<uint64_t>(scatter.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
-  const long long attempts = scatter.integer("attempts", 1000, 1, 1'000'000);
-  const auto rotation = scatter.pair("rotation", {0, 360}, kTurn);
-  const auto scale = scatter.pair("scale", {1, 1}, kTreeScale);
-  if (rotation[0] > rotation[1]) scatter.fail_expected("rotation", "[lo, hi] degrees with lo <= hi");
-  if (scale[0] > scale[1]) scatter.fail_expected("scale", "[lo, hi] with lo <= hi");
+void scatter_trees(const SceneObject& scatter, const ScatterSettings& settings, long long count, Forest& forest) {
+  const auto& [area, seed, attempts, rotation, scale] = settings;
   double total_weight = 0;
   for (const ForestVariant& v : forest.variants) total_weight += v.weight;
   if (!(total_weight > 0))
@@ -216,7 +232,10 @@ Forest read_forest(SceneObject section, const ForestDefaults& defaults) {
                                    " on the ground, closer than /forest/spacing = " + number_text(forest.spacing) +
                                    " m: move one of them or lower the spacing");
   }
-  if (scatter && scatter_count > 0) scatter_trees(*scatter, scatter_count, forest, defaults.seed);
+  if (scatter) {
+    const ScatterSettings settings = read_scatter(*scatter, defaults.seed);
+    if (scatter_count > 0) scatter_trees(*scatter, settings, scatter_count, forest);
+  }
 
   std::unordered_map<std::string, size_t> ids;
   for (size_t i = 0; i < forest.trees.size(); ++i) {

@@ -58,6 +58,9 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, co
                             "(or a /species, which brings its own)");
   if (options.grammar && !options.productions.empty())
     section.fail("productions", "inline productions go with /lsystem/axiom, not with a grammar file (/lsystem/grammar)");
+  if (options.library_grammar && !options.productions.empty())
+    section.fail("productions", "inline productions go with /lsystem/axiom; the species' grammar has its own (give "
+                                "an axiom to grow an inline grammar instead)");
   if (axiom) options.axiom = *axiom;
   options.view = section.optional_path("view");
   if (options.view && !options.grammar) section.fail("view", "a view file goes with a grammar file (/lsystem/grammar)");

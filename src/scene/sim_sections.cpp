@@ -243,8 +243,8 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
   o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::between(0, 1000));
   o.turbulence_modes = static_cast<int>(section.integer("turbulence_modes", o.turbulence_modes, 1, 64));
   o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::between(0, 10));
-  o.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0,
-                                                 std::numeric_limits<long long>::max()));
+  // At most 2^53, as every seed: the largest integer JSON keeps exact.
+  o.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
   // Read only when given, so that a scene without it resolves as before.
   if (section.has("volume")) o.volume = read_volume_options(section.object("volume"));
   return o;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -111,6 +113,25 @@ std::string metres(double value) {
   return out.str();
 }
 
+// `parent`'s /tree/scale when it is a number > 0 (anything else is left to the tree's reader,
+// which refuses it).
+std::optional<double> given_scale(SceneObject& parent) {
+  const Json* tree = parent.raw("tree");
+  if (!tree || !tree->is_object()) return std::nullopt;
+  const auto scale = tree->find("scale");
+  if (scale == tree->end() || !scale->is_number()) return std::nullopt;
+  const double value = scale->get<double>();
+  return value > 0 && std::isfinite(value) ? std::optional<double>(value) : std::nullopt;
+}
+
+// A height => whether the species grows to it in the field (its range).
+bool outside_range(const Species& s, double height) { return height < s.min_height || height > s.max_height; }
+
+// => "English oak (english_oak) grows from 10 to 40 m, got ", for a refusal outside it.
+std::string range_text(const Species& s) {
+  return s.common + " (" + s.name + ") grows from " + metres(s.min_height) + " to " + metres(s.max_height) + " m, got ";
+}
+
 }  // namespace
 
 const std::vector<Species>& species_library() {
@@ -122,10 +143,23 @@ std::optional<SpeciesChoice> read_species(SceneObject& parent) {
   const Json* value = parent.raw("species");
   if (!value) return std::nullopt;
   SpeciesChoice choice;
+  // A /tree/scale without a height sets the size as the height does: the height it grows the
+  // preset to (its scale is the default height's), which the resolved scene records.
+  const std::optional<double> scale = given_scale(parent);
+  auto scaled_height = [&](const Species& s) {
+    const double height = s.default_height * (*scale / s.tree.scale);
+    if (outside_range(s, height))
+      parent.object("tree").fail("scale", range_text(s) + metres(height) + " m from a scale of " + metres(*scale) +
+                                              ": give a scale from " +
+                                              metres(s.tree.scale * s.min_height / s.default_height) + " to " +
+                                              metres(s.tree.scale * s.max_height / s.default_height) +
+                                              ", or the species' height");
+    return height;
+  };
   if (value->is_string()) {
     choice.species = find_species(value->get<std::string>());
     if (!choice.species) fail_unknown(parent, "species", value->get<std::string>());
-    choice.height = choice.species->default_height;
+    choice.height = scale ? scaled_height(*choice.species) : choice.species->default_height;
     return choice;
   }
   if (!value->is_object())
@@ -137,16 +171,19 @@ std::optional<SpeciesChoice> read_species(SceneObject& parent) {
   if (!choice.species) fail_unknown(section, "name", *name);
   const Species& s = *choice.species;
   choice.height_given = section.has("height");
-  choice.height = section.number("height", s.default_height, Range::positive());
-  if (choice.height < s.min_height || choice.height > s.max_height)
-    section.fail("height", s.common + " (" + s.name + ") grows from " + metres(s.min_height) + " to " +
-                               metres(s.max_height) + " m, got " + metres(choice.height));
+  choice.height = section.number("height", scale && !choice.height_given ? scaled_height(s) : s.default_height,
+                                 Range::positive());
+  if (outside_range(s, choice.height)) section.fail("height", range_text(s) + metres(choice.height));
   return choice;
 }
 
 void check_species_scale(const SpeciesChoice& choice, SceneObject tree) {
   const Json* scale = tree.raw("scale");
-  if (choice.height_given && scale && !(scale->is_number() && scale->get<double>() == species_tree(choice).scale))
+  // A resolved scene records both; its height came from the scale or the scale from it, each
+  // to the round-off of the other's quotient.
+  const double grown = species_tree(choice).scale;
+  if (choice.height_given && scale &&
+      !(scale->is_number() && std::abs(scale->get<double>() - grown) <= 1e-12 * grown))
     tree.fail("scale", "the species' height sets the tree's size: give the height or the scale, not both");
 }
 

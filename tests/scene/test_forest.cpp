@@ -95,6 +95,18 @@ TEST(Forest, ListedAndScatteredTrees) {
   }
 }
 
+// A scatter of no trees (a count set to 0 to leave it out for a while) holds the keys of one of
+// more, checked as they are there, and places nothing.
+TEST(Forest, ScatterOfNoTreesKeepsItsKeys) {
+  const Scene scene = load(R"({"trees": [{}], "scatter": {"count": 0, "min": [-10, -10], "max": [10, 10],
+      "seed": 3, "attempts": 50, "rotation": [0, 90], "scale": [0.5, 2]}})");
+  EXPECT_EQ(scene.forest->trees.size(), 1u);
+  EXPECT_EQ(error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0], "max": [1, 1], "scale": [2, 1]}})"),
+            "f.json: /forest/scatter/scale: expected [lo, hi] with lo <= hi, got [2,1]");
+  EXPECT_EQ(error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0]}})"),
+            "f.json: /forest/scatter/max: expected the area's corners min and max, each [x, z] in m");
+}
+
 TEST(Forest, TreeSceneIsTheTreesOwnScene) {
   const Scene scene = load(R"({"variants": [{"name": "a"}, {"name": "b", "lsystem": {"axiom": "FF", "iterations": 0},
       "tree": {"ring_sides": 5}}], "trees": [{"id": "x"}, {"id": "y", "variant": "b", "scale": 2, "seed": 9}]})",

@@ -78,6 +78,30 @@ TEST(SpeciesScene, HeightGrowsEveryLengthAndTheResolvedSceneBakesTheSameTree) {
   EXPECT_EQ(again.resolved, scene.resolved);
 }
 
+// A /tree/scale without a height sets the size as the height does, in either form of the choice,
+// and the resolved scene (which records both) loads again to the same tree.
+TEST(SpeciesScene, AScaleWithoutAHeightGrowsTheWholePreset) {
+  const Species& oak = named("english_oak");
+  ASSERT_EQ(oak.tree.scale, 1.0);
+  const double factor = 1.25;  // 22.5 m, within the oak's 10-28
+  for (const std::string species : {R"("english_oak")", R"({"name": "english_oak"})"}) {
+    const Scene scene = load(R"({"species": )" + species + R"(, "tree": {"scale": 1.25}})");
+    EXPECT_EQ(scene.tree.scale, 1.25) << species;
+    EXPECT_DOUBLE_EQ(scene.tree.leaf.size, oak.tree.leaf.size * factor) << species;
+    EXPECT_DOUBLE_EQ(scene.tree.trunk_radius, oak.tree.trunk_radius * factor) << species;
+    const Scene again = load(scene.resolved.dump());
+    EXPECT_EQ(again.tree.scale, scene.tree.scale) << species;
+    EXPECT_EQ(again.tree.leaf.size, scene.tree.leaf.size) << species;
+    EXPECT_EQ(again.tree.trunk_radius, scene.tree.trunk_radius) << species;
+    EXPECT_EQ(again.resolved, scene.resolved) << species;
+  }
+  std::ostringstream range;
+  range << "/tree/scale: English oak (english_oak) grows from " << oak.min_height << " to " << oak.max_height
+        << " m, got ";
+  EXPECT_NE(input_error_of([&] { load(R"({"species": "english_oak", "tree": {"scale": 100}})"); }).find(range.str()),
+            std::string::npos);
+}
+
 TEST(SpeciesScene, ForestVariantsOfSeveralSpeciesEachKeepTheirWood) {
   const Scene forest = load(R"({"hsm": {"precision": "float"}, "forest": {
       "variants": [{"name": "oak", "species": "english_oak"},
@@ -127,6 +151,11 @@ TEST(SpeciesScene, BadChoicesNameThePointerAndWhatIsExpected) {
             std::string::npos);
   EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "english_oak", "height": 15}, "tree": {"scale": 2}})"); })
                 .find("/tree/scale: the species' height sets the tree's size"),
+            std::string::npos);
+  // Productions beside a species and no axiom would be left unread: the species' grammar grows.
+  EXPECT_NE(input_error_of([] { load(R"({"species": "english_oak", "lsystem": {"productions": ["F --> FF"]}})"); })
+                .find("/lsystem/productions: inline productions go with /lsystem/axiom; the species' grammar has its "
+                      "own (give an axiom to grow an inline grammar instead)"),
             std::string::npos);
   EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "english_oak", "heigth": 15}})"); })
                 .find("/species/heigth: unknown key (did you mean /species/height?)"),
