@@ -1,9 +1,11 @@
 #include "bake/bake_forest.h"
 
+#include <csignal>
 #include <system_error>
 
 #include "bake/bake_tree.h"
 #include "bake/forest_manifest.h"
+#include "bake/signals.h"
 #include "common/errors.h"
 
 namespace treeanim {
@@ -15,6 +17,12 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
   const Forest& forest = *scene.forest;
   ForestBakeResult result;
   for (size_t i = 0; i < trees.size(); ++i) {
+    // A signal while the last tree finished: the trees baked so far stay whole.
+    if (const int signal_number = pending_signal()) {
+      log.interrupted(signal_number, -1);
+      result.exit_code = signal_number == SIGINT ? kExitSigint : kExitSigterm;
+      return result;
+    }
     const ForestTree& tree = forest.trees[trees[i]];
     const Scene one = tree_scene(scene, trees[i]);
     std::string why;
@@ -32,13 +40,17 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
       result.exit_code = baked.exit_code;
       return result;
     }
-    write_tree_part(config, scene, trees[i], one, baked);
+    {
+      const DeferredInterrupts deferred;  // the part is written whole
+      write_tree_part(config, scene, trees[i], one, baked);
+    }
     // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent.
     std::error_code ignored;
     if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
     ++result.baked;
   }
   if (config.shard) return result;
+  const DeferredInterrupts deferred;  // the manifest is written whole
   const GatherReport report = gather_forest(scene, config.out_dir, config.generator);
   if (!report.missing.empty())  // a file removed while the forest baked
     throw OutputError(forest.trees[report.missing.front()].id + ": " + report.reasons.front());

@@ -16,7 +16,8 @@ struct BakeLog {
   std::function<void(long long total)> frames_begin = [](long long) {};  // the frame loop will simulate `total`
   std::function<void(long long done)> frame_done = [](long long) {};     // `done` frames of the loop are complete
   std::function<void()> frames_end = [] {};                              // the loop ended or was interrupted
-  std::function<void(int signal, long long frame)> interrupted = [](int, long long) {};  // outputs already removed
+  // Outputs already removed; frame -1: between two trees of a forest, whose baked trees stay.
+  std::function<void(int signal, long long frame)> interrupted = [](int, long long) {};
   std::function<void(const TreeBakeResult&)> baked = [](const TreeBakeResult&) {};      // a tree's outputs are final
   // A forest: tree `tree`, the `i`th (from 0) of the `count` this process bakes, is next;
   // `complete`: its part says it is baked already, and it is skipped.

@@ -238,6 +238,8 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   PreparedTree tree = prepare_tree(scene, give_up_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt);
   tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
+  // From the outputs' locks on, a signal waits for the frame loop, which removes what they made.
+  const DeferredInterrupts deferred;
   BakeFrames frames(scene, config, plan, tree.model, placement);
   frames.sampled = sampled;
   frames.cluster_motions = sampled && frames.outputs.wants_cluster_motions();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bake/signals.h"
+
 namespace treeanim {
 
 namespace {
@@ -34,6 +36,8 @@ LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, 
     SeamMeter period;
     period.add(boundary);
     for (long long k = 1; k <= frames; ++k) {
+      // Interrupted: the frame loop that follows stops at once and removes the outputs.
+      if (pending_signal()) return warmup;
       simulator.advance_frame(state, first + k);
       period.add(positions_of(state));
     }

@@ -25,7 +25,7 @@ struct LoopWarmup {
 
 // Runs `frames`-frame periods from `state` (at the loop's first frame `first`) until a period
 // changes the state by at most kLoopRepeatChange, at most kMaxLoopWarmupPeriods. Notes each
-// period on `log`.
+// period on `log`. Returns as soon as a signal is pending (bake/signals.h).
 LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log);
 
 // The seam of a baked loop: the step from its last frame back to its first, against the median

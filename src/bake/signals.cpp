@@ -1,14 +1,36 @@
 #include "bake/signals.h"
 
+#include <unistd.h>
+
+#include <atomic>
 #include <csignal>
+
+#include "common/errors.h"
 
 namespace treeanim {
 
 namespace {
 
 volatile std::sig_atomic_t received_signal = 0;
+// Spans alive (DeferredInterrupts); a lock-free atomic, so the handler may read it.
+std::atomic<int> deferring{0};
+static_assert(std::atomic<int>::is_always_lock_free);
 
-extern "C" void record_signal(int signal_number) { received_signal = signal_number; }
+// Only async-signal-safe calls here: write and _exit.
+extern "C" void record_signal(int signal_number) {
+  if (deferring.load() > 0) {
+    received_signal = signal_number;
+    return;
+  }
+  static constexpr char kSigint[] =
+      "treeanim: interrupted by SIGINT while no output was open; none was left half-written\n";
+  static constexpr char kSigterm[] =
+      "treeanim: interrupted by SIGTERM while no output was open; none was left half-written\n";
+  const bool sigint = signal_number == SIGINT;
+  [[maybe_unused]] const ssize_t written =
+      write(STDERR_FILENO, sigint ? kSigint : kSigterm, sigint ? sizeof kSigint - 1 : sizeof kSigterm - 1);
+  _exit(sigint ? kExitSigint : kExitSigterm);
+}
 
 }  // namespace
 
@@ -25,5 +47,9 @@ void install_interrupt_handlers() {
 }
 
 int pending_signal() { return received_signal; }
+
+DeferredInterrupts::DeferredInterrupts() { deferring.fetch_add(1); }
+
+DeferredInterrupts::~DeferredInterrupts() { deferring.fetch_sub(1); }
 
 }  // namespace treeanim

@@ -1,7 +1,10 @@
 #pragma once
-// SIGINT / SIGTERM during a bake: the handler only records the signal; the frame loop
-// (run_frames) polls it between frames, aborts the outputs (removing temporaries) and the
-// command exits 130 / 143.
+// SIGINT / SIGTERM. While a bake holds files it must clean up (its outputs' locks, folders and
+// temporaries, its journal and checkpoints: a DeferredInterrupts span), the handler only
+// records the signal; the frame loop (run_frames) polls it between frames, aborts the outputs
+// (removing temporaries) and the command exits 130 / 143. Outside such a span nothing of the
+// bake is on disk, so the signal ends the process at once with the same code: reading the
+// scene and growing the tree (an L-system can take minutes to derive) stop as soon as asked.
 
 namespace treeanim {
 
@@ -9,5 +12,14 @@ namespace treeanim {
 void install_interrupt_handlers();
 // The signal number received since installation, or 0.
 int pending_signal();
+
+// While one lives, a signal is recorded for pending_signal() instead of ending the process.
+class DeferredInterrupts {
+ public:
+  DeferredInterrupts();
+  ~DeferredInterrupts();
+  DeferredInterrupts(const DeferredInterrupts&) = delete;
+  DeferredInterrupts& operator=(const DeferredInterrupts&) = delete;
+};
 
 }  // namespace treeanim

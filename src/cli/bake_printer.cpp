@@ -26,8 +26,13 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
   log_.frame_done = [this](long long done) { progress_->update(done); };
   log_.frames_end = [this] { progress_->finish(); };
   log_.interrupted = [this](int signal_number, long long frame) {
-    std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept%s\n",
-                 signal_number == SIGINT ? "SIGINT" : "SIGTERM", frame,
+    const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+    if (frame < 0) {
+      std::fprintf(stderr, "treeanim: interrupted by %s between two trees; the trees baked are kept (--resume "
+                   "skips them)\n", name);
+      return;
+    }
+    std::fprintf(stderr, "treeanim: interrupted by %s at frame %lld; no output was kept%s\n", name, frame,
                  config_.checkpoints.every > 0 ? " (--resume continues from the last checkpoint)" : "");
   };
   if (quiet) return;
@@ -44,10 +49,16 @@ void BakePrinter::print_summary(const TreeBakeResult& result) const {
   for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
   if (!result.loop) return;
   const LoopSummary& loop = *result.loop;
-  std::printf("  loop: %d warm-up period%s%s; seam %.3g m, %.2f x the median frame step (%.3g m)\n",
-              loop.warmup.periods, loop.warmup.periods == 1 ? "" : "s",
-              loop.warmup.converged || loop.resumed ? "" : " (the motion did not repeat: baked as it stands)",
-              loop.seam, loop.median_step > 0 ? loop.seam / loop.median_step : 0.0, loop.median_step);
+  // A resumed bake starts from a checkpoint of the warmed-up state: the run that wrote it warmed up.
+  char warmup[96];
+  if (loop.resumed)
+    std::snprintf(warmup, sizeof warmup, "warmed up before the checkpoint it resumed from");
+  else
+    std::snprintf(warmup, sizeof warmup, "%d warm-up period%s%s", loop.warmup.periods,
+                  loop.warmup.periods == 1 ? "" : "s",
+                  loop.warmup.converged ? "" : " (the motion did not repeat: baked as it stands)");
+  std::printf("  loop: %s; seam %.3g m, %.2f x the median frame step (%.3g m)\n", warmup, loop.seam,
+              loop.median_step > 0 ? loop.seam / loop.median_step : 0.0, loop.median_step);
 }
 
 void BakePrinter::print_tree(size_t i, size_t count, size_t index, bool complete) const {

@@ -64,7 +64,9 @@ void adopt_leaf_flags(const SolverModel<Real>& model, const SimState& state, Att
   sum_drag_areas(model, attachment);
 }
 
-// The drag on a leaf is summed over its own vertices in membership order (fixed order).
+// The drag on a leaf is summed over its own vertices in membership order (fixed order). A leaf
+// held by the ground (drawn before any segment: its petiole is anchored where it was drawn)
+// never lets go: an anchored vertex cannot fly, and a leaf flying from it would stretch.
 template <typename Real>
 void detach_leaves(const SolverModel<Real>& model, Attachment<Real>& attachment, SimState& state,
                    StepScratch<Real>& scratch) {
@@ -72,7 +74,7 @@ void detach_leaves(const SolverModel<Real>& model, Attachment<Real>& attachment,
   const Rows3<Real>& drag_force = state.prediction<Real>().drag_force;
   bool detached = false;
   for (size_t l = 0; l < model.L; ++l) {
-    if (!state.leaf_attached[l]) continue;
+    if (!state.leaf_attached[l] || tree.vertex_anchored[tree.leaf_attachment_vertex[l]]) continue;
     const uint32_t c = tree.leaf_cluster[l];
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     for (uint32_t s = tree.cluster_offsets[c]; s < tree.cluster_offsets[c + 1]; ++s) {

@@ -297,6 +297,27 @@ def interrupted(signal_number, code, name):
     return scenario
 
 
+def interrupted_while_growing(bake):
+    """SIGTERM while an L-system derives for minutes (a binary tree of 40 steps, stopped only by
+    max_modules): the bake stops at once, 143, before it opened anything (no out/ at all)."""
+    grow = ["--set", "lsystem={\"axiom\": \"A\", \"productions\": [\"A --> [+A][-A]FA\"], \"iterations\": 40, "
+            "\"max_modules\": 500000000}"]
+    process = bake.start(3, grow)
+    time.sleep(1.0)
+    if process.poll() is not None:
+        raise Failed("the derivation ended within a second: %s" % process.communicate()[1][-2000:])
+    process.send_signal(signal.SIGTERM)
+    try:
+        _, stderr = process.communicate(timeout=5)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        raise Failed("the growing bake did not stop within 5 s of SIGTERM")
+    expect(subprocess.CompletedProcess(process.args, process.returncode, "", stderr), 143,
+           "interrupted by SIGTERM while no output was open; none was left half-written", bake.out)
+    if os.path.exists(bake.out):
+        raise Failed("the output folder was made: %s" % folders_under(bake.out))
+
+
 def folders_under(folder):
     """folder => every folder below it, itself included (relative paths); [] when absent."""
     return sorted(os.path.relpath(root, folder) for root, _, _ in os.walk(folder))
@@ -503,6 +524,7 @@ SCENARIOS = {
     "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
     "sigterm": interrupted(signal.SIGTERM, 143, "SIGTERM"),
     "interrupted-removes-made-folders": interrupted_removes_made_folders,
+    "interrupted-while-growing": interrupted_while_growing,
     "wind-file-deleted": wind_file_deleted,
     "wind-file-truncated": wind_file_truncated,
     "wind-file-deleted-mid-bake": wind_file_deleted_mid_bake,

@@ -201,6 +201,39 @@ TEST(Behaviour, DetachedLeavesFallAndNeverComeBack) {
   EXPECT_LT(detached, model.leaf_count());  // the weakest gusts leave some leaves on
 }
 
+// A leaf drawn before any segment is anchored at its petiole, where it was drawn: held by the
+// ground, it stays on and rigid in a gale that strips the leaves of the stem.
+TEST(Behaviour, ALeafHeldByTheGroundNeverDetaches) {
+  LsystemOptions lsystem;
+  lsystem.axiom = "L(1)[+(90)L(1)]!(0.05)F(1)F(1)L(1)";
+  lsystem.iterations = 0;
+  const TreeModel model = build_tree_model(grow_skeleton(lsystem, nullptr), TreeOptions{});
+  ASSERT_EQ(model.leaf_count(), 3u);
+  HsmOptions options;
+  options.leaf_detach_force = 1e-4;  // N
+  Simulator sim(model, options, gust_then_calm(25, 2, 3), 1.0 / 24, 4);
+  SimState state = sim.initial_state(0);
+  for (int f = 1; f <= 48; ++f) sim.advance_frame(state, f);
+  size_t grounded = 0;
+  for (size_t l = 0; l < model.leaf_count(); ++l) {
+    if (!model.vertex_anchored[model.leaf_attachment_vertex[l]]) {
+      EXPECT_EQ(state.leaf_attached[l], 0) << "leaf " << l << " of the stem";
+      continue;
+    }
+    ++grounded;
+    EXPECT_EQ(state.leaf_attached[l], 1) << "leaf " << l;
+    const uint32_t c = model.leaf_cluster[l];
+    for (uint32_t i = model.cluster_offsets[c]; i < model.cluster_offsets[c + 1]; ++i)
+      for (uint32_t j = model.cluster_offsets[c]; j < i; ++j) {
+        const uint32_t a = model.cluster_members[i], b = model.cluster_members[j];
+        EXPECT_NEAR((state.positions.col(a) - state.positions.col(b)).norm(),
+                    (model.rest_positions.col(a) - model.rest_positions.col(b)).norm(), 1e-3)
+            << "leaf " << l << ", vertices " << a << " and " << b;
+      }
+  }
+  EXPECT_EQ(grounded, 2u);
+}
+
 TEST(Behaviour, NoDetachmentByDefault) {
   const TreeModel model = testing::small_tree(6);
   Simulator sim(model, HsmOptions{}, gust_then_calm(40, 2, 2.5), 1.0 / 24, 4);
