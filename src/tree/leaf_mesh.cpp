@@ -6,8 +6,11 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <span>
+#include <string>
+#include <vector>
 
 #include "common/errors.h"
 #include "tree/tree_build_steps.h"
@@ -59,6 +62,28 @@ void append_ai_mesh(const aiMesh& mesh, std::vector<Eigen::Vector3d>& points,
   }
 }
 
+// An imported scene => InputError naming `file` unless every point is finite and every face
+// has as many distinct corners as it has indices, each a point of its mesh.
+void check_ai_meshes(const aiScene& scene, const std::string& file) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene.mMeshes[m];
+    for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
+      const aiVector3D& v = mesh.mVertices[i];
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        throw InputError(file + ": leaf mesh point " + std::to_string(i) + " is not finite");
+    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      std::vector<unsigned> corners(face.mIndices, face.mIndices + face.mNumIndices);
+      std::sort(corners.begin(), corners.end());
+      if (corners.empty() || corners.back() >= mesh.mNumVertices ||
+          std::adjacent_find(corners.begin(), corners.end()) != corners.end())
+        throw InputError(file + ": leaf mesh face " + std::to_string(f) +
+                         " has no corners, a corner past the last point or one corner twice");
+    }
+  }
+}
+
 }  // namespace
 
 LeafTemplate default_leaf_template(const LeafOptions& options) {
@@ -91,9 +116,16 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
                                   aiComponent_COLORS | aiComponent_BONEWEIGHTS |
                                   aiComponent_ANIMATIONS | aiComponent_LIGHTS |
                                   aiComponent_CAMERAS | aiComponent_MATERIALS);
-  const aiScene* scene = importer.ReadFile(
-      file, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                aiProcess_JoinIdenticalVertices);
+  // What the file holds is checked before any step reads it (the importer's own check, then
+  // every corner a point of the mesh and every point finite): a damaged file whose faces
+  // point past its vertices or whose polygons are cut short is refused here, not followed
+  // into the triangulation, which asserts on them.
+  const aiScene* scene = importer.ReadFile(file, aiProcess_ValidateDataStructure);
+  if (!scene || !scene->mRootNode)
+    throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
+  check_ai_meshes(*scene, file);
+  scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                       aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   std::vector<Eigen::Vector3d> points;

@@ -1,5 +1,6 @@
 // Leaves: default quad, '{ . }' outlines, custom meshes through assimp, the turtle's meshes.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -184,6 +185,37 @@ TEST(TreeLeaves, UnreadableMeshIsAnInputErrorNamingTheFile) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_leaf.obj: cannot read leaf mesh"), std::string::npos) << e.what();
   }
+}
+
+// Damaged meshes are refused with the file's name before the importer's triangulation reads
+// them (a PLY cut short crashed it; a binary PLY's index past its points made it read
+// anywhere; a NaN point reached the bake).
+TEST(TreeLeaves, DamagedMeshIsAnInputErrorNamingTheFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("treeanim_damaged_leaf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::pair<std::string, std::string> files[] = {
+      {"short.ply", ply_header + "0 0 0\n"},
+      {"index.ply", ply_header + "0 0 0\n0 1 0\n1 1 0\n3 0 1 2000000000\n"},
+      {"twice.ply", ply_header + "0 0 0\n0 1 0\n1 1 0\n4 0 1 1 2\n"},
+      {"nan.obj", "v 0 0 0\nv 0 1 0\nv nan 1 0\nf 1 2 3\n"},
+  };
+  for (const auto& [name, text] : files) {
+    std::ofstream(dir / name) << text;
+    TreeOptions o;
+    o.leaf.mesh = dir / name;
+    try {
+      build_tree_model(test::small_tree(), o);
+      ADD_FAILURE() << name << ": expected InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(name + ": "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("leaf mesh"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
