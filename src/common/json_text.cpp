@@ -113,6 +113,9 @@ Json parse_json_text(const std::string& text, const std::string& name, const std
                                            std::to_string(depth_used) + " of them)"
                                      : std::string()) +
                      "; no scene needs more");
+  // The parser takes a NUL byte for the end of the text and would ignore what follows it.
+  if (const size_t nul = text.find('\0'); nul != std::string::npos)
+    throw JsonSyntaxError(name + ":" + line_column(text, nul) + ": JSON syntax error: a NUL byte, which JSON text cannot hold");
   Json document;
   try {
     document = Json::parse(text, nullptr, true, /*ignore_comments=*/false);

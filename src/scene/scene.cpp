@@ -196,6 +196,7 @@ Scene load_scene_text(const std::string& text, const std::string& name,
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   std::string text, reason;
+  if (file.empty()) throw InputError("the scene file's path is empty: expected a scene file (.json)");
   if (!read_text_file(file, text, reason)) {
     const std::filesystem::path shown = std::filesystem::absolute(file).lexically_normal();
     throw InputError(shown.string() + ": cannot read the scene file (" + reason + ")");

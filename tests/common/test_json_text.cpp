@@ -48,6 +48,14 @@ TEST(JsonText, BracketsInStringsDoNotNest) {
   EXPECT_EQ(error_of("{\"a\": \"" + std::string(1000, '[') + "\\\"{\"}"), "");
 }
 
+// The parser would end the text at a NUL byte and take the scene before it, garbage after.
+TEST(JsonText, ANulByteIsRefusedWhereItStands) {
+  EXPECT_EQ(error_of(std::string("{\"seed\": 3}\n\0garbage{{", 22)),
+            "s.json:2:1: JSON syntax error: a NUL byte, which JSON text cannot hold");
+  EXPECT_EQ(error_of(std::string("{\"seed\": \0 3}", 14)),
+            "s.json:1:10: JSON syntax error: a NUL byte, which JSON text cannot hold");
+}
+
 TEST(JsonText, RepeatedKeysAreRefusedWithTheirPointerAndLines) {
   EXPECT_EQ(error_of("{\"seed\": 3,\n \"time\": {},\n \"seed\": 7}"),
             "s.json:3:2: /seed: duplicate key (first at line 1, again at line 3); keep one of them");
