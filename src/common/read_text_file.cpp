@@ -30,6 +30,13 @@ bool read_text_file(const std::filesystem::path& path, std::string& text, std::s
     if (text.size() > max_bytes) return fail(too_large);
   }
   if (in.bad()) return fail("not a readable file");
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
+  if (text.find('\r') != std::string::npos) {
+    size_t kept = 0;
+    for (size_t i = 0; i < text.size(); ++i)
+      if (!(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) text[kept++] = text[i];
+    text.resize(kept);
+  }
   return true;
 }
 

@@ -23,11 +23,21 @@ std::filesystem::path write_temp(const std::string& name, const std::string& con
 TEST(ReadTextFile, ReadsTheWholeFileBinarySafe) {
   std::string content(200000, 'x');
   content[7] = '\0';
-  content += "\r\nend";
+  content += "\rend\n";
   const auto path = write_temp("treeanim-read-whole", content);
   std::string text, reason;
   EXPECT_TRUE(read_text_file(path, text, reason));
   EXPECT_EQ(text, content);
+  std::filesystem::remove(path);
+}
+
+// A file saved on Windows: its byte-order mark goes and its CRLF line ends become LF, so a
+// grammar's line ends where a Linux one does; a lone CR stays.
+TEST(ReadTextFile, ReadsWindowsTextAsLinuxText) {
+  const auto path = write_temp("treeanim-read-windows", "\xEF\xBB\xBF" "axiom: F\r\nF --> FF\r\n\r\na\rb\r");
+  std::string text, reason;
+  EXPECT_TRUE(read_text_file(path, text, reason));
+  EXPECT_EQ(text, "axiom: F\nF --> FF\n\na\rb\r");
   std::filesystem::remove(path);
 }
 
