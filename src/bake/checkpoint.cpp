@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <system_error>
 
+#include "bake/scene_hash.h"
 #include "common/errors.h"
 #include "files/io_failure.h"
 #include "files/staged_files.h"
@@ -20,7 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kFormat = "treeanim-checkpoint";
-constexpr int32_t kFormatVersion = 3;  // 2: the prediction keeps its goal offsets; 3: and its damping terms
+// 2: the prediction keeps its goal offsets; 3: and its damping terms; 4: the state's digest.
+constexpr int32_t kFormatVersion = 4;
 
 // A variable-length UTF-8 string type, or -1.
 hid_t make_string_type() {
@@ -71,6 +73,7 @@ class CheckpointFile {
     for (hsize_t d : dims) total *= d;
     if (total > 0)
       check(H5Dwrite(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), std::string("write /state/") + name);
+    digest_ = fnv1a64(digest_, data, total * H5Tget_size(memory_type));
   }
 
   // --- reading ---
@@ -109,11 +112,18 @@ class CheckpointFile {
     for (hsize_t d : dims) total *= d;
     if (total > 0)
       check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), std::string("read /state/") + name);
+    digest_ = fnv1a64(digest_, data, total * H5Tget_size(memory_type));
   }
+
+  // The digest of every array written or read so far and of the values folded in, in order
+  // (the file's state_digest).
+  uint64_t digest() const { return digest_; }
+  void fold(const void* data, size_t bytes) const { digest_ = fnv1a64(digest_, data, bytes); }
 
  private:
   fs::path path_;
   bool reading_;
+  mutable uint64_t digest_ = kFnv1aStart;
 };
 
 // fsync of a file or folder; false when it failed.
@@ -218,6 +228,8 @@ void write_checkpoint(const fs::path& path, const SimState& state, long long fra
     file.attribute(root, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &state.time);
     file.string_attribute(root, "precision", key.float_precision ? "float" : "double");
     file.attribute(root, "predicted", H5T_STD_U8LE, H5T_NATIVE_UINT8, &predicted);
+    file.fold(&frame_index, sizeof frame_index), file.fold(&state.time, sizeof state.time);
+    file.fold(&predicted, sizeof predicted);
     Handle group(file.check(H5Gcreate2(root, "/state", H5P_DEFAULT, untimed_creation(H5P_GROUP_CREATE).get(), H5P_DEFAULT),
                             "create /state"), H5Gclose);
     const hid_t g = group.get();
@@ -236,6 +248,8 @@ void write_checkpoint(const fs::path& path, const SimState& state, long long fra
     else
       write_prediction(file, g, state.prediction_double, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);
     group.reset();
+    const uint64_t digest = file.digest();
+    file.attribute(root, "state_digest", H5T_STD_U64LE, H5T_NATIVE_UINT64, &digest);
     if (!handle.reset()) file.fail("close the file");
   } catch (...) {
     fs::remove(temporary, error);
@@ -281,7 +295,11 @@ std::pair<long long, SimState> read_checkpoint(const fs::path& path, const Check
   SimState state = shape;
   const long long frame = file.read_attribute<int64_t>(root, "frame", H5T_NATIVE_INT64);
   state.time = file.read_attribute<double>(root, "time", H5T_NATIVE_DOUBLE);
-  state.predicted = file.read_attribute<uint8_t>(root, "predicted", H5T_NATIVE_UINT8) != 0;
+  const uint8_t predicted = file.read_attribute<uint8_t>(root, "predicted", H5T_NATIVE_UINT8);
+  state.predicted = predicted != 0;
+  const int64_t frame_index = frame;
+  file.fold(&frame_index, sizeof frame_index), file.fold(&state.time, sizeof state.time);
+  file.fold(&predicted, sizeof predicted);
   Handle group(file.check(H5Gopen2(root, "/state", H5P_DEFAULT), "open /state"), H5Gclose);
   const hid_t g = group.get();
   const hsize_t V = shape.positions.cols(), C = shape.cluster_rotations.cols();
@@ -296,6 +314,10 @@ std::pair<long long, SimState> read_checkpoint(const fs::path& path, const Check
     read_prediction(file, g, shape.prediction_float, state.prediction_float, H5T_NATIVE_FLOAT);
   else
     read_prediction(file, g, shape.prediction_double, state.prediction_double, H5T_NATIVE_DOUBLE);
+  const uint64_t digest = file.read_attribute<uint64_t>(root, "state_digest", H5T_NATIVE_UINT64);
+  if (digest != file.digest())
+    throw InputError(path.string() + ": not a readable checkpoint: its state does not match the digest it was "
+                                     "written with (damaged on disk; delete it to resume from the one before)");
   if (!state.positions.allFinite() || !state.velocities.allFinite())
     throw InputError(path.string() + ": the state holds non-finite positions or velocities");
   return {frame, std::move(state)};

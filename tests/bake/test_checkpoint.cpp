@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cstring>
 #include <fstream>
@@ -133,6 +134,38 @@ TEST(Checkpoint, RefusesAnotherSceneADamagedFileAndAnotherTree) {
                 .find("the checkpoint belongs to another tree"),
             std::string::npos);
   EXPECT_TRUE(list_checkpoints(dir / "missing").empty());
+}
+
+// One value of a dataset changed in place, the file still HDF5 (a disk's silent damage): the
+// digest of the state finds it, where the bake resumed from the wrong state and wrote it.
+TEST(Checkpoint, RefusesAStateThatNoLongerMatchesItsDigest) {
+  const TreeModel model = testing::grown_tree(4, 1, 4);
+  const ScratchDir scratch("digest");
+  Simulator sim(model, HsmOptions{}, gale(), 1.0 / 24, 2);
+  SimState state = sim.initial_state(0);
+  for (int f = 1; f <= 30; ++f) sim.advance_frame(state, f);
+  const CheckpointKey key{scene_hash("{}", "treeanim 1"), "treeanim 1", false};
+  for (const char* dataset : {"/state/positions", "/state/prediction_velocity"}) {
+    SCOPED_TRACE(dataset);
+    const fs::path path = checkpoint_path(scratch.path, 30);
+    write_checkpoint(path, state, 30, key);
+    EXPECT_EQ(read_checkpoint(path, key, state).first, 30);
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hid_t data = H5Dopen2(file, dataset, H5P_DEFAULT);
+    ASSERT_GE(data, 0);
+    const hid_t space = H5Dget_space(data);
+    std::vector<double> values(size_t(H5Sget_simple_extent_npoints(space)));
+    H5Sclose(space);
+    ASSERT_GE(H5Dread(data, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+    values[values.size() / 2] += 1e-3;
+    ASSERT_GE(H5Dwrite(data, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+    H5Dclose(data);
+    H5Fclose(file);
+    EXPECT_EQ(input_error([&] { read_checkpoint(path, key, state); }),
+              path.string() + ": not a readable checkpoint: its state does not match the digest it was written "
+                              "with (damaged on disk; delete it to resume from the one before)");
+  }
 }
 
 TEST(FrameJournal, KeepsWholeRecordsAndTruncatesToTheCheckpoint) {
