@@ -19,6 +19,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Wind speed and gust amplitude, m/s: no recorded gust exceeds 113 m/s (Barrow Island, 1996), so a
 // larger value is a slip (1,000,000 for 10), not a storm.
 const Range kWindSpeed = Range::between(0, kMaxWindSpeed);
+// A wind key's time, s: a bake reaches 10^9 frames from 0 (time.start) at 1 fps or more, and
+// within this range the time between two keys, which the air divides by, stays finite.
+const Range kWindTime = Range::between(-1e10, 1e10);
 
 // A solver frequency, rad/s: at the shortest step the time keys allow (1000 fps, 10,000 substeps)
 // the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
@@ -192,7 +195,7 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
       throw InputError(where + ": expected " + std::to_string(columns) + " comma-separated values, got " +
                        std::to_string(cells.size()));
     WindKey key;
-    key.time = csv_number(cells[0], where, "time");
+    key.time = csv_number(cells[0], where, "time", kWindTime);
     key.speed = csv_number(cells[1], where, "speed", kWindSpeed);
     const Eigen::Vector3d d(csv_number(cells[2], where, "dx"), csv_number(cells[3], where, "dy"),
                             csv_number(cells[4], where, "dz"));
@@ -220,7 +223,7 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
   for (size_t i = 0; i < key_objects.size(); ++i) {
     SceneObject& k = key_objects[i];
     WindKey key;
-    key.time = k.number("time", 0, Range::any());
+    key.time = k.number("time", 0, kWindTime);
     key.speed = k.number("speed", 0, kWindSpeed);
     const auto direction = unit(k.vector3("direction", key.direction));
     if (!direction) k.fail("direction", "expected a non-zero vector");
@@ -239,7 +242,8 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
   o.branch_drag_coefficient = section.number("branch_drag_coefficient", o.branch_drag_coefficient, Range::between(0, 10));
   o.leaf_drag_coefficient = section.number("leaf_drag_coefficient", o.leaf_drag_coefficient, Range::between(0, 10));
   o.turbulence_intensity = section.number("turbulence_intensity", o.turbulence_intensity, Range::between(0, 10));
-  o.turbulence_length = section.number("turbulence_length", o.turbulence_length, {0, 1000, true, false});
+  // At least a millimetre, below any leaf: a length near 0 makes the eddies' wavenumbers overflow.
+  o.turbulence_length = section.number("turbulence_length", o.turbulence_length, Range::between(1e-3, 1000));
   o.turbulence_frequency = section.number("turbulence_frequency", o.turbulence_frequency, Range::between(0, 1000));
   o.turbulence_modes = static_cast<int>(section.integer("turbulence_modes", o.turbulence_modes, 1, 64));
   o.gust_frequency = section.number("gust_frequency", o.gust_frequency, Range::between(0, 10));
