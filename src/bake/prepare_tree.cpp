@@ -3,7 +3,9 @@
 #include <chrono>
 #include <limits>
 
+#include "common/errors.h"
 #include "common/seconds_since.h"
+#include "lsystem/lsystem.h"
 #include "sim/particle_model.h"
 #include "tree/build_tree_model.h"
 
@@ -21,7 +23,12 @@ PreparedTree prepare_tree(const Scene& scene, MeshSurface surface) {
   tree.skeleton = grow_skeleton(scene.lsystem, &tree.growth);
   tree.grow_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
-  tree.model = build_tree_model(tree.skeleton, scene.tree, surface);
+  try {
+    tree.model = build_tree_model(tree.skeleton, scene.tree, surface);
+  } catch (const TreeModelError& e) {
+    // What the model refuses comes from what the grammar drew: name it.
+    throw InputError(grammar_name(scene.lsystem) + ": the tree it draws cannot be built: " + e.what());
+  }
   tree.model_seconds = seconds_since(start);
   return tree;
 }

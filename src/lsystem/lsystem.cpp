@@ -74,6 +74,11 @@ ViewSettings load_view(const LsystemOptions& options) {
   return options.view ? read_view_file(*options.view) : ViewSettings{};
 }
 
+std::string grammar_name(const LsystemOptions& options) {
+  return options.grammar ? options.grammar->string()
+                         : options.library_grammar ? options.library_grammar->name : options.inline_name;
+}
+
 Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   if (options.grammar || options.library_grammar) {
     const GrammarText text = options.grammar ? GrammarText{options.grammar->string(), read_file(*options.grammar), false}

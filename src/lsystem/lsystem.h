@@ -31,6 +31,10 @@ DerivationSettings derivation_settings(const LsystemOptions& options, const Gram
 // override the grammar's directives).
 TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar, const ViewSettings& view = {});
 
+// options => the name messages give the grammar: its file, the species' grammar, or the
+// scene's inline rules ("<scene>/lsystem").
+std::string grammar_name(const LsystemOptions& options);
+
 // options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).
 // Throws InputError with file:line:column for grammar errors, and at the module cap.
 Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats);

@@ -48,7 +48,7 @@ void check_skeleton(const Skeleton& sk) {
                          sk.leaf_scale.size() == L && sk.leaf_polygon_offsets.size() >= L + (L > 0) &&
                          sk.leaf_triangle_offsets.size() >= L + (L > 0);
   if (!segments_ok || !leaves_ok) throw InputError("skeleton: array sizes disagree");
-  if (S == 0 && L == 0) throw InputError("the grammar draws nothing: no segment (F, G) and no leaf (L, ~, { . })");
+  if (S == 0 && L == 0) throw TreeModelError("the grammar draws nothing: no segment (F, G) and no leaf (L, ~, { . })");
   for (size_t s = 0; s < S; ++s)
     if (sk.segment_parent[s] < -1 || sk.segment_parent[s] >= int32_t(s))
       throw InputError("skeleton: segment_parent[" + std::to_string(s) + "] is not an earlier segment");

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/errors.h"
+
 namespace treeanim {
 
 enum ClusterKind : uint8_t { kClusterBranch = 0, kClusterLeaf = 1 };
@@ -70,7 +72,13 @@ struct TreeModel {
 // vertex_memberships, whose slots come out in ascending cluster id) and member_cluster.
 void index_memberships(TreeModel& model);
 
-// Range-checks every index array and size (cheap, always on). Throws InputError.
+// What the drawn tree cannot be (nothing drawn, a point or mass not finite): an InputError the
+// caller names the grammar in (prepare_tree), since the grammar drew it.
+struct TreeModelError : InputError {
+  using InputError::InputError;
+};
+
+// Range-checks every index array and size (cheap, always on). Throws TreeModelError.
 void validate_tree_model(const TreeModel& model);
 
 }  // namespace treeanim

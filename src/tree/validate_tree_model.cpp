@@ -8,7 +8,7 @@
 namespace treeanim {
 namespace {
 
-[[noreturn]] void fail(const std::string& what) { throw InputError("tree model: " + what); }
+[[noreturn]] void fail(const std::string& what) { throw TreeModelError("tree model: " + what); }
 
 void expect_size(const char* name, size_t size, size_t expected) {
   if (size != expected)
