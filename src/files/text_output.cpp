@@ -14,6 +14,10 @@ namespace treeanim {
 namespace fs = std::filesystem;
 
 void write_text_output(const fs::path& path, const std::string& text, bool executable) {
+  // A folder or device named as the file is the caller's slip, refused before anything is made.
+  if (const OutputTarget target = resolve_output_target(path); !target.kind.empty())
+    throw InputError(path.string() + (target.file == path ? " is " : " links to " + target.file.string() + ", ") +
+                     target.kind + ", left untouched; expected a regular file or a new one");
   std::error_code error;
   if (!path.parent_path().empty()) fs::create_directories(path.parent_path(), error);
   if (error) throw OutputError(path.parent_path().string() + ": cannot create the folder: " + error.message());
