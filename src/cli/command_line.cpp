@@ -188,8 +188,11 @@ int run_reporting_errors(const Subcommands& commands, Arguments& args) {
     return report("simulation failed: ", error, kExitSimulation);
   } catch (const OutputError& error) {
     return report("output failed: ", error, kExitOutput);
-  } catch (const std::bad_alloc& error) {
-    return report("out of memory: ", error, kExitSimulation);
+  } catch (const std::bad_alloc&) {
+    // Memory the machine does not have: no input is wrong, the tree or bake is too large here.
+    std::fprintf(stderr, "treeanim: out of memory: the tree or its bake needs more memory than this machine "
+                         "gives (grow fewer modules: lsystem.iterations, lsystem.max_modules)\n");
+    return kExitSimulation;
   } catch (const std::exception& error) {
     // Not a documented failure: a bug. Report it rather than abort with a core dump.
     return report("internal error: ", error, kExitSimulation);
