@@ -41,12 +41,12 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
       return result;
     }
     {
-      const DeferredInterrupts deferred;  // the part is written whole
+      const DeferredInterrupts deferred;  // the part is written whole, the spent checkpoints all removed
       write_tree_part(config, scene, trees[i], one, baked);
+      // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent.
+      std::error_code ignored;
+      if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
     }
-    // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent.
-    std::error_code ignored;
-    if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
     ++result.baked;
   }
   if (config.shard) return result;

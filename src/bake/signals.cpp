@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 
 #include "common/errors.h"
 
@@ -11,15 +12,15 @@ namespace treeanim {
 
 namespace {
 
-volatile std::sig_atomic_t received_signal = 0;
-// Spans alive (DeferredInterrupts); a lock-free atomic, so the handler may read it.
-std::atomic<int> deferring{0};
+// Lock-free atomics: the handler may run on any thread (an OpenMP worker too) and touch them.
+std::atomic<int> received_signal{0};
+std::atomic<int> deferring{0};  // spans alive (DeferredInterrupts)
 static_assert(std::atomic<int>::is_always_lock_free);
 
 // Only async-signal-safe calls here: write and _exit.
 extern "C" void record_signal(int signal_number) {
   if (deferring.load() > 0) {
-    received_signal = signal_number;
+    received_signal.store(signal_number);
     return;
   }
   static constexpr char kSigint[] =
@@ -46,10 +47,15 @@ void install_interrupt_handlers() {
   std::signal(SIGXFSZ, SIG_IGN);
 }
 
-int pending_signal() { return received_signal; }
+int pending_signal() { return received_signal.load(); }
 
 DeferredInterrupts::DeferredInterrupts() { deferring.fetch_add(1); }
 
-DeferredInterrupts::~DeferredInterrupts() { deferring.fetch_sub(1); }
+// What the span printed reaches its pipe before a signal outside spans ends the process
+// (_exit drops stdio's buffers): a forest's summaries of the trees it finished.
+DeferredInterrupts::~DeferredInterrupts() {
+  std::fflush(stdout);
+  deferring.fetch_sub(1);
+}
 
 }  // namespace treeanim

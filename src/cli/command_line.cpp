@@ -191,7 +191,8 @@ int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   } catch (const std::bad_alloc&) {
     // Memory the machine does not have: no input is wrong, the tree or bake is too large here.
     std::fprintf(stderr, "treeanim: out of memory: the tree or its bake needs more memory than this machine "
-                         "gives (grow fewer modules: lsystem.iterations, lsystem.max_modules)\n");
+                         "gives (a smaller tree: lsystem.iterations, lsystem.max_modules; fewer trees; a coarser "
+                         "wind volume)\n");
     return kExitSimulation;
   } catch (const std::exception& error) {
     // Not a documented failure: a bug. Report it rather than abort with a core dump.

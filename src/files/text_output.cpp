@@ -13,11 +13,24 @@ namespace treeanim {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// path => "" when a file can be written there, else what stands in the way.
+std::string text_target_problem(const fs::path& path) {
+  const OutputTarget target = resolve_output_target(path);
+  if (target.kind.empty()) return "";
+  return path.string() + (target.file == path ? " is " : " links to " + target.file.string() + ", ") + target.kind +
+         ", left untouched; expected a regular file or a new one";
+}
+
+}  // namespace
+
+void check_text_output_target(const fs::path& path) {
+  if (const std::string problem = text_target_problem(path); !problem.empty()) throw InputError(problem);
+}
+
 void write_text_output(const fs::path& path, const std::string& text, bool executable) {
-  // A folder or device named as the file is the caller's slip, refused before anything is made.
-  if (const OutputTarget target = resolve_output_target(path); !target.kind.empty())
-    throw InputError(path.string() + (target.file == path ? " is " : " links to " + target.file.string() + ", ") +
-                     target.kind + ", left untouched; expected a regular file or a new one");
+  if (const std::string problem = text_target_problem(path); !problem.empty()) throw OutputError(problem);
   std::error_code error;
   if (!path.parent_path().empty()) fs::create_directories(path.parent_path(), error);
   if (error) throw OutputError(path.parent_path().string() + ": cannot create the folder: " + error.message());

@@ -63,7 +63,8 @@ void append_ai_mesh(const aiMesh& mesh, std::vector<Eigen::Vector3d>& points,
 }
 
 // An imported scene => InputError naming `file` unless every point is finite and every face
-// has as many distinct corners as it has indices, each a point of its mesh.
+// has corners, each a point of its mesh, a polygon of more than three of them none twice (the
+// triangulation reads those; a repeat in a triangle or line only leaves it without area).
 void check_ai_meshes(const aiScene& scene, const std::string& file) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh& mesh = *scene.mMeshes[m];
@@ -77,7 +78,7 @@ void check_ai_meshes(const aiScene& scene, const std::string& file) {
       std::vector<unsigned> corners(face.mIndices, face.mIndices + face.mNumIndices);
       std::sort(corners.begin(), corners.end());
       if (corners.empty() || corners.back() >= mesh.mNumVertices ||
-          std::adjacent_find(corners.begin(), corners.end()) != corners.end())
+          (corners.size() > 3 && std::adjacent_find(corners.begin(), corners.end()) != corners.end()))
         throw InputError(file + ": leaf mesh face " + std::to_string(f) +
                          " has no corners, a corner past the last point or one corner twice");
     }
@@ -116,16 +117,17 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
                                   aiComponent_COLORS | aiComponent_BONEWEIGHTS |
                                   aiComponent_ANIMATIONS | aiComponent_LIGHTS |
                                   aiComponent_CAMERAS | aiComponent_MATERIALS);
-  // What the file holds is checked before any step reads it (the importer's own check, then
-  // every corner a point of the mesh and every point finite): a damaged file whose faces
-  // point past its vertices or whose polygons are cut short is refused here, not followed
-  // into the triangulation, which asserts on them.
-  const aiScene* scene = importer.ReadFile(file, aiProcess_ValidateDataStructure);
+  // What the file holds is checked before the triangulation reads it (the importer's own check
+  // of what is left once the parts a leaf does not use are dropped, then check_ai_meshes): a
+  // damaged file whose faces point past its vertices or whose polygons are cut short is refused
+  // here, where the triangulation asserted or crashed on it.
+  const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);
+  if (scene) scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   check_ai_meshes(*scene, file);
-  scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
-                                       aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices);
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                                       aiProcess_JoinIdenticalVertices);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   std::vector<Eigen::Vector3d> points;
@@ -141,6 +143,7 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   }
   const double extent = (t.positions.rowwise().maxCoeff() - t.positions.rowwise().minCoeff()).maxCoeff();
   if (!(extent > 0)) throw InputError(file + ": leaf mesh has zero extent");
+  if (!std::isfinite(extent)) throw InputError(file + ": leaf mesh reaches past any size (its nodes' transforms?)");
   t.positions *= options.size / extent;
   t.positions.row(1).array() += options.petiole;
   const Eigen::Vector3d petiole_base(0, options.petiole, 0);

@@ -141,12 +141,16 @@ TEST(Checkpoint, RefusesAnotherSceneADamagedFileAndAnotherTree) {
 TEST(Checkpoint, RefusesAStateThatNoLongerMatchesItsDigest) {
   const TreeModel model = testing::grown_tree(4, 1, 4);
   const ScratchDir scratch("digest");
-  Simulator sim(model, HsmOptions{}, gale(), 1.0 / 24, 2);
-  SimState state = sim.initial_state(0);
-  for (int f = 1; f <= 30; ++f) sim.advance_frame(state, f);
-  const CheckpointKey key{scene_hash("{}", "treeanim 1"), "treeanim 1", false};
-  for (const char* dataset : {"/state/positions", "/state/prediction_velocity"}) {
-    SCOPED_TRACE(dataset);
+  for (const auto& [dataset, precision] : {std::pair{"/state/positions", Precision::kDouble},
+                                           std::pair{"/state/prediction_velocity", Precision::kDouble},
+                                           std::pair{"/state/prediction_velocity", Precision::kFloat}}) {
+    SCOPED_TRACE(std::string(dataset) + (precision == Precision::kFloat ? " (float)" : " (double)"));
+    HsmOptions options;
+    options.precision = precision;
+    Simulator sim(model, options, gale(), 1.0 / 24, 2);
+    SimState state = sim.initial_state(0);
+    for (int f = 1; f <= 30; ++f) sim.advance_frame(state, f);
+    const CheckpointKey key{scene_hash("{}", "treeanim 1"), "treeanim 1", precision == Precision::kFloat};
     const fs::path path = checkpoint_path(scratch.path, 30);
     write_checkpoint(path, state, 30, key);
     EXPECT_EQ(read_checkpoint(path, key, state).first, 30);

@@ -215,6 +215,12 @@ TEST(TreeLeaves, DamagedMeshIsAnInputErrorNamingTheFile) {
       EXPECT_NE(std::string(e.what()).find("leaf mesh"), std::string::npos) << e.what();
     }
   }
+  // What a valid file may hold besides its triangles still loads: a line, and a triangle with a
+  // corner twice (no area), as they did before the checks.
+  std::ofstream(dir / "lines.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 2\nl 1 2\n";
+  TreeOptions o;
+  o.leaf.mesh = dir / "lines.obj";
+  EXPECT_GT(build_tree_model(test::small_tree(), o).leaf_count(), 0u);
   std::filesystem::remove_all(dir);
 }
 
