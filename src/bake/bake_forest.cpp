@@ -1,6 +1,5 @@
 #include "bake/bake_forest.h"
 
-#include <csignal>
 #include <system_error>
 
 #include "bake/bake_tree.h"
@@ -20,7 +19,7 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     // A signal while the last tree finished: the trees baked so far stay whole.
     if (const int signal_number = pending_signal()) {
       log.interrupted(signal_number, -1);
-      result.exit_code = signal_number == SIGINT ? kExitSigint : kExitSigterm;
+      result.exit_code = interrupted_exit_code(signal_number);
       return result;
     }
     const ForestTree& tree = forest.trees[trees[i]];

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <csignal>
 #include <utility>
 
 #include "bake/checkpoint.h"
@@ -193,7 +192,7 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
       frames.outputs.abort();
       log.frames_end();
       log.interrupted(signal_number, frame);
-      return signal_number == SIGINT ? kExitSigint : kExitSigterm;
+      return interrupted_exit_code(signal_number);
     }
     if (frame >= plan.written.first) write_frame(plan, start, frames, frame, placement, thread);
     // The journal reaches the disk before the checkpoint that names its frames as written.

@@ -30,7 +30,7 @@ extern "C" void record_signal(int signal_number) {
   const bool sigint = signal_number == SIGINT;
   [[maybe_unused]] const ssize_t written =
       write(STDERR_FILENO, sigint ? kSigint : kSigterm, sigint ? sizeof kSigint - 1 : sizeof kSigterm - 1);
-  _exit(sigint ? kExitSigint : kExitSigterm);
+  _exit(interrupted_exit_code(signal_number));
 }
 
 }  // namespace
@@ -48,6 +48,8 @@ void install_interrupt_handlers() {
 }
 
 int pending_signal() { return received_signal.load(); }
+
+int interrupted_exit_code(int signal_number) { return signal_number == SIGINT ? kExitSigint : kExitSigterm; }
 
 DeferredInterrupts::DeferredInterrupts() { deferring.fetch_add(1); }
 

@@ -14,6 +14,8 @@ namespace treeanim {
 void install_interrupt_handlers();
 // The signal number received since installation, or 0.
 int pending_signal();
+// SIGINT or SIGTERM => the exit code of a command it interrupted, 130 or 143.
+int interrupted_exit_code(int signal_number);
 
 // While one lives, a signal is recorded for pending_signal() instead of ending the process.
 class DeferredInterrupts {

@@ -25,10 +25,7 @@ std::vector<std::string> read_lines(const std::filesystem::path& path, const std
     throw InputError(path.string() + ": cannot read the " + what + " (" + reason + ")");
   std::vector<std::string> lines;
   std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    lines.push_back(line);
-  }
+  for (std::string line; std::getline(in, line);) lines.push_back(line);  // CRLF read as LF already
   return lines;
 }
 
