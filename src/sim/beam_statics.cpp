@@ -150,6 +150,38 @@ inline double sum_lanes(const Real (&lane)[4]) {
   return double((lane[0] + lane[2]) + (lane[1] + lane[3]));
 }
 
+// A cluster of four members on consecutive vertices v..v+3 (a leaf's card), `on` their flags
+// => its loads, as add_member_load and the four-lane sum_lanes give them, a member per lane of
+// one vector: each lane starts at +0 as LoadLanes does.
+template <typename Real>
+inline void sum_four_members(const MemberLoads<Real>& in, size_t s, size_t v, const Real (&on)[4], double* load,
+                             double* moment, double* damping, double* damping_moment) {
+  using V4 = typename Lanes4<Real>::type;
+  V4 flags, inv_count, fx, fy, fz, drag_damping, ax, ay, az;
+  std::memcpy(&flags, on, sizeof flags);
+  std::memcpy(&inv_count, in.inv_count + v, sizeof inv_count);
+  std::memcpy(&fx, in.force[0] + v, sizeof fx);
+  std::memcpy(&fy, in.force[1] + v, sizeof fy);
+  std::memcpy(&fz, in.force[2] + v, sizeof fz);
+  std::memcpy(&drag_damping, in.drag_damping + v, sizeof drag_damping);
+  std::memcpy(&ax, in.arm[0] + s, sizeof ax);
+  std::memcpy(&ay, in.arm[1] + s, sizeof ay);
+  std::memcpy(&az, in.arm[2] + s, sizeof az);
+  const V4 zero = {}, share = inv_count * flags;
+  const V4 gx = fx * share, gy = fy * share, gz = fz * share;
+  const V4 d = 2 * drag_damping * share;
+  const V4 lane[10] = {zero + gx,           zero + gy,           zero + gz,           zero + (ay * gz - az * gy),
+                       zero + (az * gx - ax * gz), zero + (ax * gy - ay * gx), zero + d, zero + ax * d,
+                       zero + ay * d,       zero + az * d};
+  auto total = [](const V4& x) { return double((x[0] + x[2]) + (x[1] + x[3])); };  // sum_lanes
+  for (int i = 0; i < 3; ++i) {
+    load[i] = total(lane[i]);
+    moment[i] = total(lane[3 + i]);
+    damping_moment[i] = total(lane[7 + i]);
+  }
+  *damping = total(lane[6]);
+}
+
 }  // namespace
 
 template <typename Real>
@@ -204,12 +236,11 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
         const uint32_t n = std::min<uint32_t>(kLoadLanes, end - base), v = members[base];
         Real on[kLoadLanes];
         for (uint32_t l = 0; l < n; ++l) on[l] = any_released ? static_cast<Real>(loads.active[base + l]) : Real(1);
-        if constexpr (decltype(lanes)::value == kLoadLanes) {
-          if (n == kLoadLanes && members[base + n - 1] == v + n - 1) {
+        constexpr int kLanes = decltype(lanes)::value;
+        if (n == kLanes && members[base + n - 1] == v + n - 1) {
 #pragma omp simd
-            for (int l = 0; l < kLoadLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, on[l], l, sum);
-            continue;
-          }
+          for (int l = 0; l < kLanes; ++l) add_member_load(loads, size_t(base) + l, size_t(v) + l, on[l], l, sum);
+          continue;
         }
         for (uint32_t l = 0; l < n; ++l) add_member_load(loads, base + l, members[base + l], on[l], int(l), sum);
       }
@@ -232,7 +263,16 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
   with_kernel_isa([&] {
     for (size_t i = 0; i < n; ++i) {
       const size_t c = at(i);
-      if (tree.cluster_offsets[c + 1] - tree.cluster_offsets[c] <= 4)
+      const uint32_t begin = tree.cluster_offsets[c], count = tree.cluster_offsets[c + 1] - begin;
+      if (count == 4 && !attachment.cluster_flying[c] && members[begin + 3] == members[begin] + 3) {
+        Real on[4] = {1, 1, 1, 1};
+        if (attachment.cluster_released[c])
+          for (int l = 0; l < 4; ++l) on[l] = static_cast<Real>(loads.active[begin + l]);
+        sum_four_members(loads, begin, members[begin], on, &scratch.cluster_load(0, c), &scratch.cluster_moment(0, c),
+                         &scratch.cluster_damping[c], &scratch.cluster_damping_moment(0, c));
+        continue;
+      }
+      if (count <= 4)
         sum_cluster(c, std::integral_constant<int, 4>{});
       else
         sum_cluster(c, std::integral_constant<int, kLoadLanes>{});

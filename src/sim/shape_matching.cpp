@@ -99,6 +99,25 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
     }
   };
   const bool released = a.cluster_released[c] != 0;
+  const uint32_t begin = tree.cluster_offsets[c];
+  if (tree.cluster_offsets[c + 1] - begin == 4 && members[begin + 3] == members[begin] + 3) {
+    // A leaf's card: its four members in one vector's lanes, each stored to its row.
+    using Lanes = typename Lanes4<Real>::type;
+    Lanes x, y, z, vx, vy, vz, weight = Lanes{} + alpha;
+    std::memcpy(&x, qx + begin, sizeof x), std::memcpy(&y, qy + begin, sizeof y), std::memcpy(&z, qz + begin, sizeof z);
+    const uint32_t v = members[begin];
+    std::memcpy(&vx, ux + v, sizeof vx), std::memcpy(&vy, uy + v, sizeof vy), std::memcpy(&vz, uz + v, sizeof vz);
+    if (released)
+      for (int l = 0; l < 4; ++l) weight[l] = active[begin + l] ? alpha : Real(0);
+    const Lanes px = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - vx);
+    const Lanes py = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - vy);
+    const Lanes pz = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
+    for (int l = 0; l < 4; ++l) {
+      const uint32_t row = model.member_correction_row[begin + l];
+      cx[row] = px[l], cy[row] = py[l], cz[row] = pz[l];
+    }
+    return;
+  }
   for (uint32_t i = model.correction_run_offsets[c]; i < model.correction_run_offsets[c + 1]; ++i) {
     const CorrectionRun& run = model.correction_runs[i];
     const bool own = run.row < model.V;
