@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "treeanim_version.h"
 
 namespace treeanim {
@@ -174,7 +175,7 @@ int dispatch(const Subcommands& commands, Arguments& args) {
 }
 
 int report(const char* kind, const std::exception& error, int code) {
-  std::fprintf(stderr, "treeanim: %s%s\n", kind, error.what());
+  std::fprintf(stderr, "treeanim: %s%s\n", kind, printable_text(error.what()).c_str());
   return code;
 }
 

@@ -9,6 +9,7 @@
 
 #include "common/errors.h"
 #include "common/did_you_mean.h"
+#include "common/message_text.h"
 #include "common/read_text_file.h"
 #include "lsystem/grammar.h"
 #include "lsystem/preprocess.h"
@@ -312,7 +313,7 @@ class Parser {
       }
     }
     fail(line, begin, "expected a directive or a production 'predecessor --> successor', got '" +
-                          std::string(text.substr(begin, end - begin)) + "'");
+                          excerpt(text.substr(begin, end - begin)) + "'");
   }
 
   // "name:" or "name :" at text[begin]; on a match, *value is just after the colon.

@@ -4,6 +4,7 @@
 
 #include "common/errors.h"
 #include "common/json_text.h"
+#include "common/message_text.h"
 #include "common/read_text_file.h"
 #include "scene/lsystem_section.h"
 #include "scene/output_section.h"
@@ -104,8 +105,7 @@ void apply_override(Json& document, const std::string& assignment) {
     throw InputError("--set " + describe_json(Json(assignment)) + ": not valid UTF-8 text");
   }
   // Named in messages, cut like describe_json: a value may be a long text.
-  const std::string shown =
-      "--set '" + (assignment.size() <= 60 ? assignment : assignment.substr(0, 57) + "...") + "'";
+  const std::string shown = "--set '" + excerpt(assignment) + "'";
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0)
     throw InputError(shown + ": expected PATH=VALUE, e.g. lsystem.iterations=6");

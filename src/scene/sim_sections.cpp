@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "common/read_text_file.h"
 
 namespace treeanim {
@@ -46,9 +47,10 @@ double csv_number(const std::string& cell, const std::string& where, const std::
   }
   while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
   if (used == 0 || used != cell.size() || !std::isfinite(v))
-    throw InputError(where + ": column '" + column + "': expected a finite number, got '" + cell + "'");
+    throw InputError(where + ": column '" + column + "': expected a finite number, got '" + excerpt(cell) + "'");
   if (!range.contains(v))
-    throw InputError(where + ": column '" + column + "': expected " + range.describe() + ", got '" + cell + "'");
+    throw InputError(where + ": column '" + column + "': expected " + range.describe() + ", got '" + excerpt(cell) +
+                     "'");
   return v;
 }
 
@@ -185,7 +187,7 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
       const bool six = cells.size() == 6 && std::equal(cells.begin(), cells.end(), expected.begin());
       if (!five && !six)
         throw InputError(where + ": expected the header 'time,speed,dx,dy,dz' or "
-                         "'time,speed,dx,dy,dz,gust', got '" + line + "'");
+                         "'time,speed,dx,dy,dz,gust', got '" + excerpt(line) + "'");
       has_gust = six;
       header_seen = true;
       continue;

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 r"""Runs the bad-input corpus: tests/bad/cases.json => every case exits with its documented code
-and names the problem on stderr; none crashes, hangs or reports an internal error.
+and names the problem on stderr, with no control character (a quoted binary byte shows as \xNN);
+none crashes, hangs or reports an internal error.
 
 usage: bad_corpus.py TREEANIM CORPUS_DIR
 Each case runs in CORPUS_DIR (paths in its args are relative to it; a lone surrogate such as
@@ -48,6 +49,8 @@ def run_case(binary, corpus, case):
             problems.append("exit %d, expected %d" % (done.returncode, case["exit"]))
         if message not in done.stderr:
             problems.append("stderr lacks %r" % message)
+        if any(ord(c) < 0x20 and c not in "\n\t" or ord(c) == 0x7F for c in done.stderr):
+            problems.append("a control character on stderr (input quoted without escaping its bytes)")
         if "internal error" in done.stderr:
             problems.append("an internal error (an exception nobody mapped)")
         left = os.listdir(tmp)
