@@ -50,6 +50,12 @@ double tree_reach(const TreeModel& model, const BarChain& chain);
 // its joint, clamped there: Rayleigh's quotient w^2 = sum(m g.u) / sum(m |u|^2) over the limb's
 // vertices for its static deflection u under its own weight turned sideways (the mean over two
 // horizontal directions). Infinite for a limb that does not bend (no compliance or no mass).
-std::vector<double> limb_frequencies(const TreeModel& model, const BarChain& chain);
+// Up to `most_walked` vertex-joint pairs (each vertex times its depth in the cluster tree) the
+// sums are taken per pair, as every bake always took them; past that, from each limb's mass
+// moments in work linear in the tree, the same sums but for round-off: a single axis of 16,000
+// clusters took 5 minutes per pair (docs/solver.md, "Stiffness").
+constexpr size_t kMostWalkedLimbPairs = size_t(1) << 24;
+std::vector<double> limb_frequencies(const TreeModel& model, const BarChain& chain,
+                                     size_t most_walked = kMostWalkedLimbPairs);
 
 }  // namespace treeanim

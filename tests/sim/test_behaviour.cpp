@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <tuple>
 
 #include "sim/simulator.h"
 #include "sim/solver_model.h"
@@ -128,6 +129,40 @@ TEST(Behaviour, LimbFrequencyHasAFloor) {
     below += free[v] < floor_rate;
   }
   EXPECT_GT(below, model.vertex_count() / 2);
+}
+
+TEST(Behaviour, LimbFrequenciesFromMassMomentsAreThoseOfTheWalks) {
+  // A tree past the walks' work (each vertex times its depth) takes Rayleigh's sums from its
+  // limbs' mass moments: the same frequencies but for round-off, limb by limb, leaves included,
+  // and along a single axis of 1,024 clusters (where its moments are long sums of differences).
+  std::vector<TreeModel> models;
+  for (const auto& [iterations, leaves, segments] : {std::tuple{6, 2, 2}, {7, 0, 1}, {5, 3, 4}})
+    models.push_back(grown_tree(iterations, leaves, segments));
+  LsystemOptions stem;
+  stem.axiom = "F";
+  stem.productions = {"F -> FF"};
+  stem.iterations = 10;
+  TreeOptions one_segment;
+  one_segment.cluster.segments_per_cluster = 1;
+  models.push_back(build_tree_model(grow_skeleton(stem, nullptr), one_segment));
+  for (const TreeModel& model : models) {
+    HsmOptions options;
+    options.youngs_modulus = 2e8;
+    const BarChain chain = build_bar_chain(model, options);
+    const std::vector<double> walked = limb_frequencies(model, chain, SIZE_MAX);
+    const std::vector<double> summed = limb_frequencies(model, chain, 0);
+    ASSERT_EQ(walked.size(), model.cluster_count());
+    size_t finite = 0;
+    for (size_t c = 0; c < model.cluster_count(); ++c) {
+      if (std::isinf(walked[c])) {
+        EXPECT_TRUE(std::isinf(summed[c])) << "cluster " << c << ": " << summed[c];
+        continue;
+      }
+      ++finite;
+      EXPECT_NEAR(summed[c], walked[c], 1e-12 * walked[c]) << "cluster " << c << " of " << model.cluster_count();
+    }
+    EXPECT_GT(finite, model.cluster_count() / 4);
+  }
 }
 
 TEST(Behaviour, TheFloorStiffensTheLimbsBelowIt) {
