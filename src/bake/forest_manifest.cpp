@@ -76,6 +76,17 @@ std::vector<ForestPageTree> page_trees(const Json& trees, const fs::path& out_di
   return pages;
 }
 
+fs::path forest_stage_path(const fs::path& out_dir) { return out_dir / "forest.usda"; }
+
+fs::path forest_page_path(const fs::path& out_dir) { return out_dir / "forest.html"; }
+
+// The scene's first output of `format`, or null.
+const OutputOptions* first_output(const Scene& scene, const std::string& format) {
+  const auto found = std::find_if(scene.outputs.begin(), scene.outputs.end(),
+                                  [&](const OutputOptions& o) { return o.format->name == format; });
+  return found == scene.outputs.end() ? nullptr : &*found;
+}
+
 }  // namespace
 
 fs::path tree_part_path(const fs::path& out_dir, const std::string& id) {
@@ -142,6 +153,12 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
   return part;
 }
 
+void check_forest_targets(const Scene& scene, const fs::path& out_dir) {
+  if (first_output(scene, "usd")) check_text_output_target(forest_stage_path(out_dir));
+  if (first_output(scene, "html")) check_text_output_target(forest_page_path(out_dir));
+  check_text_output_target(forest_manifest_path(out_dir));
+}
+
 GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator) {
   GatherReport report;
   Json trees = Json::array();
@@ -160,14 +177,11 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
   // Before the manifest, which says the forest is complete.
   if (const auto stage = usd_stage_trees(trees); !stage.empty()) {
     const long long start = trees[0].at("frame_start").get<long long>();
-    write_forest_usda(out_dir / "forest.usda", stage,
+    write_forest_usda(forest_stage_path(out_dir), stage,
                       {scene.time.fps, start, start + std::max(1LL, trees[0].at("frame_count").get<long long>()) - 1});
   }
-  if (const auto pages = page_trees(trees, out_dir); !pages.empty()) {
-    const auto html = std::find_if(scene.outputs.begin(), scene.outputs.end(),
-                                   [](const OutputOptions& o) { return o.format->name == std::string("html"); });
-    write_forest_page(out_dir / "forest.html", pages, html->max_page_bytes);
-  }
+  if (const auto pages = page_trees(trees, out_dir); !pages.empty())
+    write_forest_page(forest_page_path(out_dir), pages, first_output(scene, "html")->max_page_bytes);
   const Json manifest = {{"format", "treeanim-forest"},
                          {"format_version", 1},
                          {"generator", generator},

@@ -29,6 +29,11 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
 std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, const std::string& id,
                                        const std::string& key, std::string& why);
 
+// Before a forest bakes: InputError when a folder or another file that is not a regular one
+// stands where gather_forest writes, left untouched: the manifest, and beside it the stage or
+// the page when the scene has a usd or an html output.
+void check_forest_targets(const Scene& scene, const std::filesystem::path& out_dir);
+
 struct GatherReport {
   std::vector<size_t> missing;       // trees whose bake is not complete, ascending
   std::vector<std::string> reasons;  // (missing) why

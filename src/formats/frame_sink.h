@@ -1,10 +1,10 @@
 #pragma once
-// FrameSink (docs/design.md): one output format, made by its factory (formats/sink_factories.h).
+// FrameSink (docs/design.md): one output format, made by its factory (formats/sink_factories.h),
+// whose row also names the files it creates, without a sink (its targets, checked before simulating).
 // OutputSet calls begin() once, write() for every selected frame in order (on the sink's own
 // writer thread), then finish() and, once every sink finished, commit(); or abort() at any point.
 // Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,9 +28,6 @@ struct FrameSelection {
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  // Calls `visit` with every file the sink will create, final names (checked and de-duplicated
-  // before simulating), one at a time: a long sequence needs no list of its names.
-  virtual void for_each_target(const std::function<void(const std::filesystem::path&)>& visit) const = 0;
   // The files named in the run's summary (a sequence's first frame stands for the rest).
   virtual std::vector<std::filesystem::path> summary_paths() const = 0;
   // Opens the temporaries and writes what does not change over frames.

@@ -291,7 +291,6 @@ class GlbSink final : public FrameSink {
                                      size_t(selection_.written()),
                                      target_names(selection_))) {}
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {

@@ -8,6 +8,7 @@
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/sequence_pattern.h"
+#include "formats/sink_factories.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {
@@ -21,10 +22,6 @@ class GltfSink final : public FrameSink {
   GltfSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
       : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model), info_(info),
         normals_(options.normals), selection_{info.frame_start, info.frame_count, options.frame_step} {}
-
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
-    for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
-  }
 
   std::vector<fs::path> summary_paths() const override {
     if (selection_.written() == 0) return {};
@@ -73,6 +70,12 @@ class GltfSink final : public FrameSink {
 };
 
 }  // namespace
+
+void gltf_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
+                  const TargetVisitor& visit) {
+  const SequencePattern pattern = sequence_pattern(path, ".glb", options.pointer);
+  for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));
+}
 
 std::unique_ptr<FrameSink> make_gltf_sink(const OutputOptions& options, const fs::path& path,
                                           const TreeModel& model, const BakeInfo& info) {

@@ -27,7 +27,6 @@ class Hdf5Sink final : public FrameSink {
   Hdf5Sink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : options_(options), path_(std::move(path)), model_(model), info_(info) {}
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {

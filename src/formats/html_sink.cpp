@@ -19,6 +19,7 @@
 #include "formats/frame_sink.h"
 #include "files/output_file.h"
 #include "formats/preview_page.h"
+#include "formats/sink_factories.h"
 #include "tree/surface_materials.h"
 #include "sim/wind.h"
 
@@ -135,7 +136,6 @@ class HtmlSink final : public FrameSink {
                        " MiB at least for this tree (viewer, mesh and two frames)");
   }
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override { temporary_ = staged_.stage(path_); }
@@ -280,6 +280,10 @@ class HtmlSink final : public FrameSink {
 };
 
 }  // namespace
+
+void html_targets(const OutputOptions&, const fs::path& path, const FrameSelection&, const TargetVisitor& visit) {
+  visit(page_path(path));
+}
 
 std::unique_ptr<FrameSink> make_html_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,
                                           const BakeInfo& info) {

@@ -8,6 +8,7 @@
 #include "formats/obj_format.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/sequence_pattern.h"
+#include "formats/sink_factories.h"
 #include "formats/vertex_normals.h"
 
 namespace treeanim {
@@ -18,18 +19,15 @@ namespace {
 
 const std::vector<float> kNoNormals;
 
+// The materials file, beside the rest OBJ.
+fs::path mtl_path(const SequencePattern& pattern) { return fs::path(pattern.rest()).replace_extension(".mtl"); }
+
 class ObjSink final : public FrameSink {
  public:
   ObjSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
       : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals),
-        mtl_(fs::path(pattern_.rest()).replace_extension(".mtl")) {}
-
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
-    visit(pattern_.rest());
-    visit(mtl_);
-    for (long long k = 0; k < selection_.written(); ++k) visit(pattern_.frame(selection_.start + k * selection_.step));
-  }
+        mtl_(mtl_path(pattern_)) {}
 
   std::vector<fs::path> summary_paths() const override {
     if (selection_.written() == 0) return {pattern_.rest()};
@@ -63,6 +61,14 @@ class ObjSink final : public FrameSink {
 };
 
 }  // namespace
+
+void obj_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
+                 const TargetVisitor& visit) {
+  const SequencePattern pattern = sequence_pattern(path, ".obj", options.pointer);
+  visit(pattern.rest());
+  visit(mtl_path(pattern));
+  for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));
+}
 
 std::unique_ptr<FrameSink> make_obj_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {

@@ -37,6 +37,28 @@ constexpr int kWriterNice = 5;
 // a page-cache flush) without holding much memory: 8 frames of the 211,812-vertex tree are 20 MB.
 constexpr size_t kQueueFrames = 8;
 
+fs::path resolve(const fs::path& path, const fs::path& out_dir) {
+  return (path.is_relative() && !out_dir.empty() ? out_dir / path : path).lexically_normal();
+}
+
+// What names an output's files without its sink, which needs the tree's model: its options,
+// path and frames.
+struct OutputFiles {
+  OutputOptions options;
+  fs::path path;             // resolved against the out folder
+  FrameSelection selection;  // the frames it writes
+  SinkTargets* targets;      // its format's
+
+  OutputFiles(const OutputOptions& output, const fs::path& out_dir, long long frame_start, long long frame_count)
+      : options(output), path(resolve(output.path, out_dir)), selection{frame_start, frame_count, output.frame_step},
+        targets(find_sink_targets(output.format->name)) {
+    if (!targets) throw std::logic_error(std::string("OutputSet: no sink writes format ") + output.format->name);
+  }
+
+  // Calls `visit` with every file the output's sink will create, final names.
+  void for_each(const TargetVisitor& visit) const { targets(options, path, selection, visit); }
+};
+
 // One sink and, from begin() on, its writer: a thread that writes the queued frames in order.
 struct Worker {
   std::unique_ptr<FrameSink> sink;
@@ -77,6 +99,7 @@ struct SpareFrames {
 
 struct OutputSet::Impl {
   const TreeModel& model;
+  std::vector<OutputFiles> files;  // (outputs) what names each one's files
   std::vector<std::unique_ptr<Worker>> workers;
   std::shared_ptr<SpareFrames> spares = std::make_shared<SpareFrames>();
   bool velocities = false;
@@ -99,59 +122,66 @@ struct OutputSet::Impl {
 
 namespace {
 
-fs::path resolve(const fs::path& path, const fs::path& out_dir) {
-  return (path.is_relative() && !out_dir.empty() ? out_dir / path : path).lexically_normal();
-}
-
-// Every target is written by one output only, is absent or a regular file (after its symbolic
-// links), and every folder takes files. The first pass only looks (lstat), so a refused output
-// leaves nothing created; the second creates folders and probes them. A sequence has a target
-// per frame, so this runs on strings: path comparisons per component cost ~20 us a target, a
-// minute for a million-frame sequence.
-void check_targets(const std::vector<std::unique_ptr<Worker>>& workers, const std::vector<OutputOptions>& outputs,
-                   MadeFolders& made) {
+// Every target is written by one output only and is absent or a regular file (after its symbolic
+// links). This first pass only looks (lstat), so a refused output leaves nothing created; it
+// returns the first file of each folder, which the second pass creates and probes. A sequence
+// has a target per frame, so this runs on strings: path comparisons per component cost ~20 us a
+// target, a minute for a million-frame sequence.
+std::vector<fs::path> look_at_targets(const std::vector<OutputFiles>& outputs) {
   const fs::path cwd = fs::current_path();
   std::unordered_map<std::string, size_t> writer;  // absolute file written => output index
   std::unordered_set<std::string> folders;         // absolute folders seen
   std::vector<fs::path> probes;                    // the first file of each folder
-  for (size_t i = 0; i < workers.size(); ++i) {
-    workers[i]->sink->for_each_target([&](const fs::path& target) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    outputs[i].for_each([&](const fs::path& target) {
       OutputTarget resolved;
       try {
         resolved = resolve_output_target(target);
       } catch (const InputError& e) {
-        throw InputError(outputs[i].pointer + "/path: " + e.what());
+        throw InputError(outputs[i].options.pointer + "/path: " + e.what());
       }
       const fs::path& file = resolved.file;
       const std::string& kind = resolved.kind;
       const std::string absolute = file.is_absolute() ? file.string() : (cwd / file).string();
       const auto [it, inserted] = writer.emplace(absolute, i);
       if (!inserted)
-        throw InputError(outputs[i].pointer + "/path: writes " + file.string() + ", which " +
-                         outputs[it->second].pointer + " writes too");
+        throw InputError(outputs[i].options.pointer + "/path: writes " + file.string() + ", which " +
+                         outputs[it->second].options.pointer + " writes too");
       if (!kind.empty())
-        throw InputError(outputs[i].pointer + "/path: " + target.string() +
+        throw InputError(outputs[i].options.pointer + "/path: " + target.string() +
                          (file == target ? " is " : " links to " + file.string() + ", ") + kind +
                          ", left untouched; an output path must name a regular file or a new one");
       if (folders.insert(absolute.substr(0, absolute.rfind('/'))).second) probes.push_back(file);
     });
   }
-  for (const fs::path& file : probes) check_writable_target(file, made);
+  return probes;
+}
+
+std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
+                                      long long frame_start, long long frame_count) {
+  std::vector<OutputFiles> files;
+  for (const OutputOptions& options : outputs) files.emplace_back(options, out_dir, frame_start, frame_count);
+  return files;
 }
 
 }  // namespace
 
+void check_output_targets(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, long long frame_start,
+                          long long frame_count) {
+  look_at_targets(output_files(outputs, out_dir, frame_start, frame_count));
+}
+
 OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, const TreeModel& model,
                      const BakeInfo& info)
     : impl_(std::make_unique<Impl>(model)) {
-  for (const OutputOptions& options : outputs) {
+  impl_->files = output_files(outputs, out_dir, info.frame_start, info.frame_count);
+  for (const OutputFiles& output : impl_->files) {
+    const OutputOptions& options = output.options;
     auto worker = std::make_unique<Worker>();
-    SinkFactory* const make = find_sink_factory(options.format->name);
-    if (!make) throw std::logic_error(std::string("OutputSet: no sink writes format ") + options.format->name);
-    worker->sink = make(options, resolve(options.path, out_dir), model, info);
-    worker->selection = {info.frame_start, info.frame_count, options.frame_step};
+    worker->sink = find_sink_factory(options.format->name)(options, output.path, model, info);  // the row OutputFiles found
+    worker->selection = output.selection;
     const auto summary = worker->sink->summary_paths();
-    worker->first_path = summary.empty() ? resolve(options.path, out_dir) : summary.front();
+    worker->first_path = summary.empty() ? output.path : summary.front();
     worker->estimated_bytes = estimated_output_bytes(options, model.vertex_count(), model.triangle_count(),
                                                      model.cluster_count(), info.frame_count);
     impl_->velocities = impl_->velocities || options.velocities;
@@ -161,8 +191,8 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     impl_->workers.push_back(std::move(worker));
   }
   try {
-    check_targets(impl_->workers, outputs, impl_->folders);
-    for (const OutputOptions& options : outputs) impl_->locks.lock(resolve(options.path, out_dir));
+    for (const fs::path& file : look_at_targets(impl_->files)) check_writable_target(file, impl_->folders);
+    for (const OutputFiles& output : impl_->files) impl_->locks.lock(output.path);
   } catch (...) {
     impl_->undo();
     throw;
@@ -264,7 +294,7 @@ std::vector<std::pair<fs::path, double>> OutputSet::estimated_bytes() const {
 
 std::vector<fs::path> OutputSet::files(size_t k) const {
   std::vector<fs::path> files;
-  impl_->workers.at(k)->sink->for_each_target([&](const fs::path& file) { files.push_back(file); });
+  impl_->files.at(k).for_each([&](const fs::path& file) { files.push_back(file); });
   return files;
 }
 

@@ -53,6 +53,13 @@ struct FrameData {
   std::vector<float> cluster_motions;
 };
 
+// The first of OutputSet's checks, the one that only looks and creates nothing: every file the
+// outputs write for frame_count frames from frame_start, resolved against out_dir, is written by
+// one output only and is absent or a regular file. Throws InputError as OutputSet's constructor
+// does. A forest checks every tree's outputs so before it grows the first.
+void check_output_targets(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
+                          long long frame_start, long long frame_count);
+
 class OutputSet {
  public:
   // Resolves relative paths against out_dir (when not empty), checks every target (folder

@@ -11,6 +11,7 @@
 #include "formats/frame_sink.h"
 #include "formats/obj_format.h"
 #include "formats/rest_positions_f32.h"
+#include "formats/sink_factories.h"
 
 namespace treeanim {
 
@@ -20,27 +21,42 @@ namespace {
 
 enum class CacheFormat { kPc2, kMdd };
 
+// What a point cache writes.
+struct PointCacheFiles {
+  fs::path cache;  // "<name>.pc2" or "<name>.mdd"
+  fs::path rest;   // "<name>.rest.obj"
+  fs::path mtl;    // "<name>.rest.mtl", the materials the rest OBJ names
+};
+
+// The output's path => its files; the cache's extension is added unless the path has it.
+PointCacheFiles point_cache_files(CacheFormat format, const fs::path& path) {
+  const std::string extension = format == CacheFormat::kPc2 ? ".pc2" : ".mdd";
+  const fs::path cache = path.extension() == extension ? path : fs::path(path.string() + extension);
+  return {cache, fs::path(cache).replace_extension(".rest.obj"), fs::path(cache).replace_extension(".rest.mtl")};
+}
+
+void point_cache_targets(CacheFormat format, const fs::path& path, const TargetVisitor& visit) {
+  const PointCacheFiles files = point_cache_files(format, path);
+  visit(files.cache);
+  visit(files.rest);
+  visit(files.mtl);
+}
+
 class PointCacheSink final : public FrameSink {
  public:
   PointCacheSink(CacheFormat format, const OutputOptions& options, const fs::path& path, const TreeModel& model,
                  const BakeInfo& info)
-      : format_(format), path_(with_extension(path, format == CacheFormat::kPc2 ? ".pc2" : ".mdd")),
-        rest_(fs::path(path_).replace_extension(".rest.obj")), mtl_(fs::path(path_).replace_extension(".rest.mtl")),
-        model_(model), info_(info),
+      : format_(format), files_(point_cache_files(format, path)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
-    visit(path_);
-    visit(rest_);
-    visit(mtl_);
-  }
-  std::vector<fs::path> summary_paths() const override { return {path_, rest_}; }
+  std::vector<fs::path> summary_paths() const override { return {files_.cache, files_.rest}; }
 
   void begin() override {
-    write_mtl_file(staged_.stage(mtl_), mtl_, info_.generator + ", materials", info_.materials);
-    write_obj_file(staged_.stage(rest_), rest_, info_.generator + ", rest pose for " + path_.filename().string(),
-                   rest_positions_f32(model_), obj_shared_lines(model_, mtl_.filename().string()));
-    file_.emplace(staged_.stage(path_), path_);
+    write_mtl_file(staged_.stage(files_.mtl), files_.mtl, info_.generator + ", materials", info_.materials);
+    write_obj_file(staged_.stage(files_.rest), files_.rest,
+                   info_.generator + ", rest pose for " + files_.cache.filename().string(), rest_positions_f32(model_),
+                   obj_shared_lines(model_, files_.mtl.filename().string()));
+    file_.emplace(staged_.stage(files_.cache), files_.cache);
     const auto samples = uint32_t(selection_.written());
     const auto points = uint32_t(model_.vertex_count());
     if (format_ == CacheFormat::kPc2) {
@@ -73,7 +89,7 @@ class PointCacheSink final : public FrameSink {
 
   void finish() override {
     if (samples_ != selection_.written())
-      throw OutputError(path_.string() + ": the header announces " + std::to_string(selection_.written()) +
+      throw OutputError(files_.cache.string() + ": the header announces " + std::to_string(selection_.written()) +
                         " samples but the bake delivered " + std::to_string(samples_));
     if (format_ == CacheFormat::kMdd) {
       file_->seek(8);
@@ -89,14 +105,8 @@ class PointCacheSink final : public FrameSink {
   }
 
  private:
-  static fs::path with_extension(const fs::path& path, const std::string& extension) {
-    return path.extension() == extension ? path : fs::path(path.string() + extension);
-  }
-
   CacheFormat format_;
-  fs::path path_;  // "<name>.pc2" or "<name>.mdd"
-  fs::path rest_;  // "<name>.rest.obj"
-  fs::path mtl_;   // "<name>.rest.mtl", the materials the rest OBJ names
+  PointCacheFiles files_;
   const TreeModel& model_;
   BakeInfo info_;
   FrameSelection selection_;
@@ -115,6 +125,14 @@ std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const fs:
 std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
   return std::make_unique<PointCacheSink>(CacheFormat::kMdd, options, path, model, info);
+}
+
+void pc2_targets(const OutputOptions&, const fs::path& path, const FrameSelection&, const TargetVisitor& visit) {
+  point_cache_targets(CacheFormat::kPc2, path, visit);
+}
+
+void mdd_targets(const OutputOptions&, const fs::path& path, const FrameSelection&, const TargetVisitor& visit) {
+  point_cache_targets(CacheFormat::kMdd, path, visit);
 }
 
 }  // namespace treeanim

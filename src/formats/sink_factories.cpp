@@ -6,12 +6,20 @@
 
 namespace treeanim {
 
-// Each format's sink, defined in its own file (src/formats/<format>_sink.cpp).
+// Each format's sink, and the targets of one that writes more than its path, defined in its own
+// file (src/formats/<format>_sink.cpp).
 SinkFactory make_hdf5_sink, make_obj_sink, make_gltf_sink, make_glb_sink, make_pc2_sink, make_mdd_sink, make_vat_sink,
     make_skinned_glb_sink, make_usd_sink, make_skinned_usd_sink, make_html_sink;
+SinkTargets obj_targets, gltf_targets, pc2_targets, mdd_targets, vat_targets, html_targets;
 PlannedBytes html_output_bytes;
 
 namespace {
+
+// The targets of a format that writes one file, at its path (both forms of usd alike).
+void file_at_path(const OutputOptions&, const std::filesystem::path& path, const FrameSelection&,
+                  const TargetVisitor& visit) {
+  visit(path);
+}
 
 // A usd output's writer: the points per frame, or with "skinned" the UsdSkel layer, a writer of
 // its own as the skinned GLB is beside the GLB.
@@ -23,20 +31,21 @@ std::unique_ptr<FrameSink> make_usd_form_sink(const OutputOptions& options, cons
 struct SinkRow {
   std::string_view format;
   SinkFactory* make;
+  SinkTargets* targets;
   PlannedBytes* planned_bytes = nullptr;
 };
 
 const SinkRow kSinks[] = {
-    {"hdf5", make_hdf5_sink},
-    {"obj", make_obj_sink},
-    {"gltf", make_gltf_sink},
-    {"glb", make_glb_sink},
-    {"pc2", make_pc2_sink},
-    {"mdd", make_mdd_sink},
-    {"vat", make_vat_sink},
-    {"skinned_glb", make_skinned_glb_sink},
-    {"usd", make_usd_form_sink},
-    {"html", make_html_sink, html_output_bytes},
+    {"hdf5", make_hdf5_sink, file_at_path},
+    {"obj", make_obj_sink, obj_targets},
+    {"gltf", make_gltf_sink, gltf_targets},
+    {"glb", make_glb_sink, file_at_path},
+    {"pc2", make_pc2_sink, pc2_targets},
+    {"mdd", make_mdd_sink, mdd_targets},
+    {"vat", make_vat_sink, vat_targets},
+    {"skinned_glb", make_skinned_glb_sink, file_at_path},
+    {"usd", make_usd_form_sink, file_at_path},
+    {"html", make_html_sink, html_targets, html_output_bytes},
 };
 
 const SinkRow* find_sink(std::string_view format) {
@@ -50,6 +59,11 @@ const SinkRow* find_sink(std::string_view format) {
 SinkFactory* find_sink_factory(std::string_view format) {
   const SinkRow* row = find_sink(format);
   return row ? row->make : nullptr;
+}
+
+SinkTargets* find_sink_targets(std::string_view format) {
+  const SinkRow* row = find_sink(format);
+  return row ? row->targets : nullptr;
 }
 
 PlannedBytes* find_planned_bytes(std::string_view format) {

@@ -3,6 +3,7 @@
 // format's name. The other half, the scene keys and size estimates (output/output_formats.h), has
 // no dependencies, so that scene/ reads it without linking a writer.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string_view>
 
@@ -13,10 +14,21 @@
 namespace treeanim {
 
 class FrameSink;
+struct FrameSelection;
+
+// Called with each file an output writes, one at a time: a long sequence needs no list of its
+// names.
+using TargetVisitor = std::function<void(const std::filesystem::path&)>;
 
 // options, path resolved against the out folder, model, bake => a format's sink
 using SinkFactory = std::unique_ptr<FrameSink>(const OutputOptions& options, const std::filesystem::path& path,
                                                const TreeModel& model, const BakeInfo& info);
+
+// options, path resolved against the out folder, the frames it writes, visit => every file its
+// sink will create, final names (checked and de-duplicated before simulating). No model: a forest
+// checks every tree's targets before it grows the first.
+using SinkTargets = void(const OutputOptions& options, const std::filesystem::path& path,
+                         const FrameSelection& selection, const TargetVisitor& visit);
 
 // options, mesh size (vertices, triangles, clusters), frames of the bake => an upper bound of all
 // the output writes, for a format that plans its size before simulating (a page that reduces its
@@ -27,6 +39,8 @@ using PlannedBytes = double(const OutputOptions& options, size_t vertices, size_
 // A format's name => its sink's factory; nullptr when no sink writes that format (a test checks
 // that every row of output_formats() has one).
 SinkFactory* find_sink_factory(std::string_view format);
+// A format's name => its sink's targets; nullptr when no sink writes that format.
+SinkTargets* find_sink_targets(std::string_view format);
 // A format's name => its sink's size plan; nullptr for a format whose size is its frames' bytes.
 PlannedBytes* find_planned_bytes(std::string_view format);
 

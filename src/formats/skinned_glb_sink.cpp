@@ -38,7 +38,6 @@ class SkinnedGlbSink final : public FrameSink {
                         " frames); lower max_joints, raise frame_step or shorten the bake");
   }
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {

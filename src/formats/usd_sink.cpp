@@ -31,7 +31,6 @@ class UsdSink final : public FrameSink {
       : path_(std::move(path)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals) {}
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override { visit(path_); }
   std::vector<fs::path> summary_paths() const override { return {path_}; }
 
   void begin() override {

@@ -23,6 +23,7 @@
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
+#include "formats/sink_factories.h"
 #include "formats/vat_layout.h"
 #include "formats/vertex_normals.h"
 
@@ -136,9 +137,6 @@ class VatSink final : public FrameSink {
                        " (raise frame_step or shorten the bake)");
   }
 
-  void for_each_target(const std::function<void(const fs::path&)>& visit) const override {
-    for (const char* suffix : {".positions.exr", ".normals.exr", ".glb", ".json"}) visit(stem_ + suffix);
-  }
   std::vector<fs::path> summary_paths() const override {
     return {stem_ + ".positions.exr", stem_ + ".normals.exr", stem_ + ".glb", stem_ + ".json"};
   }
@@ -222,6 +220,10 @@ class VatSink final : public FrameSink {
 };
 
 }  // namespace
+
+void vat_targets(const OutputOptions&, const fs::path& stem, const FrameSelection&, const TargetVisitor& visit) {
+  for (const char* suffix : {".positions.exr", ".normals.exr", ".glb", ".json"}) visit(stem.string() + suffix);
+}
 
 std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,
                                          const BakeInfo& info) {

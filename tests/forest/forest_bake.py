@@ -9,6 +9,8 @@
   submit  farm submit --engine slurm against a fake sbatch on PATH (records its arguments,
           prints a job id, runs the job at once): the scripts, the dependency, --wait, the bake;
           and --engine script run as a plain shell script
+  targets a folder where the second tree's output, its part or the manifest goes: exit 2 naming
+          it before the first tree is baked, every file there before left as it was
 
 usage: forest_bake.py TREEANIM CASE      (exit 0 pass, 1 fail)
 """
@@ -232,7 +234,46 @@ def case_submit(treeanim, tmp):
     same_outputs(reference, plain)
 
 
-CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit}
+def folder_state(folder):
+    """folder => {relative path: None for a folder, else the file's bytes} of everything below it."""
+    found = {}
+    for root, dirs, names in os.walk(folder):
+        for name in dirs:
+            found[os.path.relpath(os.path.join(root, name), folder)] = None
+        for name in names:
+            with open(os.path.join(root, name), "rb") as f:
+                found[os.path.relpath(os.path.join(root, name), folder)] = f.read()
+    return found
+
+
+def case_targets(treeanim, tmp):
+    out = os.path.join(tmp, "out")
+    # The first tree's files from an earlier bake, which a refused forest must not replace.
+    for name in ["trees/hero.h5", "trees/hero.html", "caches/hero.pc2", "caches/hero.rest.obj"]:
+        os.makedirs(os.path.dirname(os.path.join(out, name)), exist_ok=True)
+        with open(os.path.join(out, name), "wb") as f:
+            f.write(b"earlier bake of " + name.encode())
+    in_the_way = [("trees/hero-bush.h5", "/outputs/0/path: "), ("forest.parts/hero-bush.json", ""),
+                  ("forest.json", ""), ("forest.html", "")]
+    for name, pointer in in_the_way:
+        folder = os.path.join(out, name)
+        os.makedirs(folder)
+        before = folder_state(out)
+        done = run(treeanim, "run", SCENE, "-o", out, "-q", check=False)
+        message = "%s%s is a directory, left untouched" % (pointer, folder)
+        if done.returncode != 2 or message not in done.stderr:
+            raise Failed("a folder at %s: exit %d, expected 2 and %r: %s"
+                         % (name, done.returncode, message, done.stderr))
+        if folder_state(out) != before:
+            raise Failed("a folder at %s: the output folder changed" % name)
+        os.rmdir(folder)
+    # A shard writes no manifest: a folder where it goes does not stop one.
+    os.makedirs(os.path.join(out, "forest.json"))
+    run(treeanim, "run", SCENE, "-o", out, "-q", "--shard", "0/16")
+
+
+CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit,
+         "targets": case_targets}
 
 
 def main():

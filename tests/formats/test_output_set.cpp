@@ -276,6 +276,30 @@ TEST_F(OutputSetTest, TwoOutputsCannotWriteOneFile) {
   }
 }
 
+// A forest's look before its first tree: OutputSet's first check without a sink or a model, the
+// same refusals as the set's, and nothing made (the set makes the folders obj/ and gltf/).
+TEST_F(OutputSetTest, TargetsAreLookedAtWithoutCreatingAnything) {
+  const TreeModel m = small_model();
+  const BakeInfo info = small_info();
+  const auto refusal = [&](const std::vector<OutputOptions>& outputs) -> std::string {
+    try {
+      check_output_targets(outputs, dir_, info.frame_start, info.frame_count);
+    } catch (const InputError& e) {
+      return std::string("input: ") + e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(refusal(every_format()), "no error");
+  EXPECT_EQ(entries(), std::vector<std::string>{});
+  std::vector<OutputOptions> twice{output("obj", "tree"), output("pc2", "tree.pc2")};
+  twice[1].pointer = "/outputs/1";
+  EXPECT_EQ(refusal(twice), output_error(twice, dir_, m, info));
+  std::filesystem::create_directories(dir_ / "seq/tree.0003.obj");
+  const std::vector<OutputOptions> sequence{output("obj", "seq/tree")};
+  EXPECT_EQ(refusal(sequence), output_error(sequence, dir_, m, info));
+  EXPECT_NE(refusal(sequence), "no error");
+}
+
 TEST_F(OutputSetTest, FailedRenameRemovesEveryTemporary) {
   const TreeModel m = small_model();
   const BakeInfo info = small_info(2, 0);
