@@ -3,11 +3,11 @@
 #include <system_error>
 
 #include "bake/bake_plan.h"
+#include "bake/bake_start.h"
 #include "bake/bake_tree.h"
 #include "bake/forest_manifest.h"
 #include "bake/signals.h"
 #include "common/errors.h"
-#include "files/text_output.h"
 #include "formats/outputs.h"
 
 namespace treeanim {
@@ -16,25 +16,42 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Which of `trees` are complete already (--resume: their parts say so), and for the others
-// what looking finds, before the first tree grows: OutputSet's first check of each tree's
-// outputs, and its part's and the manifest's paths (InputError, nothing created). Found only as
-// each tree is baked, a later tree's bad target would fail the forest after earlier trees were
-// written.
+// Which of `trees` are complete already (--resume: their parts say so); and, before the first
+// tree grows, every file the forest writes looked at (OutputTargets): the manifest and its
+// stage and page, each tree's outputs, part and checkpoints, each written by one writer and
+// absent or a regular file, and every folder they go into able to take a file. Found only as
+// each tree is baked, a later tree's bad target would fail the forest after earlier trees
+// were written. Every tree of the forest is counted for "one writer" (a tree of another shard,
+// or a complete one, keeps its files); the trees baked here are looked at and probed.
 std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees) {
-  std::vector<bool> complete(trees.size());
-  for (size_t i = 0; i < trees.size(); ++i) {
-    const std::string& id = scene.forest->trees[trees[i]].id;
-    const Scene one = tree_scene(scene, trees[i]);
+  const Forest& forest = *scene.forest;
+  std::vector<size_t> position(forest.trees.size(), trees.size());  // index into `trees`, or none
+  for (size_t i = 0; i < trees.size(); ++i) position[trees[i]] = i;
+  std::vector<bool> complete(trees.size(), false);
+  OutputTargets targets;
+  if (!config.shard) add_forest_targets(scene, config.out_dir, targets);
+  for (size_t t = 0; t < forest.trees.size(); ++t) {
+    const std::string& id = forest.trees[t].id;
+    const Scene one = tree_scene(scene, t);
+    const size_t i = position[t];
     std::string why;
-    complete[i] = config.checkpoints.resume &&
-                  complete_tree_part(config.out_dir, id, bake_key(one, config.generator), why);
-    if (complete[i]) continue;
-    const FrameRange written = plan_bake(one, config).written;
-    check_output_targets(one.outputs, config.out_dir, written.first, written.count());
-    check_text_output_target(tree_part_path(config.out_dir, id));
+    if (i < trees.size())
+      complete[i] = config.checkpoints.resume &&
+                    complete_tree_part(config.out_dir, id, bake_key(one, config.generator), why);
+    const bool written = i < trees.size() && !complete[i];
+    const BakePlan plan = plan_bake(one, tree_bake_config(config, id));
+    targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, written);
+    targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, written);
+    if (written && plan.checkpoints.every > 0)
+      targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), "the checkpoints of tree " + id);
   }
-  if (!config.shard) check_forest_targets(scene, config.out_dir);
+  MadeFolders made;  // kept once every folder takes a file: the trees write there
+  try {
+    targets.probe(made);
+  } catch (...) {
+    made.undo();
+    throw;
+  }
   return complete;
 }
 

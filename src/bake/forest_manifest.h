@@ -29,10 +29,9 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
 std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, const std::string& id,
                                        const std::string& key, std::string& why);
 
-// Before a forest bakes: InputError when a folder or another file that is not a regular one
-// stands where gather_forest writes, left untouched: the manifest, and beside it the stage or
-// the page when the scene has a usd or an html output.
-void check_forest_targets(const Scene& scene, const std::filesystem::path& out_dir);
+// What gather_forest writes, added to `targets` (formats/outputs.h): the manifest, and beside
+// it the stage or the page when the scene has a usd or an html output.
+void add_forest_targets(const Scene& scene, const std::filesystem::path& out_dir, OutputTargets& targets);
 
 struct GatherReport {
   std::vector<size_t> missing;       // trees whose bake is not complete, ascending

@@ -175,7 +175,7 @@ int dispatch(const Subcommands& commands, Arguments& args) {
 }
 
 int report(const char* kind, const std::exception& error, int code) {
-  std::fprintf(stderr, "treeanim: %s%s\n", kind, printable_text(error.what()).c_str());
+  std::fprintf(stderr, "treeanim: %s%s\n", kind, shown_message(error.what()).c_str());
   return code;
 }
 

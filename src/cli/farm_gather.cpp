@@ -14,6 +14,8 @@ int farm_gather_command(const FarmRequest& request) {
   const Scene scene = load_scene(request.scene, request.overrides);
   if (!scene.forest) throw InputError(request.scene.string() + ": no /forest: farm gather collects a forest's trees");
   const Forest& forest = *scene.forest;
+  OutputTargets targets;  // a folder where the manifest goes is bad input, as for run
+  add_forest_targets(scene, request.out_dir, targets);
   const GatherReport report = gather_forest(scene, request.out_dir, treeanim_generator());
   if (report.missing.empty()) {
     std::printf("forest: all %zu trees complete; manifest %s\n", forest.trees.size(),

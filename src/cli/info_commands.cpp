@@ -5,6 +5,7 @@
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
 #include "formats/output_estimate.h"
+#include "formats/outputs.h"
 #include "formats/sink_factories.h"
 #include "output/output_formats.h"
 
@@ -53,6 +54,7 @@ void print_volume(const VolumeSummary& volume) {
 int validate_command(const std::filesystem::path& scene_file,
                      const std::vector<std::string>& overrides) {
   const Scene scene = load_scene(scene_file, overrides);
+  check_output_paths(scene.outputs);
   if (scene.forest) {
     estimate_forest(scene);  // grows one tree of each variant
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());

@@ -23,6 +23,20 @@ size_t utf8_length(std::string_view text, size_t i) {
   return n;
 }
 
+// Code point of the well-formed UTF-8 character of n bytes at text[i].
+char32_t code_point(std::string_view text, size_t i, size_t n) {
+  char32_t c = static_cast<unsigned char>(text[i]) & (0xFFu >> (n + 1));
+  for (size_t k = 1; k < n; ++k) c = (c << 6) | (static_cast<unsigned char>(text[i + k]) & 0x3Fu);
+  return c;
+}
+
+// A character a terminal acts on rather than shows: the C1 controls (U+0080-U+009F: CSI is
+// U+009B), and the marks and overrides that reorder text (bidirectional controls).
+bool acts(char32_t c) {
+  return (c >= 0x80 && c <= 0x9F) || c == 0x200E || c == 0x200F || (c >= 0x202A && c <= 0x202E) ||
+         (c >= 0x2066 && c <= 0x2069);
+}
+
 }  // namespace
 
 std::string printable_text(std::string_view text) {
@@ -33,17 +47,28 @@ std::string printable_text(std::string_view text) {
     if ((c >= 0x20 && c < 0x7F) || c == '\t' || c == '\n') {
       out += char(c);
       ++i;
-    } else if (const size_t n = c >= 0x80 ? utf8_length(text, i) : 0) {
+    } else if (const size_t n = c >= 0x80 ? utf8_length(text, i) : 0; n && !acts(code_point(text, i, n))) {
       out.append(text.substr(i, n));
       i += n;
     } else {
-      char escaped[5];
-      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
-      out += escaped;
-      ++i;
+      for (size_t k = 0; k < std::max<size_t>(n, 1); ++k) {  // each byte of a character that acts
+        char escaped[5];
+        std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned char>(text[i + k]));
+        out += escaped;
+      }
+      i += std::max<size_t>(n, 1);
     }
   }
   return out;
+}
+
+std::string shown_message(std::string_view text, size_t most) {
+  if (text.size() <= most) return printable_text(text);
+  size_t head = most * 3 / 4, tail = text.size() - most / 4;
+  while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
+  while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
+  return printable_text(text.substr(0, head)) + " [... " + std::to_string(tail - head) + " bytes left out ...] " +
+         printable_text(text.substr(tail));
 }
 
 std::string excerpt(std::string_view text, size_t most) {

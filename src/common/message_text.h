@@ -8,8 +8,14 @@
 namespace treeanim {
 
 // `text` with every byte that is neither printable ASCII, a tab, a line break nor part of
-// well-formed UTF-8 written as \xNN.
+// well-formed UTF-8, and each byte of a character a terminal acts on (a C1 control, a
+// bidirectional override), written as \xNN.
 std::string printable_text(std::string_view text);
+
+// A message as the command line prints it: printable_text, and past `most` bytes its middle
+// left out (the start names the place and the problem, the end what was expected), so that
+// input quoted whole (a megabyte key) cannot flood the terminal.
+std::string shown_message(std::string_view text, size_t most = 2000);
 
 // `text` when it has at most `most` bytes, else its first most - 3 (never cutting a UTF-8
 // character) and "...", as printable_text: a quote of input in a message (a message is cut at

@@ -122,41 +122,6 @@ struct OutputSet::Impl {
 
 namespace {
 
-// Every target is written by one output only and is absent or a regular file (after its symbolic
-// links). This first pass only looks (lstat), so a refused output leaves nothing created; it
-// returns the first file of each folder, which the second pass creates and probes. A sequence
-// has a target per frame, so this runs on strings: path comparisons per component cost ~20 us a
-// target, a minute for a million-frame sequence.
-std::vector<fs::path> look_at_targets(const std::vector<OutputFiles>& outputs) {
-  const fs::path cwd = fs::current_path();
-  std::unordered_map<std::string, size_t> writer;  // absolute file written => output index
-  std::unordered_set<std::string> folders;         // absolute folders seen
-  std::vector<fs::path> probes;                    // the first file of each folder
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    outputs[i].for_each([&](const fs::path& target) {
-      OutputTarget resolved;
-      try {
-        resolved = resolve_output_target(target);
-      } catch (const InputError& e) {
-        throw InputError(outputs[i].options.pointer + "/path: " + e.what());
-      }
-      const fs::path& file = resolved.file;
-      const std::string& kind = resolved.kind;
-      const std::string absolute = file.is_absolute() ? file.string() : (cwd / file).string();
-      const auto [it, inserted] = writer.emplace(absolute, i);
-      if (!inserted)
-        throw InputError(outputs[i].options.pointer + "/path: writes " + file.string() + ", which " +
-                         outputs[it->second].options.pointer + " writes too");
-      if (!kind.empty())
-        throw InputError(outputs[i].options.pointer + "/path: " + target.string() +
-                         (file == target ? " is " : " links to " + file.string() + ", ") + kind +
-                         ", left untouched; an output path must name a regular file or a new one");
-      if (folders.insert(absolute.substr(0, absolute.rfind('/'))).second) probes.push_back(file);
-    });
-  }
-  return probes;
-}
-
 std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
                                       long long frame_start, long long frame_count) {
   std::vector<OutputFiles> files;
@@ -166,9 +131,50 @@ std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs,
 
 }  // namespace
 
-void check_output_targets(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, long long frame_start,
-                          long long frame_count) {
-  look_at_targets(output_files(outputs, out_dir, frame_start, frame_count));
+void check_output_paths(const std::vector<OutputOptions>& outputs) {
+  for (const OutputFiles& output : output_files(outputs, {}, 0, 0)) output.for_each([](const fs::path&) {});
+}
+
+// A sequence has a target per frame, so the checks run on strings: path comparisons per
+// component cost ~20 us a target, a minute for a million-frame sequence.
+void OutputTargets::add(const fs::path& target, const std::string& writer, const std::string& refused,
+                        const std::string& expected, bool written) {
+  OutputTarget resolved;
+  try {
+    resolved = resolve_output_target(target);
+  } catch (const InputError& e) {
+    if (!written) return;  // another's problem: it refuses its own
+    throw InputError(refused + e.what());
+  }
+  const fs::path& file = resolved.file;
+  const std::string absolute = file.is_absolute() ? file.string() : (cwd_ / file).string();
+  const auto [it, inserted] = writer_.emplace(absolute, writer);
+  if (!inserted) throw InputError(refused + "writes " + file.string() + ", which " + it->second + " writes too");
+  if (!written) return;
+  if (!resolved.kind.empty())
+    throw InputError(refused + target.string() + (file == target ? " is " : " links to " + file.string() + ", ") +
+                     resolved.kind + ", left untouched; " + expected);
+  if (folders_.insert(absolute.substr(0, absolute.rfind('/'))).second) probes_.push_back(file);
+}
+
+void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
+                                long long frame_start, long long frame_count, const std::string& owner, bool written) {
+  for (const OutputFiles& output : output_files(outputs, out_dir, frame_start, frame_count)) {
+    const std::string& pointer = output.options.pointer;
+    const std::string writer = owner.empty() ? pointer : pointer + " of " + owner;
+    const std::string refused = (owner.empty() ? "" : owner + ": ") + pointer + "/path: ";
+    output.for_each([&](const fs::path& target) {
+      add(target, writer, refused, "an output path must name a regular file or a new one", written);
+    });
+  }
+}
+
+void OutputTargets::add_file(const fs::path& file, const std::string& writer, bool written) {
+  add(file, writer, writer + ": ", "expected a regular file or a new one", written);
+}
+
+void OutputTargets::probe(MadeFolders& made) const {
+  for (const fs::path& file : probes_) check_writable_target(file, made);
 }
 
 OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, const TreeModel& model,
@@ -191,7 +197,9 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     impl_->workers.push_back(std::move(worker));
   }
   try {
-    for (const fs::path& file : look_at_targets(impl_->files)) check_writable_target(file, impl_->folders);
+    OutputTargets targets;
+    targets.add_outputs(outputs, out_dir, info.frame_start, info.frame_count);
+    targets.probe(impl_->folders);
     for (const OutputFiles& output : impl_->files) impl_->locks.lock(output.path);
   } catch (...) {
     impl_->undo();

@@ -7,9 +7,12 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
+#include "files/staged_files.h"
 #include "output/output_options.h"
 #include "sim/sim_options.h"
 #include "tree/surface_materials.h"
@@ -53,12 +56,41 @@ struct FrameData {
   std::vector<float> cluster_motions;
 };
 
-// The first of OutputSet's checks, the one that only looks and creates nothing: every file the
-// outputs write for frame_count frames from frame_start, resolved against out_dir, is written by
-// one output only and is absent or a regular file. Throws InputError as OutputSet's constructor
-// does. A forest checks every tree's outputs so before it grows the first.
-void check_output_targets(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
-                          long long frame_start, long long frame_count);
+// The files a bake will write, looked at before any is: each written by one writer only, and
+// absent or a regular file after its symbolic links (InputError, nothing created); then, by
+// probe(), every folder able to take a file. OutputSet checks its outputs so; a forest checks
+// every tree's outputs, parts and manifest before it grows the first, so that a later tree's
+// target cannot fail the forest after earlier trees were written.
+// The outputs' paths read as their writers will read them (a sequence's frame-number field),
+// without looking at the disk => InputError as a bake gives it.
+void check_output_paths(const std::vector<OutputOptions>& outputs);
+
+class OutputTargets {
+ public:
+  // The outputs' files for frame_count frames from frame_start, resolved against out_dir, named
+  // in messages by `owner` and the output's pointer (owner "" for a lone tree). `written` false:
+  // a writer that does not write now (a forest tree of another shard, or complete), whose
+  // files only no other writer may take.
+  void add_outputs(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
+                   long long frame_start, long long frame_count, const std::string& owner = "", bool written = true);
+  // One more file, written by `writer` (e.g. "the forest's manifest").
+  void add_file(const std::filesystem::path& file, const std::string& writer, bool written = true);
+  // Each folder made when missing (into `made`, which the caller undoes when it gives up: a
+  // folder another process may be writing into is not removed while it bakes) and a file
+  // created and removed in it. Throws OutputError naming the path.
+  void probe(MadeFolders& made) const;
+
+ private:
+  // `target`, written by `writer`, refused in messages that start with `refused` and end, for a
+  // folder or another file that is not a regular one, with `expected` => registered.
+  void add(const std::filesystem::path& target, const std::string& writer, const std::string& refused,
+           const std::string& expected, bool written);
+
+  std::filesystem::path cwd_ = std::filesystem::current_path();
+  std::unordered_map<std::string, std::string> writer_;  // absolute file written => its writer
+  std::unordered_set<std::string> folders_;              // absolute folders seen
+  std::vector<std::filesystem::path> probes_;            // the first file of each folder
+};
 
 class OutputSet {
  public:

@@ -161,7 +161,6 @@ class SkinnedUsdSink final : public FrameSink {
 
 std::unique_ptr<FrameSink> make_skinned_usd_sink(const OutputOptions& options, const fs::path& path,
                                                  const TreeModel& model, const BakeInfo& info) {
-  check_usda_path(options);
   return std::make_unique<SkinnedUsdSink>(options, path, model, info);
 }
 

@@ -27,13 +27,6 @@ constexpr const char* kSubsetPrims[kMaterialCount] = {"bark", "leaves"};
 
 }  // namespace
 
-void check_usda_path(const OutputOptions& options) {
-  if (options.path.extension() != ".usda")
-    throw InputError(options.pointer + "/path: a usd output is a text layer whose name ends in .usda (e.g. \"" +
-                     std::filesystem::path(options.path).replace_extension(".usda").string() + "\"), got \"" +
-                     options.path.string() + "\"");
-}
-
 std::string usd_layer_header(const BakeInfo& info, const FrameSelection& selection, const std::string& custom) {
   const long long last = selection.start + (selection.written() - 1) * selection.step;
   std::string out = "#usda 1.0\n(\n";

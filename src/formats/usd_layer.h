@@ -14,9 +14,6 @@
 
 namespace treeanim {
 
-// Throws InputError "<pointer>/path: ..." unless the output's path names a .usda text layer.
-void check_usda_path(const OutputOptions& options);
-
 // The stage's metadata, with `custom` as its customLayerData when not empty: the frames written
 // are the time codes, one per frame at the bake's rate.
 std::string usd_layer_header(const BakeInfo& info, const FrameSelection& selection, const std::string& custom);

@@ -119,7 +119,6 @@ class UsdSink final : public FrameSink {
 
 std::unique_ptr<FrameSink> make_usd_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,
                                          const BakeInfo& info) {
-  check_usda_path(options);
   return std::make_unique<UsdSink>(options, path, model, info);
 }
 

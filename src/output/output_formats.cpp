@@ -114,6 +114,8 @@ const std::vector<OutputFormatRow> kFormats = {
                .type = Type::kBoolean,
                .store = [](OutputOptions& o, double v) { o.skinned = v != 0; }},
               kMaxJointsKey},
+     .path_extension = ".usda",
+     .file_kind = "a usd output is a text layer",
      // text: ~36 characters a point, ~38 a normal; skinned: ~96 a joint's translation and rotation
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t clusters) {
        return o.skinned ? 96.0 * joint_count(o, clusters) : (36.0 + (o.normals ? 38.0 : 0.0)) * double(vertices);

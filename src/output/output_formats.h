@@ -33,6 +33,9 @@ struct OutputFormatRow {
   bool always_normals = false;  // writes vertex normals without a `normals` key
   bool leaf_flags = false;      // writes FrameData::leaf_attached
   bool skinned = false;         // writes joints and their keys (usd: with its `skinned` key)
+  // The extension its path must end in, and what the file is ("" / nullptr: any path)
+  const char* path_extension = "";
+  const char* file_kind = nullptr;
   // options, mesh size => bytes of one written frame's data, uncompressed (formats/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
 };

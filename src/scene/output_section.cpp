@@ -1,9 +1,11 @@
 #include "scene/output_section.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <vector>
 
+#include "common/message_text.h"
 #include "output/output_formats.h"
 
 namespace treeanim {
@@ -53,6 +55,11 @@ OutputOptions read_output_options(SceneObject element) {
   const auto path = element.optional_string("path");
   if (!path || path->empty()) element.fail_expected("path", "a non-empty path string");
   options.path = *path;
+  if (*options.format->path_extension && options.path.extension() != options.format->path_extension)
+    element.fail("path", std::string(options.format->file_kind) + " whose name ends in " +
+                             options.format->path_extension + " (e.g. \"" +
+                             std::filesystem::path(options.path).replace_extension(options.format->path_extension).string() +
+                             "\"), got \"" + excerpt(*path) + "\"");
   options.frame_step = static_cast<int>(element.integer("frame_step", 1, 1, 1000000));
   for (const OutputKey& key : options.format->keys) read_format_key(element, key, options);
   if (options.format->always_normals) options.normals = true;

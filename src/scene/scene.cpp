@@ -102,7 +102,7 @@ void apply_override(Json& document, const std::string& assignment) {
   try {
     (void)Json(assignment).dump();
   } catch (const nlohmann::json::type_error&) {
-    throw InputError("--set " + describe_json(Json(assignment)) + ": not valid UTF-8 text");
+    throw InputError("--set '" + excerpt(assignment) + "': not valid UTF-8 text");
   }
   // Named in messages, cut like describe_json: a value may be a long text.
   const std::string shown = "--set '" + excerpt(assignment) + "'";

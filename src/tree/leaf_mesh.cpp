@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <span>
 #include <string>
@@ -60,6 +61,17 @@ void append_ai_mesh(const aiMesh& mesh, std::vector<Eigen::Vector3d>& points,
     if (face.mNumIndices != 3) continue;  // points and lines of the file carry no area
     for (unsigned k = 0; k < 3; ++k) triangles.push_back(first + face.mIndices[k]);
   }
+}
+
+// A PLY file (it starts "ply") whose header has no end_header line sends assimp's reader
+// seeking round for ever (assimp 5.2): refused here, naming the file, before it is handed over.
+void check_ply_header(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(4, '\0');
+  if (!in.read(head.data(), 4) || head.compare(0, 3, "ply") != 0 || (head[3] != '\n' && head[3] != '\r')) return;
+  for (std::string line; std::getline(in, line);)
+    if (line == "end_header" || line == "end_header\r") return;
+  throw InputError(file + ": cannot read leaf mesh: a PLY file whose header has no end_header line (cut short?)");
 }
 
 // An imported scene => InputError naming `file` unless every point is finite and every face
@@ -121,6 +133,7 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   // of what is left once the parts a leaf does not use are dropped, then check_ai_meshes): a
   // damaged file whose faces point past its vertices or whose polygons are cut short is refused
   // here, where the triangulation asserted or crashed on it.
+  check_ply_header(file);
   const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);
   if (scene) scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode)

@@ -20,6 +20,21 @@ TEST(MessageText, EscapesControlBytesAndBrokenUtf8) {
             "\\x80 \\xc3x \\xc0\\xaf \\xed\\xa0\\x80 \\xf4\\x90\\x80\\x80 \\xe2\\x82");
 }
 
+TEST(MessageText, EscapesWhatATerminalActsOn) {
+  // CSI as a C1 control (U+009B) and a right-to-left override (U+202E): well-formed, yet acted on.
+  EXPECT_EQ(printable_text("a\xc2\x9b" "31m b\xe2\x80\xae" "c \xc2\xa0"), "a\\xc2\\x9b31m b\\xe2\\x80\\xaec \xc2\xa0");
+}
+
+TEST(MessageText, AShownMessageKeepsItsStartAndEnd) {
+  const std::string key(1000000, 'k');
+  const std::string shown = shown_message("scene.json: /" + key + ": unknown key (did you mean /time?)");
+  EXPECT_LT(shown.size(), 2100u);
+  EXPECT_EQ(shown.rfind("scene.json: /kkk", 0), 0u);
+  EXPECT_NE(shown.find(" bytes left out ...] "), std::string::npos);
+  EXPECT_EQ(shown.substr(shown.size() - 35), ": unknown key (did you mean /time?)");
+  EXPECT_EQ(shown_message("short\x1b"), "short\\x1b");
+}
+
 TEST(MessageText, ExcerptCutsLongQuotesBetweenCharacters) {
   EXPECT_EQ(excerpt("short"), "short");
   EXPECT_EQ(excerpt(std::string(60, 'a')), std::string(60, 'a'));

@@ -283,7 +283,8 @@ TEST_F(OutputSetTest, TargetsAreLookedAtWithoutCreatingAnything) {
   const BakeInfo info = small_info();
   const auto refusal = [&](const std::vector<OutputOptions>& outputs) -> std::string {
     try {
-      check_output_targets(outputs, dir_, info.frame_start, info.frame_count);
+      OutputTargets targets;
+      targets.add_outputs(outputs, dir_, info.frame_start, info.frame_count);
     } catch (const InputError& e) {
       return std::string("input: ") + e.what();
     }
@@ -298,6 +299,55 @@ TEST_F(OutputSetTest, TargetsAreLookedAtWithoutCreatingAnything) {
   const std::vector<OutputOptions> sequence{output("obj", "seq/tree")};
   EXPECT_EQ(refusal(sequence), output_error(sequence, dir_, m, info));
   EXPECT_NE(refusal(sequence), "no error");
+}
+
+// Writers of a forest: one tree's file is no other tree's, nor the manifest's; a tree that is
+// not written here keeps its files but is not looked at; a folder that takes no file is found
+// by the probe, and the folders it made are removed by their undo.
+TEST_F(OutputSetTest, EachFileOfSeveralWritersHasOne) {
+  const BakeInfo info = small_info();
+  const auto refusal = [&](const auto& add) -> std::string {
+    MadeFolders made;
+    try {
+      OutputTargets targets;
+      targets.add_file(dir_ / "forest.json", "the forest's manifest");
+      add(targets);
+      targets.probe(made);
+    } catch (const std::exception& e) {
+      made.undo();
+      return e.what();
+    }
+    made.undo();
+    return "no error";
+  };
+  const std::vector<OutputOptions> a{output("hdf5", "a.h5"), output("pc2", "shared")};
+  EXPECT_EQ(refusal([&](OutputTargets& t) { t.add_outputs(a, dir_, info.frame_start, info.frame_count, "tree a"); }),
+            "no error");
+  EXPECT_EQ(refusal([&](OutputTargets& t) {
+              t.add_outputs(a, dir_, info.frame_start, info.frame_count, "tree a", false);
+              t.add_outputs({output("hdf5", "shared.pc2")}, dir_, info.frame_start, info.frame_count, "tree b");
+            }),
+            "tree b: /outputs/0/path: writes " + (dir_ / "shared.pc2").string() +
+                ", which /outputs/0 of tree a writes too");
+  EXPECT_EQ(refusal([&](OutputTargets& t) {
+              t.add_outputs({output("hdf5", "forest.json")}, dir_, info.frame_start, info.frame_count, "tree forest");
+            }),
+            "tree forest: /outputs/0/path: writes " + (dir_ / "forest.json").string() +
+                ", which the forest's manifest writes too");
+  std::filesystem::create_directories(dir_ / "b.h5");
+  EXPECT_EQ(refusal([&](OutputTargets& t) {
+              t.add_outputs({output("hdf5", "b.h5")}, dir_, info.frame_start, info.frame_count, "tree b", false);
+            }),
+            "no error");
+  std::filesystem::remove(dir_ / "b.h5");
+  std::ofstream(dir_ / "blocked") << "a file where a folder goes";
+  EXPECT_EQ(refusal([&](OutputTargets& t) {
+              t.add_outputs({output("hdf5", "deep/er/c.h5"), output("hdf5", "blocked/c.h5")}, dir_, info.frame_start,
+                            info.frame_count, "tree c");
+            }),
+            (dir_ / "blocked/c.h5").string() + ": cannot create the folder " + (dir_ / "blocked").string() +
+                ": Not a directory");
+  EXPECT_EQ(entries(), std::vector<std::string>{"blocked"});
 }
 
 TEST_F(OutputSetTest, FailedRenameRemovesEveryTemporary) {

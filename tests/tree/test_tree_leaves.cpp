@@ -202,6 +202,9 @@ TEST(TreeLeaves, DamagedMeshIsAnInputErrorNamingTheFile) {
       {"index.ply", ply_header + "0 0 0\n0 1 0\n1 1 0\n3 0 1 2000000000\n"},
       {"twice.ply", ply_header + "0 0 0\n0 1 0\n1 1 0\n4 0 1 1 2\n"},
       {"nan.obj", "v 0 0 0\nv 0 1 0\nv nan 1 0\nf 1 2 3\n"},
+      // A header cut short: assimp's reader sought round for ever.
+      {"headless.ply", "ply\nformat ascii 1.0\n"},
+      {"headless-element.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"},
   };
   for (const auto& [name, text] : files) {
     std::ofstream(dir / name) << text;
