@@ -29,7 +29,7 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
   for (size_t i = 0; i < trees.size(); ++i) position[trees[i]] = i;
   std::vector<bool> complete(trees.size(), false);
   OutputTargets targets;
-  if (!config.shard) add_forest_targets(scene, config.out_dir, targets);
+  add_forest_targets(scene, config.out_dir, targets, !config.shard);
   for (size_t t = 0; t < forest.trees.size(); ++t) {
     const std::string& id = forest.trees[t].id;
     const Scene one = tree_scene(scene, t);
@@ -42,8 +42,10 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
     const BakePlan plan = plan_bake(one, tree_bake_config(config, id));
     targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, written);
     targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, written);
-    if (written && plan.checkpoints.every > 0)
+    if (written && plan.checkpoints.every > 0) {
+      targets.add_folder(plan.checkpoints.dir, "the checkpoints of tree " + id);
       targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), "the checkpoints of tree " + id);
+    }
   }
   MadeFolders made;  // kept once every folder takes a file: the trees write there
   try {

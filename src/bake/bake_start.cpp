@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -19,13 +20,15 @@ std::optional<FrameJournal> journal_before(const BakePlan& plan, const JournalLa
   try {
     journal = FrameJournal::open(journal_path(plan.checkpoints.dir, plan.written.first), layout);
   } catch (const InputError& error) {
-    if (notes) std::fprintf(notes, "treeanim: not resuming from %s: %s\n", checkpoint.c_str(), error.what());
+    if (notes) std::fprintf(notes, "treeanim: not resuming from %s: %s\n", printable_text(checkpoint.string()).c_str(),
+                            printable_text(error.what()).c_str());
     return std::nullopt;
   }
   if (journal->size() < frame - plan.written.first) {
     if (notes)
       std::fprintf(notes, "treeanim: not resuming from %s: the frame journal holds frames %lld to %lld only\n",
-                   checkpoint.c_str(), plan.written.first, plan.written.first + journal->size() - 1);
+                   printable_text(checkpoint.string()).c_str(), plan.written.first,
+                   plan.written.first + journal->size() - 1);
     return std::nullopt;
   }
   return journal;
@@ -57,12 +60,13 @@ BakeStart start_bake(const BakePlan& plan, const JournalLayout& layout, const Si
     start.state = std::move(state);
     start.checkpoint = path;
     start.journal = std::move(journal);
-    if (notes) std::fprintf(notes, "treeanim: resuming at frame %lld from %s\n", start.frame, path.c_str());
+    if (notes) std::fprintf(notes, "treeanim: resuming at frame %lld from %s\n", start.frame,
+                            printable_text(path.string()).c_str());
     return start;
   }
   if (resume && notes)
     std::fprintf(notes, "treeanim: no usable checkpoint in %s: baking from frame %lld\n",
-                 plan.checkpoints.dir.c_str(), plan.first);
+                 printable_text(plan.checkpoints.dir.string()).c_str(), plan.first);
   return start;
 }
 
@@ -78,7 +82,8 @@ void remove_foreign_checkpoints(const BakePlan& plan, long long start, const Sim
     }
     std::error_code ignored;
     fs::remove(path, ignored);
-    if (notes) std::fprintf(notes, "treeanim: removed %s (%s)\n", path.c_str(), why.c_str());
+    if (notes) std::fprintf(notes, "treeanim: removed %s (%s)\n", printable_text(path.string()).c_str(),
+                            printable_text(why).c_str());
   }
 }
 

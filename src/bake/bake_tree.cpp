@@ -128,7 +128,8 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
     : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
       measures_bounds(placement != nullptr),
-      outputs(scene.outputs, config.out_dir, model, info) {}
+      outputs(scene.outputs, config.out_dir, model, info,
+              plan.checkpoints.every > 0 ? plan.checkpoints.dir : std::filesystem::path()) {}
 
 void BakeFrames::push(FrameData data) {
   if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame

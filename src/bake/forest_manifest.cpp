@@ -153,10 +153,10 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
   return part;
 }
 
-void add_forest_targets(const Scene& scene, const fs::path& out_dir, OutputTargets& targets) {
-  targets.add_file(forest_manifest_path(out_dir), "the forest's manifest");
-  if (first_output(scene, "usd")) targets.add_file(forest_stage_path(out_dir), "the forest's USD stage");
-  if (first_output(scene, "html")) targets.add_file(forest_page_path(out_dir), "the forest's page");
+void add_forest_targets(const Scene& scene, const fs::path& out_dir, OutputTargets& targets, bool written) {
+  targets.add_file(forest_manifest_path(out_dir), "the forest's manifest", written);
+  if (first_output(scene, "usd")) targets.add_file(forest_stage_path(out_dir), "the forest's USD stage", written);
+  if (first_output(scene, "html")) targets.add_file(forest_page_path(out_dir), "the forest's page", written);
 }
 
 GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator) {

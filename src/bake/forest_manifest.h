@@ -30,8 +30,10 @@ std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, con
                                        const std::string& key, std::string& why);
 
 // What gather_forest writes, added to `targets` (formats/outputs.h): the manifest, and beside
-// it the stage or the page when the scene has a usd or an html output.
-void add_forest_targets(const Scene& scene, const std::filesystem::path& out_dir, OutputTargets& targets);
+// it the stage or the page when the scene has a usd or an html output. `written` false: a
+// shard's bake, which gathers nothing but must not write where the gather will.
+void add_forest_targets(const Scene& scene, const std::filesystem::path& out_dir, OutputTargets& targets,
+                        bool written = true);
 
 struct GatherReport {
   std::vector<size_t> missing;       // trees whose bake is not complete, ascending

@@ -64,7 +64,10 @@ std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost,
 }
 
 std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard) {
-  if (shard) return assign_tasks(estimate_forest(scene).tree_cost, shard->count)[shard->index];
+  // Every variant grows here, with or without shards: a later variant's bad grammar, view or
+  // leaf mesh is bad input before the first tree's files are written.
+  const ForestEstimate estimate = estimate_forest(scene);
+  if (shard) return assign_tasks(estimate.tree_cost, shard->count)[shard->index];
   std::vector<size_t> trees(scene.forest->trees.size());
   std::iota(trees.begin(), trees.end(), size_t{0});
   return trees;

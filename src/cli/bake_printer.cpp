@@ -7,6 +7,7 @@
 #include "bake/bake_tree.h"
 #include "bake/forest_manifest.h"
 #include "bake/prepare_tree.h"
+#include "common/message_text.h"
 #include "sim/kernel_isa.h"
 
 namespace treeanim {
@@ -45,8 +46,8 @@ void BakePrinter::print_summary(const TreeBakeResult& result) const {
   std::printf("baked %lld frames: %zu vertices%s, %zu clusters, %lld substeps in %.2f s (simulation + writing %.2f s)\n",
               result.written.count(), result.vertices, samples.c_str(), result.clusters, result.substeps,
               result.seconds, result.run_seconds);
-  for (const auto& path : result.final_paths) std::printf("  wrote %s\n", path.string().c_str());
-  for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", path.string().c_str(), line.c_str());
+  for (const auto& path : result.final_paths) std::printf("  wrote %s\n", printable_text(path.string()).c_str());
+  for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", printable_text(path.string()).c_str(), line.c_str());
   if (!result.loop) return;
   const LoopSummary& loop = *result.loop;
   // A resumed bake starts from a checkpoint of the warmed-up state: the run that wrote it warmed up.
@@ -65,11 +66,11 @@ void BakePrinter::print_tree(size_t i, size_t count, size_t index, bool complete
   const Forest& forest = *scene_.forest;
   const ForestTree& tree = forest.trees[index];
   if (complete) {
-    std::printf("tree %zu/%zu %s: complete, skipped\n", i + 1, count, tree.id.c_str());
+    std::printf("tree %zu/%zu %s: complete, skipped\n", i + 1, count, printable_text(tree.id).c_str());
     return;
   }
-  std::printf("tree %zu/%zu %s (%s, seed %llu) at (%.2f, %.2f, %.2f)\n", i + 1, count, tree.id.c_str(),
-              forest.variants[tree.variant].name.c_str(), static_cast<unsigned long long>(tree.seed),
+  std::printf("tree %zu/%zu %s (%s, seed %llu) at (%.2f, %.2f, %.2f)\n", i + 1, count, printable_text(tree.id).c_str(),
+              printable_text(forest.variants[tree.variant].name).c_str(), static_cast<unsigned long long>(tree.seed),
               tree.position.x(), tree.position.y(), tree.position.z());
   std::fflush(stdout);
 }
@@ -86,11 +87,11 @@ void BakePrinter::forest_baked(const ForestBakeResult& result) const {
   if (config_.shard)
     std::printf("shard %zu/%zu: %zu trees baked, %zu complete before; once every shard is done: treeanim farm "
                 "gather %s%s%s\n",
-                config_.shard->index, config_.shard->count, result.baked, result.skipped, scene_file_.string().c_str(),
-                out.empty() ? "" : " -o ", out.string().c_str());
+                config_.shard->index, config_.shard->count, result.baked, result.skipped, printable_text(scene_file_.string()).c_str(),
+                out.empty() ? "" : " -o ", printable_text(out.string()).c_str());
   else
     std::printf("forest: %zu trees (%zu baked, %zu complete before); manifest %s\n", scene_.forest->trees.size(),
-                result.baked, result.skipped, forest_manifest_path(out).string().c_str());
+                result.baked, result.skipped, printable_text(forest_manifest_path(out).string()).c_str());
 }
 
 }  // namespace treeanim

@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -19,7 +20,7 @@ int farm_gather_command(const FarmRequest& request) {
   const GatherReport report = gather_forest(scene, request.out_dir, treeanim_generator());
   if (report.missing.empty()) {
     std::printf("forest: all %zu trees complete; manifest %s\n", forest.trees.size(),
-                forest_manifest_path(request.out_dir).string().c_str());
+                printable_text(forest_manifest_path(request.out_dir).string()).c_str());
     return 0;
   }
   std::map<size_t, std::vector<size_t>> by_task;  // task => indices into report.missing
@@ -31,16 +32,17 @@ int farm_gather_command(const FarmRequest& request) {
   }
   for (size_t m = 0; m < report.missing.size(); ++m) by_task[task_of[report.missing[m]]].push_back(m);
   std::fprintf(stderr, "treeanim: %zu of %zu trees are not complete; %s not written\n", report.missing.size(),
-               forest.trees.size(), forest_manifest_path(request.out_dir).string().c_str());
+               forest.trees.size(), printable_text(forest_manifest_path(request.out_dir).string()).c_str());
   for (const auto& [task, missing] : by_task) {
     if (request.tasks > 0) {
       std::fprintf(stderr, "  task %zu of %zu", task, request.tasks);
       if (!request.logs.empty())
-        std::fprintf(stderr, " (log %s)", (request.logs / ("task-" + std::to_string(task) + ".log")).c_str());
+        std::fprintf(stderr, " (log %s)", printable_text((request.logs / ("task-" + std::to_string(task) + ".log")).string()).c_str());
       std::fprintf(stderr, ": %zu tree%s\n", missing.size(), missing.size() == 1 ? "" : "s");
     }
     for (size_t m : missing)
-      std::fprintf(stderr, "    %s: %s\n", forest.trees[report.missing[m]].id.c_str(), report.reasons[m].c_str());
+      std::fprintf(stderr, "    %s: %s\n", printable_text(forest.trees[report.missing[m]].id).c_str(),
+                   printable_text(report.reasons[m]).c_str());
   }
   std::string failed;
   for (const auto& entry : by_task) failed += (failed.empty() ? "" : " ") + std::to_string(entry.first);
@@ -51,11 +53,11 @@ int farm_gather_command(const FarmRequest& request) {
   if (request.tasks > 0)
     std::fprintf(stderr, "what to do: read the logs above, then run each failed task I again (it resumes), for I "
                          "in %s:\n  treeanim run %s --shard I/%zu%s\nand gather again.\n",
-                 failed.c_str(), scene_word.c_str(), request.tasks, rest.c_str());
+                 failed.c_str(), printable_text(scene_word).c_str(), request.tasks, printable_text(rest).c_str());
   else
     std::fprintf(stderr, "what to do: bake the missing trees again (treeanim run %s%s bakes only those), then gather "
                          "again.\n",
-                 scene_word.c_str(), rest.c_str());
+                 printable_text(scene_word).c_str(), printable_text(rest).c_str());
   return kExitOutput;
 }
 

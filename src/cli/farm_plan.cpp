@@ -5,6 +5,7 @@
 #include "bake/forest_tasks.h"
 #include "cli/commands.h"
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "files/free_space.h"
 #include "files/text_output.h"
 
@@ -25,7 +26,7 @@ int farm_plan_command(const FarmRequest& request) {
                {"tasks", Json::array()},
                {"seconds_per_vertex_step", kSecondsPerVertexStep}};
   std::printf("forest %s: %zu trees of %zu variants, %lld frames x %d substeps, %zu tasks\n",
-              request.scene.string().c_str(), forest.trees.size(), forest.variants.size(), scene.time.frames,
+              printable_text(request.scene.string()).c_str(), forest.trees.size(), forest.variants.size(), scene.time.frames,
               scene.time.substeps, tasks.size());
   std::printf("%6s %7s %14s %11s %10s\n", "task", "trees", "vertex-steps", "core-hours", "bytes");
   double total_cost = 0, total_bytes = 0, most = 0;

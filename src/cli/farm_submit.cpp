@@ -11,6 +11,7 @@
 #include "cli/run_program.h"
 #include "cli/shell_words.h"
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "files/free_space.h"
 #include "files/staged_files.h"
 #include "files/text_output.h"
@@ -109,15 +110,16 @@ std::string trimmed(const std::string& text) {
 int report_submitted(const FarmJob& job, bool wait, const std::string& array_id, const std::string& gather_id,
                      int gather_status, const fs::path& array, const fs::path& gather) {
   std::printf("submitted job array %s (%zu tasks, logs %s) and gather job %s after it\n  scripts %s, %s\n",
-              array_id.c_str(), job.tasks, (job.logs / "task-<I>.log").c_str(), gather_id.c_str(),
-              array.c_str(), gather.c_str());
+              array_id.c_str(), job.tasks, printable_text((job.logs / "task-<I>.log").string()).c_str(), gather_id.c_str(),
+              printable_text(array.string()).c_str(), printable_text(gather.string()).c_str());
   if (!wait) {
-    std::printf("  the manifest will be %s; the gather's report: %s\n", (job.out / "forest.json").c_str(),
-                (job.logs / "gather.log").c_str());
+    std::printf("  the manifest will be %s; the gather's report: %s\n",
+                printable_text((job.out / "forest.json").string()).c_str(),
+                printable_text((job.logs / "gather.log").string()).c_str());
     return 0;
   }
   std::printf("gather job %s ended with exit %d; its report: %s\n", gather_id.c_str(), gather_status,
-              (job.logs / "gather.log").c_str());
+              printable_text((job.logs / "gather.log").string()).c_str());
   return gather_status;
 }
 
@@ -217,9 +219,10 @@ int farm_submit_command(const FarmRequest& request) {
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");
   const fs::path script = job.farm / (job.name + ".sh");
   write_text_output(script, plain_script(job), true);
+  const std::string shown = printable_text(script.string());
   std::printf("wrote %s: %zu tasks then the gather; run it (every task in turn), or give your queue one job per "
               "task ('%s I', I = 0 to %zu) and then '%s gather'\n",
-              script.c_str(), job.tasks, script.c_str(), job.tasks - 1, script.c_str());
+              shown.c_str(), job.tasks, shown.c_str(), job.tasks - 1, shown.c_str());
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
+#include "common/message_text.h"
 #include "formats/output_estimate.h"
 #include "formats/outputs.h"
 #include "formats/sink_factories.h"
@@ -62,7 +63,7 @@ int validate_command(const std::filesystem::path& scene_file,
     print_counts(tree_summary(scene, prepare_tree(scene)));
   }
   if (scene.volume) print_volume(*scene.volume);
-  std::printf("%s: OK\n", scene_file.string().c_str());
+  std::printf("%s: OK\n", printable_text(scene_file.string()).c_str());
   return 0;
 }
 
@@ -110,7 +111,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
               summary["estimate"]["bytes_per_frame"].get<double>() / 1024.0,
               summary["estimate"]["bytes_positions_total"].get<double>() / (1024.0 * 1024.0));
   for (const Json& output : outputs) {  // formats/output_estimate.h
-    const std::string path = output["path"].get<std::string>(), format = output["format"].get<std::string>();
+    const std::string path = printable_text(output["path"].get<std::string>()), format = output["format"].get<std::string>();
     const double mib = output["bytes"].get<double>() / (1024.0 * 1024.0);
     if (find_planned_bytes(format))  // a format that plans its whole size before simulating
       std::printf("output %s (%s): at most %.1f MiB in all, planned to fit its limit\n", path.c_str(), format.c_str(), mib);

@@ -61,8 +61,10 @@ std::string non_regular_kind(const fs::path& path) {
 }
 
 void MadeFolders::make(const fs::path& folder, std::error_code& error) {
+  // Missing: nothing there, not even a link (a dangling link is someone's, never ours to remove).
   std::vector<fs::path> missing;
-  for (fs::path p = folder; !p.empty() && !fs::exists(p, error); p = p.parent_path()) missing.push_back(p);
+  for (fs::path p = folder; !p.empty() && !fs::exists(fs::symlink_status(p, error)); p = p.parent_path())
+    missing.push_back(p);
   fs::create_directories(folder, error);
   made_.insert(made_.begin(), missing.begin(), missing.end());  // later folders first: deeper or apart
 }

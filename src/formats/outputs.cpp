@@ -150,11 +150,15 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
   const std::string absolute = file.is_absolute() ? file.string() : (cwd_ / file).string();
   const auto [it, inserted] = writer_.emplace(absolute, writer);
   if (!inserted) throw InputError(refused + "writes " + file.string() + ", which " + it->second + " writes too");
+  const std::string folder = absolute.substr(0, absolute.rfind('/'));
+  if (const auto owner = owned_.find(folder); owner != owned_.end() && owner->second != writer)
+    throw InputError(refused + "writes " + file.string() + ", in the folder of " + owner->second);
+  in_folder_.emplace(folder, writer);
   if (!written) return;
   if (!resolved.kind.empty())
     throw InputError(refused + target.string() + (file == target ? " is " : " links to " + file.string() + ", ") +
                      resolved.kind + ", left untouched; " + expected);
-  if (folders_.insert(absolute.substr(0, absolute.rfind('/'))).second) probes_.push_back(file);
+  if (folders_.insert(folder).second) probes_.push_back(file);
 }
 
 void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
@@ -173,12 +177,21 @@ void OutputTargets::add_file(const fs::path& file, const std::string& writer, bo
   add(file, writer, writer + ": ", "expected a regular file or a new one", written);
 }
 
+void OutputTargets::add_folder(const fs::path& folder, const std::string& writer) {
+  const fs::path normal = folder.lexically_normal();
+  std::string absolute = (normal.is_absolute() ? normal : cwd_ / normal).string();
+  if (absolute.size() > 1 && absolute.back() == '/') absolute.pop_back();
+  if (const auto other = in_folder_.find(absolute); other != in_folder_.end() && other->second != writer)
+    throw InputError(other->second + ": writes in " + folder.string() + ", the folder of " + writer);
+  owned_.emplace(absolute, writer);
+}
+
 void OutputTargets::probe(MadeFolders& made) const {
   for (const fs::path& file : probes_) check_writable_target(file, made);
 }
 
 OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& out_dir, const TreeModel& model,
-                     const BakeInfo& info)
+                     const BakeInfo& info, const fs::path& checkpoints)
     : impl_(std::make_unique<Impl>(model)) {
   impl_->files = output_files(outputs, out_dir, info.frame_start, info.frame_count);
   for (const OutputFiles& output : impl_->files) {
@@ -198,6 +211,7 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
   }
   try {
     OutputTargets targets;
+    if (!checkpoints.empty()) targets.add_folder(checkpoints, "the checkpoints");
     targets.add_outputs(outputs, out_dir, info.frame_start, info.frame_count);
     targets.probe(impl_->folders);
     for (const OutputFiles& output : impl_->files) impl_->locks.lock(output.path);

@@ -75,6 +75,9 @@ class OutputTargets {
                    long long frame_start, long long frame_count, const std::string& owner = "", bool written = true);
   // One more file, written by `writer` (e.g. "the forest's manifest").
   void add_file(const std::filesystem::path& file, const std::string& writer, bool written = true);
+  // A folder whose files only `writer` writes (a bake's checkpoints: it removes what it does not
+  // read back), refused to every other writer's files, added before or after it.
+  void add_folder(const std::filesystem::path& folder, const std::string& writer);
   // Each folder made when missing (into `made`, which the caller undoes when it gives up: a
   // folder another process may be writing into is not removed while it bakes) and a file
   // created and removed in it. Throws OutputError naming the path.
@@ -88,6 +91,8 @@ class OutputTargets {
 
   std::filesystem::path cwd_ = std::filesystem::current_path();
   std::unordered_map<std::string, std::string> writer_;  // absolute file written => its writer
+  std::unordered_map<std::string, std::string> in_folder_;  // absolute folder => a writer of a file in it
+  std::unordered_map<std::string, std::string> owned_;      // absolute folder => its only writer
   std::unordered_set<std::string> folders_;              // absolute folders seen
   std::vector<std::filesystem::path> probes_;            // the first file of each folder
 };
@@ -99,9 +104,10 @@ class OutputSet {
   // against other bakes (files/output_lock.h) before simulation; finish() and abort() unlock. The
   // options are as the scene reader checked them. Throws InputError for a target no output may
   // write (a directory, one written twice), OutputError naming the path for unwritable
-  // targets, a GLB past 4 GiB and an output another bake holds.
+  // targets, a GLB past 4 GiB and an output another bake holds. `checkpoints`: the folder of the
+  // bake's checkpoints (empty: none), where no output may write.
   OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
-            const TreeModel& model, const BakeInfo& info);
+            const TreeModel& model, const BakeInfo& info, const std::filesystem::path& checkpoints = {});
   ~OutputSet();  // abort()s when finish() was not reached
   OutputSet(const OutputSet&) = delete;
   OutputSet& operator=(const OutputSet&) = delete;

@@ -54,7 +54,12 @@ OutputOptions read_output_options(SceneObject element) {
   options.format = find_output_format(element.choice("format", "", formats));
   const auto path = element.optional_string("path");
   if (!path || path->empty()) element.fail_expected("path", "a non-empty path string");
+  if (path->find('\0') != std::string::npos) element.fail_expected("path", "a path without a NUL character");
   options.path = *path;
+  // A file's name, not a folder's: "out/" or "out/." would write the hidden file "out/.pc2" (or
+  // fail once the whole bake is done, where the folder stands).
+  if (const std::string name = options.path.filename().string(); name.empty() || name == "." || name == "..")
+    element.fail("path", "expected the path of a file, got \"" + excerpt(*path) + "\", which names a folder");
   if (*options.format->path_extension && options.path.extension() != options.format->path_extension)
     element.fail("path", std::string(options.format->file_kind) + " whose name ends in " +
                              options.format->path_extension + " (e.g. \"" +

@@ -183,6 +183,8 @@ std::optional<std::filesystem::path> SceneObject::optional_path(const std::strin
   auto text = optional_string(key);
   if (!text) return std::nullopt;
   if (text->empty()) fail_expected(key, "a non-empty path");
+  // The system reads a path only up to a NUL: the file opened would not be the one named.
+  if (text->find('\0') != std::string::npos) fail_expected(key, "a path without a NUL character");
   std::filesystem::path p(*text);
   return p.is_absolute() ? p : (reader_->scene_dir() / p).lexically_normal();
 }

@@ -348,6 +348,14 @@ TEST_F(OutputSetTest, EachFileOfSeveralWritersHasOne) {
             (dir_ / "blocked/c.h5").string() + ": cannot create the folder " + (dir_ / "blocked").string() +
                 ": Not a directory");
   EXPECT_EQ(entries(), std::vector<std::string>{"blocked"});
+  // A dangling link where a folder goes is someone's: refused, and left where it was.
+  std::filesystem::remove(dir_ / "blocked");
+  std::filesystem::create_directory_symlink(dir_ / "nowhere", dir_ / "linked");
+  EXPECT_NE(refusal([&](OutputTargets& t) {
+              t.add_outputs({output("hdf5", "linked/c.h5")}, dir_, info.frame_start, info.frame_count, "tree c");
+            }),
+            "no error");
+  EXPECT_TRUE(std::filesystem::is_symlink(dir_ / "linked"));
 }
 
 TEST_F(OutputSetTest, FailedRenameRemovesEveryTemporary) {
