@@ -43,8 +43,9 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
     targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, written);
     targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, written);
     if (written && plan.checkpoints.every > 0) {
-      targets.add_folder(plan.checkpoints.dir, "the checkpoints of tree " + id);
-      targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), "the checkpoints of tree " + id);
+      const std::string checkpoints = "the checkpoints of tree " + id;
+      targets.add_folder(plan.checkpoints.dir, checkpoints);
+      targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), checkpoints);
     }
   }
   MadeFolders made;  // kept once every folder takes a file: the trees write there

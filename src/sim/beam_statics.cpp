@@ -117,20 +117,40 @@ struct MemberLoads {
   const Real* arm[3];
 };
 
+// A member's share (1 / active memberships, 0 when released), its vertex's drag f and damping
+// D, its rest arm a => its ten values of LoadLanes: f, a x f, 2 D and 2 D a, each times the
+// share. T: a Real, or four members in lanes (sum_four_members).
+template <typename T>
+inline void member_load(const T& share, const T& fx, const T& fy, const T& fz, const T& drag_damping, const T& ax,
+                        const T& ay, const T& az, T (&value)[10]) {
+  const T gx = fx * share, gy = fy * share, gz = fz * share;
+  const T d = 2 * drag_damping * share;
+  value[0] = gx, value[1] = gy, value[2] = gz;
+  value[3] = ay * gz - az * gy, value[4] = az * gx - ax * gz, value[5] = ax * gy - ay * gx;
+  value[6] = d, value[7] = ax * d, value[8] = ay * d, value[9] = az * d;
+}
+
+// A cluster's ten load sums, sum_of(k) for value k => stored where the chain reads them.
+template <typename SumOf>
+inline void store_cluster_loads(SumOf sum_of, double* load, double* moment, double& damping, double* damping_moment) {
+  for (int i = 0; i < 3; ++i) {
+    load[i] = sum_of(i);
+    moment[i] = sum_of(3 + i);
+    damping_moment[i] = sum_of(7 + i);
+  }
+  damping = sum_of(6);
+}
+
 // Membership s of vertex v, `on` 1 when it is active, else 0 => the vertex's share of the loads
 // and their moments, added in lane l. `on` comes as a Real: a byte read in the vector loop would
 // make GCC run it in 8-byte vectors.
 template <typename Real, int Lanes>
 inline void add_member_load(const MemberLoads<Real>& in, size_t s, size_t v, Real on, int l,
                             LoadLanes<Real, Lanes>& sum) {
-  const Real share = in.inv_count[v] * on;
-  const Real gx = in.force[0][v] * share, gy = in.force[1][v] * share, gz = in.force[2][v] * share;
-  const Real d = 2 * in.drag_damping[v] * share;
-  const Real ax = in.arm[0][s], ay = in.arm[1][s], az = in.arm[2][s];
-  sum.lane[0][l] += gx, sum.lane[1][l] += gy, sum.lane[2][l] += gz;
-  sum.lane[3][l] += ay * gz - az * gy, sum.lane[4][l] += az * gx - ax * gz, sum.lane[5][l] += ax * gy - ay * gx;
-  sum.lane[6][l] += d;
-  sum.lane[7][l] += ax * d, sum.lane[8][l] += ay * d, sum.lane[9][l] += az * d;
+  Real value[10];
+  member_load(in.inv_count[v] * on, in.force[0][v], in.force[1][v], in.force[2][v], in.drag_damping[v], in.arm[0][s],
+              in.arm[1][s], in.arm[2][s], value);
+  for (int k = 0; k < 10; ++k) sum.lane[k][l] += value[k];
 }
 
 // Eight lanes => their sum in a fixed order, ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)),
@@ -155,7 +175,7 @@ inline double sum_lanes(const Real (&lane)[4]) {
 // one vector: each lane starts at +0 as LoadLanes does.
 template <typename Real>
 inline void sum_four_members(const MemberLoads<Real>& in, size_t s, size_t v, const Real (&on)[4], double* load,
-                             double* moment, double* damping, double* damping_moment) {
+                             double* moment, double& damping, double* damping_moment) {
   using V4 = typename Lanes4<Real>::type;
   V4 flags, inv_count, fx, fy, fz, drag_damping, ax, ay, az;
   std::memcpy(&flags, on, sizeof flags);
@@ -167,19 +187,15 @@ inline void sum_four_members(const MemberLoads<Real>& in, size_t s, size_t v, co
   std::memcpy(&ax, in.arm[0] + s, sizeof ax);
   std::memcpy(&ay, in.arm[1] + s, sizeof ay);
   std::memcpy(&az, in.arm[2] + s, sizeof az);
-  const V4 zero = {}, share = inv_count * flags;
-  const V4 gx = fx * share, gy = fy * share, gz = fz * share;
-  const V4 d = 2 * drag_damping * share;
-  const V4 lane[10] = {zero + gx,           zero + gy,           zero + gz,           zero + (ay * gz - az * gy),
-                       zero + (az * gx - ax * gz), zero + (ax * gy - ay * gx), zero + d, zero + ax * d,
-                       zero + ay * d,       zero + az * d};
-  auto total = [](const V4& x) { return double((x[0] + x[2]) + (x[1] + x[3])); };  // sum_lanes
-  for (int i = 0; i < 3; ++i) {
-    load[i] = total(lane[i]);
-    moment[i] = total(lane[3 + i]);
-    damping_moment[i] = total(lane[7 + i]);
-  }
-  *damping = total(lane[6]);
+  V4 value[10];
+  member_load(V4(inv_count * flags), fx, fy, fz, drag_damping, ax, ay, az, value);
+  const V4 zero = {};
+  store_cluster_loads(
+      [&](int k) {
+        const V4 lane = zero + value[k];
+        return double((lane[0] + lane[2]) + (lane[1] + lane[3]));  // sum_lanes
+      },
+      load, moment, damping, damping_moment);
 }
 
 }  // namespace
@@ -251,14 +267,8 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
       else
         add_loads(std::false_type{});
     }
-    double *load = &scratch.cluster_load(0, c), *moment = &scratch.cluster_moment(0, c);
-    double* damping_moment = &scratch.cluster_damping_moment(0, c);
-    for (int i = 0; i < 3; ++i) {
-      load[i] = sum_lanes(sum.lane[i]);
-      moment[i] = sum_lanes(sum.lane[3 + i]);
-      damping_moment[i] = sum_lanes(sum.lane[7 + i]);
-    }
-    scratch.cluster_damping[c] = sum_lanes(sum.lane[6]);
+    store_cluster_loads([&](int k) { return sum_lanes(sum.lane[k]); }, &scratch.cluster_load(0, c),
+                        &scratch.cluster_moment(0, c), scratch.cluster_damping[c], &scratch.cluster_damping_moment(0, c));
   };
   with_kernel_isa([&] {
     for (size_t i = 0; i < n; ++i) {
@@ -269,7 +279,7 @@ void sum_loads(const SolverModel<Real>& model, const Attachment<Real>& attachmen
         if (attachment.cluster_released[c])
           for (int l = 0; l < 4; ++l) on[l] = static_cast<Real>(loads.active[begin + l]);
         sum_four_members(loads, begin, members[begin], on, &scratch.cluster_load(0, c), &scratch.cluster_moment(0, c),
-                         &scratch.cluster_damping[c], &scratch.cluster_damping_moment(0, c));
+                         scratch.cluster_damping[c], &scratch.cluster_damping_moment(0, c));
         continue;
       }
       if (count <= 4)

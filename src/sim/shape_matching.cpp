@@ -76,6 +76,14 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
   const Real r00 = Real(R[0]), r01 = Real(R[3]), r02 = Real(R[6]), r10 = Real(R[1]), r11 = Real(R[4]), r12 = Real(R[7]);
   const Real r20 = Real(R[2]), r21 = Real(R[5]), r22 = Real(R[8]);
   const Real tx = Real(shift[0]), ty = Real(shift[1]), tz = Real(shift[2]);
+  // Rest offset q, predicted u, weight => the correction weight (R q - q + shift - u); each a
+  // Real, or four members in lanes.
+  auto correction = [&](const auto& weight, const auto& x, const auto& y, const auto& z, const auto& vx,
+                        const auto& vy, const auto& vz, auto& px, auto& py, auto& pz) {
+    px = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - vx);
+    py = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - vy);
+    pz = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
+  };
   // A run of memberships whose rows are consecutive is one loop; where the rows are the member
   // vertices' own (a free vertex in this cluster alone), their u is read in order too. Only a
   // cluster with released memberships reads their flags (Attachment::cluster_released).
@@ -93,9 +101,7 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
       }
       Real weight = alpha;
       if constexpr (any_released) weight = active[s] ? alpha : Real(0);  // a released membership pulls nothing
-      cx[s + to_row] = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - vx);
-      cy[s + to_row] = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - vy);
-      cz[s + to_row] = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
+      correction(weight, x, y, z, vx, vy, vz, cx[s + to_row], cy[s + to_row], cz[s + to_row]);
     }
   };
   const bool released = a.cluster_released[c] != 0;
@@ -109,9 +115,8 @@ void write_corrections(const SolverModel<Real>& model, const Attachment<Real>& a
     std::memcpy(&vx, ux + v, sizeof vx), std::memcpy(&vy, uy + v, sizeof vy), std::memcpy(&vz, uz + v, sizeof vz);
     if (released)
       for (int l = 0; l < 4; ++l) weight[l] = active[begin + l] ? alpha : Real(0);
-    const Lanes px = weight * ((((r00 * x + r01 * y) + r02 * z) - x) + tx - vx);
-    const Lanes py = weight * ((((r10 * x + r11 * y) + r12 * z) - y) + ty - vy);
-    const Lanes pz = weight * ((((r20 * x + r21 * y) + r22 * z) - z) + tz - vz);
+    Lanes px, py, pz;
+    correction(weight, x, y, z, vx, vy, vz, px, py, pz);
     for (int l = 0; l < 4; ++l) {
       const uint32_t row = model.member_correction_row[begin + l];
       cx[row] = px[l], cy[row] = py[l], cz[row] = pz[l];
