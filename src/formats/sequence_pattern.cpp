@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -33,9 +34,15 @@ SequencePattern sequence_pattern(const fs::path& path, const std::string& extens
                          name.find('%', percent + 1) == std::string::npos;
   if (!one_field)
     throw InputError(pointer + "/path: expected at most one frame-number field \"%d\" or \"%0Nd\" (N 1-9) in "
-                     "the file name, got \"" + text + "\"");
+                     "the file name, got \"" + excerpt(text) + "\"");
   const size_t field_start = text.size() - name.size() + percent;
-  return {text.substr(0, field_start), text.substr(field_start + field_length), padded ? name[percent + 2] - '0' : 1};
+  SequencePattern pattern{text.substr(0, field_start), text.substr(field_start + field_length),
+                          padded ? name[percent + 2] - '0' : 1};
+  // The files hold what the extension says: a glTF sequence named "f%d.obj" would write GLBs as .obj.
+  if (!pattern.suffix.ends_with(extension))
+    throw InputError(pointer + "/path: expected a file name that ends in " + extension + " after its frame field (e.g. \"" +
+                     excerpt(name.substr(0, percent + field_length)) + extension + "\"), got \"" + excerpt(text) + "\"");
+  return pattern;
 }
 
 }  // namespace treeanim

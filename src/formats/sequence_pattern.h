@@ -16,7 +16,8 @@ struct SequencePattern {
 
 // An output path => its sequence pattern. A path with one "%d" or "%0Nd" field keeps it;
 // any other path gets ".%04d<extension>" appended (after dropping a trailing `extension`).
-// Throws InputError "<pointer>/path: ..." for other '%' fields.
+// Throws InputError "<pointer>/path: ..." for other '%' fields, and for a field not followed
+// by a name that ends in `extension`.
 SequencePattern sequence_pattern(const std::filesystem::path& path, const std::string& extension,
                                  const std::string& pointer);
 

@@ -18,7 +18,7 @@
 namespace treeanim {
 
 // A place in a grammar source. line 0 marks a one-line source (an inline scene rule),
-// reported as "name:column".
+// reported as "name, column N".
 struct SourcePos {
   int32_t source = 0;  // index into Grammar::sources
   int32_t line = 0;    // 1-based; 0 for a one-line source

@@ -85,7 +85,7 @@ struct Lsystem {
 };
 
 struct Grammar {
-  std::vector<std::string> sources;   // names of the texts (file path, or <scene>/lsystem/...)
+  std::vector<std::string> sources;   // names of the texts (file path, or "scene.json: /lsystem/...")
   ExprProgram program;                // code of every expression
   std::vector<std::pair<std::string, double>> defines;  // resolved, scene overrides applied
   std::vector<SuccessorModule> axiom;       // evaluated when derivation starts (ran() uses the seed)
@@ -109,7 +109,7 @@ struct Grammar {
   // Index in lsystems of the first "lsystem: label" (label truncated, as cpfg does), or -1.
   int lsystem_index(double label) const;
 
-  // "file:line:column" or "name:column" of a place.
+  // "file:line:column" or "name, column N" of a place.
   std::string where(const SourcePos& pos) const;
 };
 

@@ -933,7 +933,7 @@ int Grammar::lsystem_index(double label) const {
 
 std::string Grammar::where(const SourcePos& pos) const {
   const std::string& name = sources.at(static_cast<size_t>(pos.source));
-  if (pos.line == 0) return name + ":" + std::to_string(pos.column);
+  if (pos.line == 0) return name + ", column " + std::to_string(pos.column);
   return name + ":" + std::to_string(pos.line) + ":" + std::to_string(pos.column);
 }
 

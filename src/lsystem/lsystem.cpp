@@ -24,8 +24,8 @@ void check_overrides(const LsystemOptions& options, const Grammar& grammar, cons
       continue;
     std::string known;
     for (const std::string& d : grammar.file_defines) known += (known.empty() ? "" : ", ") + d;
-    throw InputError(source + ": " + options.inline_name + "/defines/" + name +
-                     ": the grammar has no '#define " + name + "' (it defines: " +
+    throw InputError(options.inline_name() + "/defines/" + name + ": the grammar " + source + " has no '#define " +
+                     name + "' (it defines: " +
                      (known.empty() ? "nothing" : known) + ")");
   }
 }
@@ -76,7 +76,7 @@ ViewSettings load_view(const LsystemOptions& options) {
 
 std::string grammar_name(const LsystemOptions& options) {
   return options.grammar ? options.grammar->string()
-                         : options.library_grammar ? options.library_grammar->name : options.inline_name;
+                         : options.library_grammar ? options.library_grammar->name : options.inline_name();
 }
 
 Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
@@ -89,8 +89,8 @@ Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   }
   std::vector<GrammarText> texts;
   for (size_t i = 0; i < options.productions.size(); ++i)
-    texts.push_back({options.inline_name + "/productions/" + std::to_string(i), options.productions[i], true});
-  return parse_grammar(texts, options.defines, GrammarText{options.inline_name + "/axiom", options.axiom, true});
+    texts.push_back({options.inline_name() + "/productions/" + std::to_string(i), options.productions[i], true});
+  return parse_grammar(texts, options.defines, GrammarText{options.inline_name() + "/axiom", options.axiom, true});
 }
 
 DerivationSettings derivation_settings(const LsystemOptions& options, const Grammar& grammar) {
@@ -99,7 +99,7 @@ DerivationSettings derivation_settings(const LsystemOptions& options, const Gram
   else if (grammar.derivation_length) settings.iterations = *grammar.derivation_length;
   else
     throw InputError(grammar.sources.at(0) + ": the grammar has no 'derivation length:'; give the number of steps as " +
-                     options.inline_name.substr(std::string("<scene>").size()) + "/iterations");
+                     options.pointer + "/iterations");
   // Seed 0 in the grammar leaves the scene seed as it is.
   settings.seed = options.seed ^ (grammar.seed * 0x9e3779b97f4a7c15ULL);
   settings.max_modules = options.max_modules;

@@ -32,7 +32,7 @@ DerivationSettings derivation_settings(const LsystemOptions& options, const Gram
 TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& grammar, const ViewSettings& view = {});
 
 // options => the name messages give the grammar: its file, the species' grammar, or the
-// scene's inline rules ("<scene>/lsystem").
+// scene's inline rules ("scene.json: /lsystem").
 std::string grammar_name(const LsystemOptions& options);
 
 // options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).

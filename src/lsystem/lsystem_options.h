@@ -10,7 +10,7 @@
 
 namespace treeanim {
 
-// One text of a grammar: a whole file, or one inline rule (single_line: reported as name:column).
+// One text of a grammar: a whole file, or one inline rule (single_line: reported as "name, column N").
 struct GrammarText {
   std::string name;
   std::string text;
@@ -33,7 +33,10 @@ struct LsystemOptions {
   std::optional<Eigen::Vector3d> tropism;        // overrides T of "tropism:"
   std::optional<double> tropism_elasticity;      // overrides e of "tropism:"
   std::optional<int> surface_precision;          // quads per patch along s and t of every view-file surface (1 ... 10)
-  std::string inline_name = "<scene>/lsystem";   // names inline rules in messages (+ "/axiom", "/productions/3")
+  std::string scene_name;                        // the scene file that holds the section ("" when none)
+  std::string pointer = "/lsystem";              // the section's JSON pointer in it
+  // What messages call the section's inline rules: "scene.json: /lsystem" (+ "/axiom", "/productions/3").
+  std::string inline_name() const { return scene_name.empty() ? pointer : scene_name + ": " + pointer; }
 };
 
 }  // namespace treeanim

@@ -46,7 +46,8 @@ std::vector<std::pair<std::string, double>> read_defines(SceneObject& section) {
 
 LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, const GrammarText* species_grammar) {
   LsystemOptions options;
-  options.inline_name = "<scene>" + section.pointer();
+  options.scene_name = section.source_name();
+  options.pointer = section.pointer();
   options.grammar = section.optional_path("grammar");
   const std::optional<std::string> axiom = section.optional_string("axiom");
   options.productions = read_productions(section);

@@ -232,6 +232,8 @@ void SceneReader::fail(const std::string& pointer, const std::string& message) c
   throw InputError((source_name_.empty() ? "" : source_name_ + ": ") + where + ": " + message);
 }
 
+const std::string& SceneObject::source_name() const { return reader_->source_name(); }
+
 SceneObject SceneReader::root() { return SceneObject(this, &root_, ""); }
 
 void SceneReader::register_object(const std::string& object_pointer) {

@@ -75,6 +75,8 @@ class SceneObject {
   // "<pointer>/<key>" with JSON-pointer escaping.
   std::string pointer_of(const std::string& key) const;
   const std::string& pointer() const { return pointer_; }
+  // The scene file's name as messages give it ("" when none).
+  const std::string& source_name() const;
   // The object as read so far (defaults of the keys read are filled in).
   const Json& json() const { return *node_; }
   // Throws InputError "<pointer>/<key>: <message>".
@@ -100,6 +102,7 @@ class SceneReader {
 
   SceneObject root();
   const std::filesystem::path& scene_dir() const { return scene_dir_; }
+  const std::string& source_name() const { return source_name_; }
   // Throws InputError "<source>: <pointer>: <message>".
   [[noreturn]] void fail(const std::string& pointer, const std::string& message) const;
   // Throws InputError for the first key (in document order) no reader declared.

@@ -77,9 +77,9 @@ TEST(GrowSkeleton, SceneDefineMustExistInTheFile) {
   LsystemOptions options;
   options.grammar = grammar_file("abop-2.6a-monopodial.lsys");
   options.defines = {{"r9", 0.5}};
-  std::string expected = options.grammar->string();
-  expected += ": <scene>/lsystem/defines/r9: the grammar has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)";
-  EXPECT_EQ(error_of(options), expected);
+  options.scene_name = "scene.json";
+  EXPECT_EQ(error_of(options), "scene.json: /lsystem/defines/r9: the grammar " + options.grammar->string() +
+                                   " has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)");
 }
 
 TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
@@ -87,7 +87,7 @@ TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
   options.axiom = std::string("F");  // (a plain = "F" trips g++ 12's false -Wrestrict)
   options.productions = {"F --> FF"};
   EXPECT_EQ(error_of(options),
-            "<scene>/lsystem/axiom: the grammar has no 'derivation length:'; give the number of steps as "
+            "/lsystem/axiom: the grammar has no 'derivation length:'; give the number of steps as "
             "/lsystem/iterations");
 }
 
@@ -103,7 +103,7 @@ TEST(GrowSkeleton, InlineErrorsNameTheRule) {
   options.productions = {"A(x) --> A(x)", "A(x) --> B(x, q)"};
   options.iterations = 1;
   EXPECT_EQ(error_of(options),
-            "<scene>/lsystem/productions/1:15: unknown name 'q' (expected a formal parameter (x))");
+            "/lsystem/productions/1, column 15: unknown name 'q' (expected a formal parameter (x))");
 }
 
 }  // namespace

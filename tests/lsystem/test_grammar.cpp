@@ -91,17 +91,17 @@ TEST(Grammar, SceneDefinesOverrideFileDefines) {
 
 TEST(Grammar, InlineRulesAreNamedByPointer) {
   try {
-    parse_grammar({{"<scene>/lsystem/productions/0", "A --> B", true}, {"<scene>/lsystem/productions/1", "B --> C(", true}},
-                  {}, GrammarText{"<scene>/lsystem/axiom", "A", true});
+    parse_grammar({{"s.json: /lsystem/productions/0", "A --> B", true}, {"s.json: /lsystem/productions/1", "B --> C(", true}},
+                  {}, GrammarText{"s.json: /lsystem/axiom", "A", true});
     FAIL();
   } catch (const InputError& error) {
-    EXPECT_STREQ(error.what(), "<scene>/lsystem/productions/1:9: expected a number, a name or '(', got the end of the expression");
+    EXPECT_STREQ(error.what(), "s.json: /lsystem/productions/1, column 9: expected a number, a name or '(', got the end of the expression");
   }
   try {
-    parse_grammar({}, {}, GrammarText{"<scene>/lsystem/axiom", "A[B", true});
+    parse_grammar({}, {}, GrammarText{"s.json: /lsystem/axiom", "A[B", true});
     FAIL();
   } catch (const InputError& error) {
-    EXPECT_STREQ(error.what(), "<scene>/lsystem/axiom:2: unbalanced brackets: '[' is never closed (expected ']' before the end of the axiom)");
+    EXPECT_STREQ(error.what(), "s.json: /lsystem/axiom, column 2: unbalanced brackets: '[' is never closed (expected ']' before the end of the axiom)");
   }
 }
 

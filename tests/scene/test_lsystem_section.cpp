@@ -29,7 +29,7 @@ TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {
   EXPECT_EQ(o.seed, 77u);  // the scene's top-level seed
   EXPECT_EQ(o.step, 1.0);
   EXPECT_EQ(o.max_modules, 20'000'000u);
-  EXPECT_EQ(o.inline_name, "<scene>/lsystem");
+  EXPECT_EQ(o.inline_name(), "scene.json: /lsystem");
   EXPECT_EQ(scene["lsystem"]["seed"], 77);
   EXPECT_EQ(scene["lsystem"]["max_modules"], 20'000'000);
 }
