@@ -16,38 +16,48 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Which of `trees` are complete already (--resume: their parts say so); and, before the first
-// tree grows, every file the forest writes looked at (OutputTargets): the manifest and its
-// stage and page, each tree's outputs, part and checkpoints, each written by one writer and
-// absent or a regular file, and every folder they go into able to take a file. Found only as
-// each tree is baked, a later tree's bad target would fail the forest after earlier trees
-// were written. Every tree of the forest is counted for "one writer" (a tree of another shard,
-// or a complete one, keeps its files); the trees baked here are looked at and probed.
-std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees) {
-  const Forest& forest = *scene.forest;
-  std::vector<size_t> position(forest.trees.size(), trees.size());  // index into `trees`, or none
-  for (size_t i = 0; i < trees.size(); ++i) position[trees[i]] = i;
-  std::vector<bool> complete(trees.size(), false);
-  OutputTargets targets;
-  add_forest_targets(scene, config.out_dir, targets, !config.shard);
-  for (size_t t = 0; t < forest.trees.size(); ++t) {
-    const std::string& id = forest.trees[t].id;
+// Every file the forest writes into `targets`: the manifest and its stage and page, each tree's
+// outputs and part, and the checkpoints of the trees that write now. `written(t)`: tree t bakes
+// now (its targets are looked at as well as counted); the others only keep their files from
+// any other writer.
+template <typename Written>
+void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifest_written, Written written,
+                      OutputTargets& targets) {
+  add_forest_targets(scene, config.out_dir, targets, manifest_written);
+  for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
+    const std::string& id = scene.forest->trees[t].id;
     const Scene one = tree_scene(scene, t);
-    const size_t i = position[t];
-    std::string why;
-    if (i < trees.size())
-      complete[i] = config.checkpoints.resume &&
-                    complete_tree_part(config.out_dir, id, bake_key(one, config.generator), why);
-    const bool written = i < trees.size() && !complete[i];
+    const bool writes = written(t, one);
     const BakePlan plan = plan_bake(one, tree_bake_config(config, id));
-    targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, written);
-    targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, written);
-    if (written && plan.checkpoints.every > 0) {
+    targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, writes);
+    targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, writes);
+    if (writes && plan.checkpoints.every > 0) {
       const std::string checkpoints = "the checkpoints of tree " + id;
       targets.add_folder(plan.checkpoints.dir, checkpoints);
       targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), checkpoints);
     }
   }
+}
+
+// Which of `trees` are complete already (--resume: their parts say so); and, before the first
+// tree grows, every file the forest writes looked at (OutputTargets): each written by one
+// writer and absent or a regular file, and every folder they go into able to take a file.
+// Found only as each tree is baked, a later tree's bad target would fail the forest after
+// earlier trees were written. Every tree of the forest is counted for "one writer" (a tree of
+// another shard, or a complete one, keeps its files); the trees baked here are looked at and probed.
+std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees) {
+  std::vector<size_t> position(scene.forest->trees.size(), trees.size());  // index into `trees`, or none
+  for (size_t i = 0; i < trees.size(); ++i) position[trees[i]] = i;
+  std::vector<bool> complete(trees.size(), false);
+  OutputTargets targets;
+  add_forest_files(scene, config, !config.shard, [&](size_t t, const Scene& one) {
+    const size_t i = position[t];
+    if (i == trees.size()) return false;
+    std::string why;
+    complete[i] = config.checkpoints.resume &&
+                  complete_tree_part(config.out_dir, scene.forest->trees[t].id, bake_key(one, config.generator), why);
+    return !complete[i];
+  }, targets);
   MadeFolders made;  // kept once every folder takes a file: the trees write there
   try {
     targets.probe(made);
@@ -59,6 +69,11 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
 }
 
 }  // namespace
+
+void check_forest_writers(const Scene& scene) {
+  OutputTargets targets;
+  add_forest_files(scene, BakeConfig{}, false, [](size_t, const Scene&) { return false; }, targets);
+}
 
 ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,
                              const BakeLog& log) {

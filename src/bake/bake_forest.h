@@ -17,6 +17,10 @@ struct ForestBakeResult {
   size_t skipped = 0;  // trees complete before (--resume)
 };
 
+// Every file the forest would write has one writer (the manifest, each tree's outputs and
+// part), wherever it bakes: InputError naming both writers, as a bake reports it. Writes nothing.
+void check_forest_writers(const Scene& scene);
+
 // Bakes `trees` (shard_trees()) of the forest. With --resume a tree whose part says it is
 // complete is skipped and the tree in progress resumes from its checkpoint. Without a shard,
 // writes OUT/forest.json at the end (OutputError when a tree's files went missing meanwhile).

@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "bake/bake_forest.h"
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
@@ -57,6 +58,7 @@ int validate_command(const std::filesystem::path& scene_file,
   const Scene scene = load_scene(scene_file, overrides);
   check_output_paths(scene.outputs);
   if (scene.forest) {
+    check_forest_writers(scene);
     estimate_forest(scene);  // grows one tree of each variant
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
