@@ -88,13 +88,17 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
       return result;
     }
     log.forest_tree(i, trees.size(), trees[i], complete[i]);
+    const ForestTree& tree = forest.trees[trees[i]];
+    const BakeConfig own = tree_bake_config(config, tree.id);
+    // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent
+    // (a bake killed between its part and their removal left them).
+    std::error_code ignored;
     if (complete[i]) {
+      if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
       ++result.skipped;
       continue;
     }
-    const ForestTree& tree = forest.trees[trees[i]];
     const Scene one = tree_scene(scene, trees[i]);
-    const BakeConfig own = tree_bake_config(config, tree.id);
     const TreePlacement placement = make_tree_placement(tree.position, tree.rotation);
     const TreeBakeResult baked = bake_tree(one, own, &placement, log);
     if (baked.exit_code != 0) {
@@ -104,15 +108,14 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     {
       const DeferredInterrupts deferred;  // the part is written whole, the spent checkpoints all removed
       write_tree_part(config, scene, trees[i], one, baked);
-      // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent.
-      std::error_code ignored;
       if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
     }
     ++result.baked;
   }
   if (config.shard) return result;
   const DeferredInterrupts deferred;  // the manifest is written whole
-  const GatherReport report = gather_forest(scene, config.out_dir, config.generator);
+  const GatherReport report =
+      gather_forest(scene, config.out_dir, config.generator, config.checkpoints.every > 0 ? config.checkpoints.dir : "");
   if (!report.missing.empty())  // a file removed while the forest baked
     throw OutputError(forest.trees[report.missing.front()].id + ": " + report.reasons.front());
   return result;

@@ -1,5 +1,7 @@
 #include "bake/forest_manifest.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 
 #include "common/json_text.h"
@@ -159,7 +161,8 @@ void add_forest_targets(const Scene& scene, const fs::path& out_dir, OutputTarge
   if (first_output(scene, "html")) targets.add_file(forest_page_path(out_dir), "the forest's page", written);
 }
 
-GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator) {
+GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator,
+                           const fs::path& checkpoints) {
   GatherReport report;
   Json trees = Json::array();
   for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
@@ -190,6 +193,8 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
                          {"fps", scene.time.fps},
                          {"trees", std::move(trees)}};
   write_text_output(forest_manifest_path(out_dir), manifest.dump(2) + "\n");
+  // Each finished tree removed its spent checkpoints; rmdir leaves a folder with files, or a link.
+  if (!checkpoints.empty()) ::rmdir(checkpoints.c_str());
   return report;
 }
 

@@ -40,9 +40,11 @@ struct GatherReport {
   std::vector<std::string> reasons;  // (missing) why
 };
 
-// Every tree complete (its part of this generator's key) => writes OUT/forest.json and returns
-// no missing trees; else writes nothing and returns them. Throws OutputError when the manifest
-// cannot be written.
-GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir, const std::string& generator);
+// Every tree complete (its part of this generator's key) => writes OUT/forest.json, removes
+// the folder of the trees' checkpoints (`checkpoints`, "" for none) when their bakes left it
+// empty, and returns no missing trees; else writes nothing and returns them. Throws
+// OutputError when the manifest cannot be written.
+GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir, const std::string& generator,
+                           const std::filesystem::path& checkpoints);
 
 }  // namespace treeanim

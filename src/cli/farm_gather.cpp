@@ -17,7 +17,9 @@ int farm_gather_command(const FarmRequest& request) {
   const Forest& forest = *scene.forest;
   OutputTargets targets;  // a folder where the manifest goes is bad input, as for run
   add_forest_targets(scene, request.out_dir, targets);
-  const GatherReport report = gather_forest(scene, request.out_dir, treeanim_generator());
+  // The tasks' checkpoints, in the output folder (farm_submit.cpp).
+  const GatherReport report =
+      gather_forest(scene, request.out_dir, treeanim_generator(), checkpoint_folder(request.out_dir, {}));
   if (report.missing.empty()) {
     std::printf("forest: all %zu trees complete; manifest %s\n", forest.trees.size(),
                 printable_text(forest_manifest_path(request.out_dir).string()).c_str());

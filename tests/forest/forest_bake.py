@@ -139,7 +139,13 @@ def case_resume(treeanim, tmp):
     if process.returncode != -signal.SIGKILL:
         raise Failed("expected the shard to die of SIGKILL, got exit %s" % process.returncode)
     finished = len(os.listdir(parts))
+    # As a kill between a tree's part and the removal of its checkpoints leaves them: spent.
+    spent = os.path.join(out, "checkpoints", sorted(os.listdir(parts))[0][:-len(".json")])
+    os.makedirs(spent, exist_ok=True)
+    open(os.path.join(spent, "checkpoint-20.h5"), "wb").close()
     done = run(treeanim, "run", SCENE, "-o", out, *shard, "--resume", *longer)
+    if os.path.exists(spent):
+        raise Failed("the resumed shard skipped a complete tree but left its spent checkpoints in %s" % spent)
     if done.stdout.count("complete, skipped") != finished:
         raise Failed("%d trees were complete, the resumed shard skipped %d:\n%s"
                      % (finished, done.stdout.count("complete, skipped"), done.stdout))
@@ -148,6 +154,9 @@ def case_resume(treeanim, tmp):
     run(treeanim, "run", SCENE, "-o", out, "-q", "--shard", "1/2", *longer)
     run(treeanim, "farm", "gather", SCENE, "-o", out, *longer)
     same_outputs(reference, out)
+    if os.path.exists(os.path.join(out, "checkpoints")):
+        raise Failed("the forest is whole, yet the folder of its spent checkpoints stayed: %s"
+                     % sorted(os.listdir(os.path.join(out, "checkpoints"))))
 
 
 def case_plan(treeanim, tmp):
