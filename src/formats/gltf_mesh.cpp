@@ -1,10 +1,64 @@
 #include "formats/gltf_mesh.h"
 
 #include <algorithm>
+#include <exception>
 #include <limits>
+#include <ostream>
+#include <streambuf>
 #include <utility>
 
+#include "common/errors.h"
+#include "files/io_failure.h"
+#include "files/output_file.h"
+
 namespace treeanim {
+
+namespace {
+
+// A stream's bytes into an OutputFile; the first failure is kept for the caller (a stream
+// swallows what its buffer throws) and ends the writing.
+class OutputFileBuffer final : public std::streambuf {
+ public:
+  explicit OutputFileBuffer(OutputFile& file) : file_(file) {}
+  void rethrow() const {
+    if (failure_) std::rethrow_exception(failure_);
+  }
+
+ protected:
+  std::streamsize xsputn(const char* data, std::streamsize count) override {
+    if (failure_) return 0;
+    try {
+      file_.write(data, static_cast<size_t>(count));
+      return count;
+    } catch (...) {
+      failure_ = std::current_exception();
+      return 0;
+    }
+  }
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    const char byte = traits_type::to_char_type(c);
+    return xsputn(&byte, 1) == 1 ? c : traits_type::eof();
+  }
+
+ private:
+  OutputFile& file_;
+  std::exception_ptr failure_;
+};
+
+}  // namespace
+
+void write_glb(const tinygltf::Model& gltf, const std::filesystem::path& temporary,
+               const std::filesystem::path& target) {
+  OutputFile file(temporary, target);
+  OutputFileBuffer buffer(file);
+  std::ostream stream(&buffer);
+  tinygltf::TinyGLTF writer;
+  const bool written = writer.WriteGltfSceneToStream(&gltf, stream, false, true);
+  buffer.rethrow();
+  if (!written || !stream) throw OutputError(io_failure(target, "tinygltf could not write the GLB"));
+  file.close();
+}
 
 GltfBuilder::GltfBuilder(tinygltf::Model& gltf) : gltf_(gltf) { gltf_.buffers.emplace_back(); }
 

@@ -6,6 +6,7 @@
 #include <tiny_gltf.h>
 
 #include <array>
+#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,6 +17,10 @@
 #include "tree/tree_model.h"
 
 namespace treeanim {
+
+// `gltf` as one binary glTF in `temporary`, every write checked (tinygltf's own file writer
+// reports no failed write: a full disk left a cut file). Throws OutputError naming `target`.
+void write_glb(const tinygltf::Model& gltf, const std::filesystem::path& temporary, const std::filesystem::path& target);
 
 // Appends views and accessors to a tinygltf model over one growing buffer.
 class GltfBuilder {

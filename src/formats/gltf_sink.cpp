@@ -3,7 +3,6 @@
 #include <cstring>
 
 #include "common/errors.h"
-#include "files/io_failure.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
 #include "formats/rest_positions_f32.h"
@@ -47,10 +46,7 @@ class GltfSink final : public FrameSink {
     set_bounds(gltf_, position_, frame.positions, 3);
     if (normals_) replace(normal_, frame.normals);
     const fs::path target = pattern_.frame(frame.frame);
-    const fs::path temporary = staged_.stage(target);
-    tinygltf::TinyGLTF writer;
-    if (!writer.WriteGltfSceneToFile(&gltf_, temporary.string(), false, true, false, true))
-      throw OutputError(io_failure(target, "tinygltf could not write the glTF frame"));
+    write_glb(gltf_, staged_.stage(target), target);
   }
 
  private:

@@ -10,7 +10,6 @@
 #include <limits>
 
 #include "common/errors.h"
-#include "files/io_failure.h"
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
@@ -52,9 +51,7 @@ class SkinnedGlbSink final : public FrameSink {
   void finish() override {
     error_ = skin_error(track_, model_.vertex_count());
     tinygltf::Model gltf = assemble();
-    tinygltf::TinyGLTF writer;
-    if (!writer.WriteGltfSceneToFile(&gltf, temporary_.string(), false, true, false, true))
-      throw OutputError(io_failure(path_, "tinygltf could not write the skinned GLB"));
+    write_glb(gltf, temporary_, path_);
   }
 
   std::string report() const override { return skin_error_report(error_, skin_.joint_count()); }

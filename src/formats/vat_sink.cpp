@@ -18,7 +18,6 @@
 #include <optional>
 
 #include "common/errors.h"
-#include "files/io_failure.h"
 #include "files/output_file.h"
 #include "formats/frame_sink.h"
 #include "formats/gltf_mesh.h"
@@ -116,9 +115,7 @@ void write_rest_glb(const fs::path& temporary, const fs::path& target, const Tre
   attributes["TEXCOORD_0"] = add.floats(gltf_uvs(model), TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
   attributes["TEXCOORD_1"] = add.floats(uv1, TINYGLTF_TYPE_VEC2, 2, TINYGLTF_TARGET_ARRAY_BUFFER);
   add_tree_scene(add, model, info, attributes);
-  tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&gltf, temporary.string(), false, true, false, true))
-    throw OutputError(io_failure(target, "tinygltf could not write the rest mesh"));
+  write_glb(gltf, temporary, target);
 }
 
 class VatSink final : public FrameSink {

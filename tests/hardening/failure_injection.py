@@ -257,12 +257,12 @@ def output_read_only_folder(bake):
     expect(bake.run(24), 4, "output failed: ", bake.out)
 
 
-def limit_file_size(ignore_sigxfsz):
-    """=> preexec function: a 100 KiB file-size limit, as a full disk or a quota gives."""
+def limit_file_size(ignore_sigxfsz, kib=100):
+    """=> preexec function: a file-size limit (KiB), as a full disk or a quota gives."""
     def preexec():
         if ignore_sigxfsz:
             signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-        resource.setrlimit(resource.RLIMIT_FSIZE, (100 * 1024, 100 * 1024))
+        resource.setrlimit(resource.RLIMIT_FSIZE, (kib * 1024, kib * 1024))
     return preexec
 
 
@@ -279,6 +279,19 @@ def disk_full_efbig(bake):
     """A write that fails with an error (SIGXFSZ ignored, as with ENOSPC): exit 4 naming the file."""
     done = bake.run(2000, preexec=limit_file_size(True))
     expect(done, 4, "write failed: File too large", bake.out)
+
+
+def disk_full_gltf(bake):
+    """The glTF writers (a sequence, the skinned GLB, the VAT's mesh), each alone past a 4 KiB
+    limit: exit 4 naming the cause, no file cut short (tinygltf's own file writer reports no
+    failed write)."""
+    for output in ('{"format": "gltf", "path": "seq/tree"}', '{"format": "skinned_glb", "path": "skin.glb"}',
+                   '{"format": "vat", "path": "vat/tree"}'):
+        done = bake.run(24, ["--set", "outputs=[%s]" % output], preexec=limit_file_size(True, 4))
+        try:
+            expect(done, 4, "write failed: File too large", bake.out)
+        except Failed as failure:
+            raise Failed("%s: %s" % (output, failure))
 
 
 def interrupted(signal_number, code, name):
@@ -521,6 +534,7 @@ SCENARIOS = {
         repeat_a_key, "bake.json:6:3: /time: duplicate key (first at line 5, again at line 6)"),
     "disk-full": disk_full,
     "disk-full-efbig": disk_full_efbig,
+    "disk-full-gltf": disk_full_gltf,
     "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
     "sigterm": interrupted(signal.SIGTERM, 143, "SIGTERM"),
     "interrupted-removes-made-folders": interrupted_removes_made_folders,
