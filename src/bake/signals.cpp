@@ -45,6 +45,8 @@ void install_interrupt_handlers() {
   // A file-size limit (ulimit -f) must fail the write (EFBIG => exit 4, temporaries removed),
   // not kill the process with SIGXFSZ and strand the temporaries.
   std::signal(SIGXFSZ, SIG_IGN);
+  // Nor a reader that closed its end of stdout or stderr (`| head`): the print fails, the bake goes on.
+  std::signal(SIGPIPE, SIG_IGN);
 }
 
 int pending_signal() { return received_signal.load(); }

@@ -10,7 +10,7 @@
 
 namespace treeanim {
 
-// Installs handlers for SIGINT and SIGTERM and ignores SIGXFSZ (idempotent).
+// Installs handlers for SIGINT and SIGTERM and ignores SIGXFSZ and SIGPIPE (idempotent).
 void install_interrupt_handlers();
 // The signal number received since installation, or 0.
 int pending_signal();

@@ -70,8 +70,8 @@ void MadeFolders::make(const fs::path& folder, std::error_code& error) {
 }
 
 void MadeFolders::undo() noexcept {
-  std::error_code ignored;
-  for (const fs::path& p : made_) fs::remove(p, ignored);  // fails, harmlessly, on a folder not empty
+  // rmdir, not remove: what stands there now may be someone's file or link, not the folder made.
+  for (const fs::path& p : made_) ::rmdir(p.c_str());  // fails, harmlessly, on a folder not empty
   made_.clear();
 }
 

@@ -301,6 +301,26 @@ TEST_F(OutputSetTest, TargetsAreLookedAtWithoutCreatingAnything) {
   EXPECT_NE(refusal(sequence), "no error");
 }
 
+// A folder a bake made and gives up is removed only while it is an empty folder: a file or a
+// link that took its place meanwhile is someone else's.
+TEST_F(OutputSetTest, UndoRemovesOnlyTheEmptyFoldersItMade) {
+  MadeFolders made;
+  std::error_code error;
+  made.make(dir_ / "a/b/c", error);
+  ASSERT_FALSE(error);
+  made.make(dir_ / "x", error);
+  std::filesystem::remove(dir_ / "a/b/c");
+  std::ofstream(dir_ / "a/b/c") << "precious";  // a user's file where the folder was
+  std::filesystem::remove(dir_ / "x");
+  std::filesystem::create_directory_symlink(dir_ / "a", dir_ / "x");
+  made.undo();
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_ / "a/b/c"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir_ / "x"));
+  made.make(dir_ / "d/e", error);
+  made.undo();
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "d"));
+}
+
 // Writers of a forest: one tree's file is no other tree's, nor the manifest's; a tree that is
 // not written here keeps its files but is not looked at; a folder that takes no file is found
 // by the probe, and the folders it made are removed by their undo.

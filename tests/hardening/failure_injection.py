@@ -438,6 +438,21 @@ def second_writer_refused(bake):
         raise Failed("unexpected files after the first bake: %s" % [f for f in left if "seq/" not in f])
 
 
+def reader_gone(bake):
+    """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
+    exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        args = [a for a in bake.args(200) if a != "--quiet"] + ["--verbose"]
+        done = subprocess.run(args, stdout=write, stderr=write, timeout=120)
+    finally:
+        os.close(write)
+    left = files_under(bake.out)
+    if done.returncode != 0 or "bake.h5" not in left or any(".lock" in f or ".tmp-" in f for f in left):
+        raise Failed("exit %d; files: %s" % (done.returncode, [f for f in left if "seq/" not in f]))
+
+
 def resume_after_kill_not_blocked(bake):
     """A bake killed with SIGKILL holds no lock any more: its --resume bakes to the end, reusing
     and then removing the lock files it left."""
@@ -547,6 +562,7 @@ SCENARIOS = {
     "glb-far-too-large-under-ulimit-v": glb_far_too_large_under_ulimit_v,
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
+    "reader-gone": reader_gone,
     "resume-after-kill-not-blocked": resume_after_kill_not_blocked,
     "no-room-for-the-forest": no_room_for_the_forest,
 }
