@@ -95,13 +95,17 @@ fs::path StagedFiles::stage(const fs::path& target) {
   return temporaries_.back();
 }
 
-void StagedFiles::commit() {
+void StagedFiles::check() const {
   for (const fs::path& target : targets_) {
     const std::string kind = non_regular_kind(target);
     if (!kind.empty())
       throw OutputError(target.string() + ": " + kind + " appeared at the output path during the bake; it was " +
                         "left as it is and the finished file is not written");
   }
+}
+
+void StagedFiles::commit() {
+  check();
   for (size_t i = 0; i < targets_.size(); ++i) {
     std::error_code error;
     fs::rename(temporaries_[i], targets_[i], error);

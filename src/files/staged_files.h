@@ -50,9 +50,11 @@ class StagedFiles {
   // Registers `target` (resolve_output_target: a link's file is what gets replaced); returns the
   // temporary to write instead, beside that file.
   std::filesystem::path stage(const std::filesystem::path& target);
-  // Renames every temporary to its target, in staging order; a target that is no longer absent or
-  // a regular file (something appeared there during the bake) is left as it is and fails the
-  // commit. Throws OutputError naming the path.
+  // Throws OutputError naming a target that is no longer absent or a regular file (something
+  // appeared there during the bake), which the commit would leave as it is.
+  void check() const;
+  // check(), then renames every temporary to its target, in staging order. Throws OutputError
+  // naming the path.
   void commit();
   // Removes every temporary still present. Never throws.
   void discard() noexcept;

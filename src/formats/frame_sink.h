@@ -2,7 +2,8 @@
 // FrameSink (docs/design.md): one output format, made by its factory (formats/sink_factories.h),
 // whose row also names the files it creates, without a sink (its targets, checked before simulating).
 // OutputSet calls begin() once, write() for every selected frame in order (on the sink's own
-// writer thread), then finish() and, once every sink finished, commit(); or abort() at any point.
+// writer thread), then finish() and, once every sink finished and every sink's targets are
+// checked, commit(); or abort() at any point.
 // Sinks never see solver internals, only the TreeModel, the BakeInfo and FrameData.
 #include <filesystem>
 #include <memory>
@@ -36,6 +37,8 @@ class FrameSink {
   virtual void write(const FrameData& frame) = 0;
   // Completes and closes the temporaries.
   virtual void finish() {}
+  // Throws OutputError when a final name no longer takes a file (StagedFiles::check).
+  void check_targets() const { staged_.check(); }
   // Renames every temporary to its final name.
   void commit() { staged_.commit(); }
   // A line for the run's summary after finish() ("" for none), e.g. a fit's error.

@@ -281,8 +281,10 @@ void OutputSet::finish() {
     // Each writer drains its queue (all at once, on their threads); the first failure in
     // the outputs' order is the one reported.
     for (auto& worker : impl_->workers) worker->writer->close();
-    // Every file complete before any is renamed: a failure here still leaves no output.
+    // Every file complete, and every target still one a file may replace, before any is
+    // renamed: a failure here still leaves no output.
     for (auto& worker : impl_->workers) worker->sink->finish();
+    for (auto& worker : impl_->workers) worker->sink->check_targets();
     for (auto& worker : impl_->workers) worker->sink->commit();
   } catch (...) {
     abort();

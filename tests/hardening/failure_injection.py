@@ -438,6 +438,17 @@ def second_writer_refused(bake):
         raise Failed("unexpected files after the first bake: %s" % [f for f in left if "seq/" not in f])
 
 
+def directory_appears_mid_bake(bake):
+    """A folder made at the last output's path while the bake writes: exit 4 naming it, and no
+    output renamed into place, those before it included."""
+    process = bake.start(3000)
+    bake.wait_until_writing(process)
+    os.makedirs(os.path.join(bake.out, "tree.pc2"))
+    _, stderr = process.communicate(timeout=300)
+    done = subprocess.CompletedProcess(process.args, process.returncode, "", stderr)
+    expect(done, 4, "tree.pc2: a directory appeared at the output path during the bake", bake.out)
+
+
 def reader_gone(bake):
     """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
     exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
@@ -563,6 +574,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "directory-appears-mid-bake": directory_appears_mid_bake,
     "resume-after-kill-not-blocked": resume_after_kill_not_blocked,
     "no-room-for-the-forest": no_room_for_the_forest,
 }
