@@ -271,6 +271,9 @@ void write_checkpoint(const fs::path& path, const SimState& state, long long fra
 std::pair<long long, SimState> read_checkpoint(const fs::path& path, const CheckpointKey& key, const SimState& shape) {
   const auto lock = hdf5_lock();
   const CheckpointFile file(path, true);
+  // A FIFO or a device would block the open, or read for ever.
+  if (std::error_code error; !fs::is_regular_file(path, error))
+    throw InputError(path.string() + ": not a readable checkpoint: not a regular file");
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     H5Eclear2(H5E_DEFAULT);
     throw InputError(path.string() + ": not a readable checkpoint: not an HDF5 file (damaged, or not written by treeanim)");

@@ -15,6 +15,7 @@
 
 #include "common/errors.h"
 #include "files/io_failure.h"
+#include "files/staged_files.h"
 
 namespace treeanim {
 
@@ -71,6 +72,8 @@ uint64_t journal_record_bytes(const JournalLayout& layout) {
 FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {
   std::error_code error;
   fs::create_directories(path.parent_path(), error);
+  if (const std::string kind = resolve_output_target(path).kind; !kind.empty())  // "w+b" would take a FIFO
+    throw OutputError(path.string() + ": " + kind + " stands where the bake writes its frame journal; left untouched");
   std::FILE* file = std::fopen(path.c_str(), "w+b");
   if (!file) throw OutputError(io_failure(path, "cannot create the frame journal"));
   FrameJournal journal(path, layout, file, 0);
@@ -81,6 +84,9 @@ FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& lay
 }
 
 FrameJournal FrameJournal::open(const fs::path& path, const JournalLayout& layout) {
+  // A FIFO or a device would block the open, or read for ever.
+  if (std::error_code error; !fs::is_regular_file(path, error))
+    throw InputError(path.string() + ": the frame journal is not a regular file");
   std::FILE* file = std::fopen(path.c_str(), "r+b");
   if (!file) throw InputError(io_failure(path, "cannot open the frame journal"));
   FrameJournal journal(path, layout, file, 0);

@@ -449,6 +449,28 @@ def directory_appears_mid_bake(bake):
     expect(done, 4, "tree.pc2: a directory appeared at the output path during the bake", bake.out)
 
 
+def fifo_in_the_checkpoints(bake):
+    """A FIFO in place of the newest checkpoint, then of the frame journal: --resume refuses
+    it (exit 2, then 4) instead of blocking in its open for a writer that never comes."""
+    extra = ["--checkpoint-every", "10", "--resume"]
+    done = bake.run(40, extra)
+    if done.returncode != 0:
+        raise Failed("the first bake: exit %d: %s" % (done.returncode, done.stderr))
+    folder = os.path.join(bake.out, "checkpoints")
+    for name, code, message in (("checkpoint-30.h5", 2, "checkpoint-30.h5: not a readable checkpoint: not a regular file"),
+                                ("frames-from-0.journal", 4, "a FIFO stands where the bake writes its frame journal")):
+        os.remove(os.path.join(folder, name))
+        os.mkfifo(os.path.join(folder, name))
+        try:
+            done = bake.run(40, extra, timeout=60)
+        except subprocess.TimeoutExpired:
+            raise Failed("--resume blocked on a FIFO at %s" % name)
+        if done.returncode != code or message not in done.stderr:
+            raise Failed("%s: exit %d: %s" % (name, done.returncode, done.stderr))
+        if name.endswith(".h5"):
+            os.remove(os.path.join(folder, name))
+
+
 def reader_gone(bake):
     """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
     exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
@@ -574,6 +596,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "fifo-in-the-checkpoints": fifo_in_the_checkpoints,
     "directory-appears-mid-bake": directory_appears_mid_bake,
     "resume-after-kill-not-blocked": resume_after_kill_not_blocked,
     "no-room-for-the-forest": no_room_for_the_forest,
