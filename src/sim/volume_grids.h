@@ -29,6 +29,8 @@ class VolumeGrids {
                       std::vector<uint8_t>& inside) const = 0;
   // The same for one point; false outside.
   virtual bool sample(const Eigen::Vector3d& point, bool clamp, Eigen::Vector3d& velocity) const = 0;
+  // The value of every inactive voxel (volume units): the grids' background, per axis.
+  virtual Eigen::Vector3d background() const = 0;
   // Every active voxel => visit(its grid's name, its index coordinates, its speed in volume units,
   // whether its velocity is finite). A split grid's speed is its components' at that voxel.
   using VoxelVisit = std::function<void(const std::string& grid, const std::array<int, 3>& ijk, double speed,

@@ -194,16 +194,23 @@ VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double 
       summary.voxel_size = frame.grids->voxel_size() * options.units;
       summary.layout = frame.grids->layout();
     }
-    // Every active value: finite and within the wind's range, in m/s.
-    frame.grids->visit_active([&](const std::string& grid, const std::array<int, 3>& ijk, double speed, bool finite) {
-      const std::string where = path + ": grid '" + grid + "', voxel (" + std::to_string(ijk[0]) + ", " +
-                                std::to_string(ijk[1]) + ", " + std::to_string(ijk[2]) + ")";
+    // Every active value, and the background the inactive ones read: finite and within the
+    // wind's range, in m/s.
+    auto check = [&](const std::string& where, double speed, bool finite) {
       if (!finite) throw InputError(where + ": the velocity is not finite");
       speed *= options.units;
       if (speed > max_speed)
         throw InputError(where + ": a speed of " + number_text(speed) + " m/s, beyond the wind's " +
                          number_text(max_speed) + " m/s (is `units` right?)");
       summary.largest_speed = std::max(summary.largest_speed, speed);
+    };
+    const Eigen::Vector3d background = frame.grids->background();
+    check(path + ": the background of " + frame.grids->layout() + " (the inactive voxels' value)",
+          background.allFinite() ? background.norm() : 0, background.allFinite());
+    frame.grids->visit_active([&](const std::string& grid, const std::array<int, 3>& ijk, double speed, bool finite) {
+      check(path + ": grid '" + grid + "', voxel (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +
+                std::to_string(ijk[2]) + ")",
+            speed, finite);
     });
   }
   return summary;

@@ -99,6 +99,14 @@ class OpenVdbGrids final : public VolumeGrids {
     return sample_at(access, point, clamp, velocity);
   }
 
+  Eigen::Vector3d background() const override {
+    if (vector) {
+      const openvdb::Vec3s b = vector->background();
+      return {b[0], b[1], b[2]};
+    }
+    return {split[0]->background(), split[1]->background(), split[2]->background()};
+  }
+
   void visit_active(const VoxelVisit& visit) const override {
     auto coordinates = [](const openvdb::Coord& c) { return std::array<int, 3>{c.x(), c.y(), c.z()}; };
     if (vector) {
@@ -166,6 +174,26 @@ class OpenVdbGrids final : public VolumeGrids {
   }
 };
 
+// A grid's inactive values set to its background: what the sampler reads between the active
+// voxels is then what docs/scene.md says, never a value a cache left there unchecked.
+template <typename Grid>
+void clear_inactive(Grid& grid) {
+  const typename Grid::ValueType background = grid.background();
+  for (auto it = grid.tree().beginValueOff(); it; ++it) it.setValue(background);
+}
+
+// The grid named `name` in the file, read whole; one of that name only (OpenVDB would pick one
+// and print a warning on stdout).
+openvdb::GridBase::Ptr read_named_grid(openvdb::io::File& file, const std::string& name) {
+  size_t count = 0;
+  const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+  for (const openvdb::GridBase::Ptr& grid : *grids) count += grid->getName() == name;
+  if (count > 1)
+    throw std::invalid_argument(std::to_string(count) + " grids are named '" + name +
+                                "': which one is the velocity is not clear");
+  return file.readGrid(name);
+}
+
 // Frame file, grid name => its grids read whole; throws std::runtime_error with what is wrong.
 std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::string& name) {
   std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
@@ -174,12 +202,14 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
   openvdb::io::File file(path);
   file.open(false);
   if (file.hasGrid(name)) {
-    openvdb::GridBase::Ptr grid = file.readGrid(name);
-    frame->vector = openvdb::GridBase::grid<openvdb::Vec3SGrid>(grid);
-    if (!frame->vector)
+    openvdb::GridBase::Ptr grid = read_named_grid(file, name);
+    const openvdb::Vec3SGrid::Ptr vector = openvdb::GridBase::grid<openvdb::Vec3SGrid>(grid);
+    if (!vector)
       throw std::invalid_argument("grid '" + name + "' holds " + grid_type(*grid) +
                                   " values; a velocity is a vec3s grid, or the float grids '" + name + ".x', '" +
                                   name + ".y', '" + name + ".z'");
+    clear_inactive(*vector);
+    frame->vector = vector;
     frame->box[0] = frame->vector->evalActiveVoxelBoundingBox();
   } else {
     const char* axes[3] = {".x", ".y", ".z"};
@@ -188,11 +218,13 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
       if (!file.hasGrid(component))
         throw std::invalid_argument("no grid '" + name + "' (nor '" + name + ".x', '" + name + ".y', '" + name +
                                     ".z'); its grids: " + grid_list(file));
-      openvdb::GridBase::Ptr grid = file.readGrid(component);
-      frame->split[k] = openvdb::GridBase::grid<openvdb::FloatGrid>(grid);
-      if (!frame->split[k])
+      openvdb::GridBase::Ptr grid = read_named_grid(file, component);
+      const openvdb::FloatGrid::Ptr split = openvdb::GridBase::grid<openvdb::FloatGrid>(grid);
+      if (!split)
         throw std::invalid_argument("grid '" + component + "' holds " + grid_type(*grid) +
                                     " values; a velocity component is a float grid");
+      clear_inactive(*split);
+      frame->split[k] = split;
       frame->box[k] = frame->split[k]->evalActiveVoxelBoundingBox();
     }
   }

@@ -76,6 +76,22 @@ def check_bad(treeanim, tmp):
         grids[0].name = "vel"
         vdb.write(path, grids=[grids[0]])
 
+    def rewritten(name, change):
+        """A copy of `vol` whose every frame's grids went through change(grids) => its folder."""
+        folder = os.path.join(tmp, name)
+        shutil.copytree(vol, folder)
+        for frame in range(1, 11):
+            path = os.path.join(folder, f"vel.{frame:04d}.vdb")
+            grids = vdb.readAll(path)[0]
+            vdb.write(path, grids=change(grids))
+        return folder
+    twice = rewritten("twice", lambda grids: [grids[0], grids[0].deepCopy()])
+
+    def nan_background(grids):
+        grids[0].background = (float("nan"), 0.0, 0.0)
+        return grids
+    background = rewritten("background", nan_background)
+
     def volume(folder, **extra):
         return {"volume": {"path": os.path.join(folder, "vel.####.vdb"), **extra}}
     nine = {"fps": 24, "frames": 9, "substeps": 2}  # times 0 .. 8/24 s: frames 1 .. 9
@@ -100,6 +116,11 @@ def check_bad(treeanim, tmp):
         ("loop", volume(vol), {"fps": 24, "frames": 9, "loop": True},
          "/wind/volume: a loop needs a wind that repeats"),
         ("up", volume(vol, up="x"), nine, "/wind/volume/up"),
+        ("two-grids-one-name", volume(twice), nine,
+         "twice/vel.0001.vdb: 2 grids are named 'vel': which one is the velocity is not clear"),
+        ("background-not-finite", volume(background), nine,
+         "background/vel.0001.vdb: the background of vec3s grid 'vel' (the inactive voxels' value): the velocity is "
+         "not finite"),
     ]
     failures = []
     for name, wind, time, message in cases:
@@ -119,6 +140,30 @@ def check_bad(treeanim, tmp):
                 failures.append(f"{name} ({arguments[0]}): " + "; ".join(problems))
             else:
                 print(f"{name} ({arguments[0]}): exit 2: {result.stderr.strip()}")
+    # An inactive voxel reads the grid's background whatever value the cache stored there: half
+    # the box switched off holding 1e30 (or NaN) bakes as the same half switched off at 0.
+    def switched_off(value):
+        def change(grids):
+            access = grids[0].getAccessor()
+            for i in range(4):
+                for j in range(9):
+                    for k in range(9):
+                        access.setValueOff((i, j, k), value)
+            return grids
+        return change
+    baked = []
+    for name, value in (("off-at-background", (0.0, 0.0, 0.0)), ("off-at-1e30", (1e30, 0.0, 0.0)),
+                        ("off-at-nan", (float("nan"), 0.0, 0.0))):
+        path = scene(tmp, f"{name}.json", volume(rewritten(name, switched_off(value))), nine)
+        out = os.path.join(tmp, "out-" + name)
+        result = run(treeanim, "run", path, "-o", out)
+        if result.returncode != 0:
+            failures.append(f"{name}: exit {result.returncode}: {result.stderr.strip()}")
+            continue
+        with h5py.File(os.path.join(out, "tree.h5")) as f:
+            baked.append(f["frames/positions"][()])
+    if len(baked) == 3 and not (np.array_equal(baked[0], baked[1]) and np.array_equal(baked[0], baked[2])):
+        failures.append("a value stored in an inactive voxel changed the bake: it must read the background")
     # A binary copied without the OpenVDB module beside it bakes a scene without a volume, and
     # refuses one with a volume, before writing anything, saying why.
     copied = os.path.join(tmp, "copied", "treeanim")
