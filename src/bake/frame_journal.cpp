@@ -1,12 +1,14 @@
-// Journal layout (little-endian, docs/checkpoint.md): a 96-byte header, magic "TAJOURN1",
+// Journal layout (little-endian, docs/checkpoint.md): a 96-byte header, magic "TAJOURN2",
 // u64 record bytes, i64 first frame, u64 V, u64 L, u8 velocities, padding, u64 motion clusters
 // C, padding, then the FNV-1a scene hash as 32 bytes of text, zero-padded; then fixed-size records: i64 frame,
 // f64 time, f32 positions (V x 3), f32 velocities (V x 3, when recorded), u8 leaf flags (L),
-// f32 cluster motions (C x 7, when recorded).
+// f32 cluster motions (C x 7, when recorded), u32 zlib crc32 of the record's bytes before it.
 #include "bake/frame_journal.h"
 
 #include <unistd.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <stdexcept>
@@ -25,7 +27,7 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the journal is written in host order");
 
-constexpr char kMagic[8] = {'T', 'A', 'J', 'O', 'U', 'R', 'N', '1'};
+constexpr char kMagic[8] = {'T', 'A', 'J', 'O', 'U', 'R', 'N', '2'};
 constexpr size_t kHeaderBytes = 96;
 constexpr size_t kHashBytes = 32;
 
@@ -66,8 +68,35 @@ FrameJournal::~FrameJournal() {
 }
 
 uint64_t journal_record_bytes(const JournalLayout& layout) {
-  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves + 28 * layout.motion_clusters;
+  return 16 + 12 * layout.vertices * (layout.velocities ? 2 : 1) + layout.leaves + 28 * layout.motion_clusters + 4;
 }
+
+namespace {
+
+// A record's parts in file order, read into `frame` (FrameData) or written from it (const
+// FrameData), each folded into the record's crc32 => whether every transfer succeeded.
+template <typename Frame, typename Number, typename Transfer>
+bool transfer_record(Transfer transfer, Number& number, Frame& frame, bool velocities, uint32_t& crc) {
+  uLong sum = crc32(0L, Z_NULL, 0);
+  auto part = [&](auto* data, size_t bytes) {
+    if (!transfer(data, bytes)) return false;
+    const auto* first = reinterpret_cast<const Bytef*>(data);
+    for (size_t done = 0; done < bytes;) {  // crc32 takes a uInt length
+      const size_t chunk = std::min<size_t>(bytes - done, 1u << 30);
+      sum = crc32(sum, first + done, static_cast<uInt>(chunk));
+      done += chunk;
+    }
+    return true;
+  };
+  const bool ok = part(&number, 8) && part(&frame.time, 8) && part(frame.positions.data(), 4 * frame.positions.size()) &&
+                  (!velocities || part(frame.velocities.data(), 4 * frame.velocities.size())) &&
+                  part(frame.leaf_attached.data(), frame.leaf_attached.size()) &&
+                  part(frame.cluster_motions.data(), 4 * frame.cluster_motions.size());
+  crc = static_cast<uint32_t>(sum);
+  return ok;
+}
+
+}  // namespace
 
 FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {
   std::error_code error;
@@ -109,15 +138,14 @@ FrameData FrameJournal::read(long long index) {
   const size_t motions = 7 * layout_.motion_clusters;
   frame.cluster_motions.resize(motions);
   int64_t number = 0;
+  uint32_t crc = 0, stored = 0;
+  auto read = [&](void* data, size_t bytes) { return std::fread(data, 1, bytes, file_) == bytes; };
   const bool ok =
       index < records_ && std::fseek(file_, long(kHeaderBytes + uint64_t(index) * record_bytes()), SEEK_SET) == 0 &&
-      std::fread(&number, 8, 1, file_) == 1 && std::fread(&frame.time, 8, 1, file_) == 1 &&
-      std::fread(frame.positions.data(), 4, n, file_) == n &&
-      (!layout_.velocities || std::fread(frame.velocities.data(), 4, n, file_) == n) &&
-      std::fread(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves &&
-      std::fread(frame.cluster_motions.data(), 4, motions, file_) == motions;
+      transfer_record(read, number, frame, layout_.velocities, crc) && read(&stored, 4);
   frame.frame = number;
-  if (!ok || number != layout_.first_frame + index)
+  // A flipped bit would reach the outputs unseen (a NaN among them): the crc finds it.
+  if (!ok || number != layout_.first_frame + index || stored != crc)
     throw InputError(path_.string() + ": record " + std::to_string(index) + " of the frame journal is damaged");
   return frame;
 }
@@ -131,17 +159,16 @@ void FrameJournal::truncate(long long count) {
 }
 
 void FrameJournal::append(const FrameData& frame) {
-  const int64_t number = frame.frame;
   const size_t n = 3 * layout_.vertices, motions = 7 * layout_.motion_clusters;
   if (frame.positions.size() != n || (layout_.velocities && frame.velocities.size() != n) ||
       frame.leaf_attached.size() != layout_.leaves || frame.cluster_motions.size() != motions)
     throw std::logic_error("FrameJournal::append: frame " + std::to_string(frame.frame) +
                            " does not match the journal's layout");
-  const bool ok = std::fseek(file_, 0, SEEK_END) == 0 && std::fwrite(&number, 8, 1, file_) == 1 &&
-                  std::fwrite(&frame.time, 8, 1, file_) == 1 && std::fwrite(frame.positions.data(), 4, n, file_) == n &&
-                  (!layout_.velocities || std::fwrite(frame.velocities.data(), 4, n, file_) == n) &&
-                  std::fwrite(frame.leaf_attached.data(), 1, layout_.leaves, file_) == layout_.leaves &&
-                  std::fwrite(frame.cluster_motions.data(), 4, motions, file_) == motions;
+  const int64_t number = frame.frame;
+  uint32_t crc = 0;
+  auto write = [&](const void* data, size_t bytes) { return std::fwrite(data, 1, bytes, file_) == bytes; };
+  const bool ok = std::fseek(file_, 0, SEEK_END) == 0 && transfer_record(write, number, frame, layout_.velocities, crc) &&
+                  write(&crc, 4);
   if (!ok) throw OutputError(io_failure(path_, "cannot append to the frame journal"));
   ++records_;
 }

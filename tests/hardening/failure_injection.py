@@ -471,6 +471,28 @@ def fifo_in_the_checkpoints(bake):
             os.remove(os.path.join(folder, name))
 
 
+def journal_bit_flipped(bake):
+    """A bit flipped in a record of the frame journal: --resume refuses it (exit 2 naming the
+    record) rather than replay it into the outputs, which stay as they were."""
+    extra = ["--checkpoint-every", "10", "--resume"]
+    done = bake.run(40, extra)
+    if done.returncode != 0:
+        raise Failed("the first bake: exit %d: %s" % (done.returncode, done.stderr))
+    before = open(os.path.join(bake.out, "bake.h5"), "rb").read()
+    journal = os.path.join(bake.out, "checkpoints", "frames-from-0.journal")
+    with open(journal, "r+b") as f:
+        record = int.from_bytes(f.read(16)[8:], "little")
+        f.seek(96 + 5 * record + 16 + 7)  # a position's top byte
+        byte = f.read(1)[0]
+        f.seek(-1, os.SEEK_CUR)
+        f.write(bytes([byte ^ 0x40]))
+    done = bake.run(40, extra)
+    if done.returncode != 2 or "record 5 of the frame journal is damaged" not in done.stderr:
+        raise Failed("exit %d: %s" % (done.returncode, done.stderr))
+    if open(os.path.join(bake.out, "bake.h5"), "rb").read() != before:
+        raise Failed("the refused resume changed bake.h5")
+
+
 def reader_gone(bake):
     """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
     exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
@@ -596,6 +618,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "journal-bit-flipped": journal_bit_flipped,
     "fifo-in-the-checkpoints": fifo_in_the_checkpoints,
     "directory-appears-mid-bake": directory_appears_mid_bake,
     "resume-after-kill-not-blocked": resume_after_kill_not_blocked,
