@@ -1,7 +1,8 @@
 #pragma once
-// One writer per output: a bake holds a lock file beside each output's final path (a sequence:
-// beside its pattern, once) from before the simulation to its end, so a second bake of the same
-// output is refused at once rather than both renaming over each other. The lock is a POSIX
+// One writer per output: a bake holds a lock file beside each output's first file, reached
+// through any links (a sequence: its first file, whatever spelling of the pattern named it),
+// from before the simulation to its end, so a second bake of the same output is refused at
+// once rather than both renaming over each other. The lock is a POSIX
 // record lock (fcntl F_SETLK), which the kernel drops when the process dies, SIGKILL included:
 // a resumed bake is never blocked by its own dead run, and a lock file left by one is reused.
 #include <filesystem>

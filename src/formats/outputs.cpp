@@ -129,6 +129,16 @@ std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs,
   return files;
 }
 
+// The file an output's lock stands beside: its first file, through any links, so that a link to
+// another output's file, or another spelling of the same sequence, takes the same lock.
+fs::path lock_target(const OutputFiles& output) {
+  fs::path first;
+  output.for_each([&](const fs::path& file) {
+    if (first.empty()) first = file;
+  });
+  return resolve_output_target(first.empty() ? output.path : first).file;
+}
+
 }  // namespace
 
 void check_output_paths(const std::vector<OutputOptions>& outputs) {
@@ -214,7 +224,7 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     if (!checkpoints.empty()) targets.add_folder(checkpoints, "the checkpoints");
     targets.add_outputs(outputs, out_dir, info.frame_start, info.frame_count);
     targets.probe(impl_->folders);
-    for (const OutputFiles& output : impl_->files) impl_->locks.lock(output.path);
+    for (const OutputFiles& output : impl_->files) impl_->locks.lock(lock_target(output));
   } catch (...) {
     impl_->undo();
     throw;

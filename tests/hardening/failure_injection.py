@@ -493,6 +493,22 @@ def journal_bit_flipped(bake):
         raise Failed("the refused resume changed bake.h5")
 
 
+def second_writer_of_an_alias_refused(bake):
+    """A second bake whose outputs name the first's files another way (a link to its HDF5, its
+    OBJ sequence without the frame field): refused, exit 4, as a second bake of the same paths."""
+    first = bake.start(3000)
+    bake.wait_until_writing(first)
+    os.symlink("bake.h5", os.path.join(bake.out, "alias.h5"))
+    try:
+        for output in ('{"format": "hdf5", "path": "alias.h5"}', '{"format": "obj", "path": "seq/tree"}'):
+            second = bake.run(20, ["--set", "outputs=[%s]" % output])
+            if second.returncode != 4 or "another bake is writing this output (process %d, lock " % first.pid not in second.stderr:
+                raise Failed("%s: exit %d: %s" % (output, second.returncode, second.stderr))
+    finally:
+        first.kill()
+        first.communicate()
+
+
 def reader_gone(bake):
     """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
     exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
@@ -618,6 +634,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "second-writer-of-an-alias-refused": second_writer_of_an_alias_refused,
     "journal-bit-flipped": journal_bit_flipped,
     "fifo-in-the-checkpoints": fifo_in_the_checkpoints,
     "directory-appears-mid-bake": directory_appears_mid_bake,
