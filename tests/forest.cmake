@@ -5,7 +5,7 @@ find_program(TREEANIM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(NOT TREEANIM_PYTHON)
   find_program(TREEANIM_PYTHON python3 REQUIRED)
 endif()
-foreach(forest_case shards resume plan submit targets)
+foreach(forest_case shards resume plan submit targets locked)
   add_test(NAME forest.${forest_case}
     COMMAND ${TREEANIM_PYTHON} ${CMAKE_SOURCE_DIR}/tests/forest/forest_bake.py $<TARGET_FILE:treeanim> ${forest_case})
   set_tests_properties(forest.${forest_case} PROPERTIES LABELS forest TIMEOUT 300)

@@ -8,6 +8,7 @@
 #include "bake/forest_manifest.h"
 #include "bake/signals.h"
 #include "common/errors.h"
+#include "files/output_lock.h"
 #include "formats/outputs.h"
 
 namespace treeanim {
@@ -78,7 +79,22 @@ void check_forest_writers(const Scene& scene) {
 ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,
                              const BakeLog& log) {
   const Forest& forest = *scene.forest;
-  const std::vector<bool> complete = look_before_baking(scene, config, trees);
+  // A whole forest writes the manifest and every part: a second one into the same folder is
+  // refused before it looks at anything (shards of one forest share it, each with trees of its own).
+  OutputLocks manifest;
+  MadeFolders made;  // the manifest's folder, for its lock
+  std::vector<bool> complete;
+  try {
+    const fs::path manifest_path = forest_manifest_path(config.out_dir);
+    std::error_code error;
+    if (!config.shard && !manifest_path.parent_path().empty()) made.make(manifest_path.parent_path(), error);
+    if (!config.shard && !error) manifest.lock(manifest_path);
+    complete = look_before_baking(scene, config, trees);
+  } catch (...) {
+    manifest.release();
+    made.undo();
+    throw;
+  }
   ForestBakeResult result;
   for (size_t i = 0; i < trees.size(); ++i) {
     // A signal while the last tree finished: the trees baked so far stay whole.

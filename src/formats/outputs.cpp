@@ -225,6 +225,13 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     targets.add_outputs(outputs, out_dir, info.frame_start, info.frame_count);
     targets.probe(impl_->folders);
     for (const OutputFiles& output : impl_->files) impl_->locks.lock(lock_target(output));
+    // And the checkpoints' folder, before the bake reads or clears it: two bakes there would
+    // write over each other's journal and checkpoints.
+    if (!checkpoints.empty()) {
+      std::error_code error;
+      if (!checkpoints.parent_path().empty()) impl_->folders.make(checkpoints.parent_path(), error);
+      impl_->locks.lock(checkpoints);
+    }
   } catch (...) {
     impl_->undo();
     throw;

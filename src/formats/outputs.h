@@ -105,7 +105,7 @@ class OutputSet {
   // options are as the scene reader checked them. Throws InputError for a target no output may
   // write (a directory, one written twice), OutputError naming the path for unwritable
   // targets, a GLB past 4 GiB and an output another bake holds. `checkpoints`: the folder of the
-  // bake's checkpoints (empty: none), where no output may write.
+  // bake's checkpoints (empty: none), where no output may write, locked as the outputs are.
   OutputSet(const std::vector<OutputOptions>& outputs, const std::filesystem::path& out_dir,
             const TreeModel& model, const BakeInfo& info, const std::filesystem::path& checkpoints = {});
   ~OutputSet();  // abort()s when finish() was not reached

@@ -255,6 +255,32 @@ def folder_state(folder):
     return found
 
 
+def case_locked(treeanim, tmp):
+    """A second whole forest into the folder a first one is baking: refused at once (exit 4,
+    naming the first's process) before it makes or writes anything; the first goes on."""
+    out = os.path.join(tmp, "out")
+    first = subprocess.Popen([treeanim, "run", SCENE, "-o", out, "-q", "--set", "time.frames=5000"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while not os.path.exists(os.path.join(out, ".forest.json.lock")):
+            if first.poll() is not None or time.monotonic() > deadline:
+                raise Failed("the first forest did not start baking (exit %s)" % first.returncode)
+            time.sleep(0.01)
+        second = run(treeanim, "run", SCENE, "-o", out, "--set", "time.frames=20", "--set",
+                     'outputs=[{"format": "pc2", "path": "other/{tree}.pc2"}]', check=False)
+        message = "forest.json: another bake is writing this output (process %d, lock " % first.pid
+        if second.returncode != 4 or message not in second.stderr:
+            raise Failed("the second forest: exit %d: %s" % (second.returncode, second.stderr[-2000:]))
+        if os.path.exists(os.path.join(out, "other")):
+            raise Failed("the refused forest made its folder 'other'")
+        if first.poll() is not None:
+            raise Failed("the first forest stopped (exit %s)" % first.returncode)
+    finally:
+        first.kill()
+        first.wait()
+
+
 def case_targets(treeanim, tmp):
     out = os.path.join(tmp, "out")
     # The first tree's files from an earlier bake, which a refused forest must not replace.
@@ -282,7 +308,7 @@ def case_targets(treeanim, tmp):
 
 
 CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit,
-         "targets": case_targets}
+         "targets": case_targets, "locked": case_locked}
 
 
 def main():

@@ -509,6 +509,24 @@ def second_writer_of_an_alias_refused(bake):
         first.communicate()
 
 
+def second_bake_of_the_checkpoints_refused(bake):
+    """A second bake, of other outputs, given the first's checkpoint folder: refused (exit 4)
+    before it reads or clears anything there; the first's checkpoints stay."""
+    first = bake.start(3000, ["--checkpoint-every", "100"])
+    bake.wait_until_writing(first)
+    try:
+        folder = os.path.join(bake.out, "checkpoints")
+        before = sorted(n for n in os.listdir(folder) if not n.startswith("."))  # not the temporaries
+        second = bake.run(20, ["--checkpoint-every", "5", "--checkpoint-dir", folder], out=os.path.join(bake.tmp, "other"))
+        if second.returncode != 4 or "another bake is writing this output (process %d, lock " % first.pid not in second.stderr:
+            raise Failed("exit %d: %s" % (second.returncode, second.stderr))
+        if any(name not in os.listdir(folder) for name in before):
+            raise Failed("the refused bake removed %s" % [n for n in before if n not in os.listdir(folder)])
+    finally:
+        first.kill()
+        first.communicate()
+
+
 def reader_gone(bake):
     """Progress and messages to a pipe whose reader has gone (`| head`): the bake goes on to
     exit 0 with every output whole, not killed by SIGPIPE with its temporaries and locks left."""
@@ -634,6 +652,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "second-bake-of-the-checkpoints-refused": second_bake_of_the_checkpoints_refused,
     "second-writer-of-an-alias-refused": second_writer_of_an_alias_refused,
     "journal-bit-flipped": journal_bit_flipped,
     "fifo-in-the-checkpoints": fifo_in_the_checkpoints,
