@@ -218,8 +218,14 @@ void throw_vertex_failure(const SolverModel<Real>& model, const Attachment<Real>
   std::snprintf(distances, sizeof distances, "moved %.3g m from rest, more than %.3g times the tree's size (%.3g m, its reach along the branches or its extent)",
                 prediction.offset.row(runaway).template cast<double>().norm(), kRunawaySizes,
                 std::sqrt(model.runaway_distance2) / kRunawaySizes);
+  // Without the global term nothing holds a limb's bending but its clusters' overlaps: no
+  // step or local stiffness keeps a tree standing in a wind that tears those apart.
   throw SimulationError(where(runaway) + distances +
-                        ": the tree came apart; raise time.substeps or the stiffness (docs/solver.md, \"Runaway\")");
+                        (model.beam ? ": the tree came apart; raise time.substeps or the stiffness"
+                                    : ": the tree came apart: without the global term (hsm.global_matching false) only "
+                                      "its clusters' local shapes hold it, which this wind overcomes; turn the global "
+                                      "term on") +
+                        " (docs/solver.md, \"Runaway\")");
 }
 
 // One parallel region: the correction (and load) pass; after a barrier, the state (kLastStep)
