@@ -210,9 +210,16 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
 
 TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,
                            BakeFrames& frames, const TreePlacement* placement, const BakeLog& log) {
-  frames.outputs.finish();
-  log.frames_end();
   TreeBakeResult result;
+  // A signal while the files are completed (a skin's fit, a page: seconds) stops the bake as
+  // one between frames does; one after they are in place leaves them (exit 0).
+  if (!frames.outputs.finish(pending_signal)) {
+    log.frames_end();
+    log.interrupted(pending_signal(), plan.written.last);
+    result.exit_code = interrupted_exit_code(pending_signal());
+    return result;
+  }
+  log.frames_end();
   result.written = plan.written;
   result.substeps = (plan.written.last - start.frame) * frames.info.substeps;
   result.final_paths = frames.outputs.final_paths();
@@ -270,6 +277,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   result.exit_code = run_frames(plan, simulator, start, frames, placement, log);
   if (result.exit_code != 0) return result;
   result = finish_bake(plan, start, warmup, frames, placement, log);
+  if (result.exit_code != 0) return result;
   result.vertices = vertices;
   result.samples = samples ? samples->vertex_count() : 0;
   result.clusters = clusters;

@@ -293,7 +293,7 @@ void OutputSet::push(FrameData frame) {
     if (worker->selection.wants(shared->frame)) worker->writer->push(shared);
 }
 
-void OutputSet::finish() {
+bool OutputSet::finish(const std::function<bool()>& stop) {
   try {
     // Each writer drains its queue (all at once, on their threads); the first failure in
     // the outputs' order is the one reported.
@@ -301,6 +301,10 @@ void OutputSet::finish() {
     // Every file complete, and every target still one a file may replace, before any is
     // renamed: a failure here still leaves no output.
     for (auto& worker : impl_->workers) worker->sink->finish();
+    if (stop()) {
+      abort();
+      return false;
+    }
     for (auto& worker : impl_->workers) worker->sink->check_targets();
     for (auto& worker : impl_->workers) worker->sink->commit();
   } catch (...) {
@@ -309,6 +313,7 @@ void OutputSet::finish() {
   }
   impl_->locks.release();
   impl_->done = true;
+  return true;
 }
 
 void OutputSet::abort() noexcept {

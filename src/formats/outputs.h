@@ -5,6 +5,7 @@
 // temporary.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -123,8 +124,10 @@ class OutputSet {
   FrameData spare_frame();
   // Queues a frame (blocks while the queue is full). Rethrows a writer failure as OutputError.
   void push(FrameData frame);
-  // Drains the queue, closes files, renames temporaries to their final names.
-  void finish();
+  // Drains the queue, closes files, renames temporaries to their final names; unless
+  // `stop` says, once every file is complete, that the bake was interrupted meanwhile (the
+  // files can take long: a skin's fit, a page): then aborts, as abort(), and returns false.
+  bool finish(const std::function<bool()>& stop = [] { return false; });
   // Stops the writer and removes every temporary. Never throws.
   void abort() noexcept;
   // Final paths (files, or the first file of a sequence pattern) for the summary line.
