@@ -101,6 +101,8 @@ bool transfer_record(Transfer transfer, Number& number, Frame& frame, bool veloc
 FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& layout) {
   std::error_code error;
   fs::create_directories(path.parent_path(), error);
+  if (error)  // a read-only disk: the open below would only say "No such file or directory"
+    throw OutputError(path.string() + ": cannot create the folder of the frame journal: " + error.message());
   if (const std::string kind = resolve_output_target(path).kind; !kind.empty())  // "w+b" would take a FIFO
     throw OutputError(path.string() + ": " + kind + " stands where the bake writes its frame journal; left untouched");
   std::FILE* file = std::fopen(path.c_str(), "w+b");

@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "common/errors.h"
 #include "common/message_text.h"
+#include "sim/kernel_isa.h"
 #include "treeanim_version.h"
 
 namespace treeanim {
@@ -182,6 +183,7 @@ int report(const char* kind, const std::exception& error, int code) {
 // Runs the subcommand; a failure's exception => its message and exit code.
 int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   try {
+    if (const std::string isa = asked_isa_error(); !isa.empty()) throw InputError(isa);
     return dispatch(commands, args);
   } catch (const InputError& error) {
     return report("error: ", error, kExitInput);

@@ -1,6 +1,7 @@
 #include "common/message_text.h"
 
 #include <cstdio>
+#include <sstream>
 
 namespace treeanim {
 
@@ -76,6 +77,12 @@ std::string excerpt(std::string_view text, size_t most) {
   size_t cut = most >= 3 ? most - 3 : 0;
   while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
   return printable_text(text.substr(0, cut)) + "...";
+}
+
+std::string number_text(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
 }
 
 }  // namespace treeanim

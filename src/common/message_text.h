@@ -22,4 +22,7 @@ std::string shown_message(std::string_view text, size_t most = 2000);
 // its first NUL).
 std::string excerpt(std::string_view text, size_t most = 60);
 
+// A number in a message, as a stream writes it: six significant digits ("0.02", "1e-09", "inf").
+std::string number_text(double value);
+
 }  // namespace treeanim

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "files/staged_files.h"
 #include "formats/frame_sink.h"
 #include "formats/hdf5_support.h"
@@ -298,8 +299,8 @@ class Hdf5Sink final : public FrameSink {
       const double q = std::nearbyint((double(frame.positions[i]) - double(rest_[i])) / options_.quantize);
       if (!(std::fabs(q) <= 2147483647.0))
         throw OutputError(path_.string() + ": frame " + std::to_string(frame.frame) + " moves vertex " +
-                          std::to_string(i / 3) + " " + std::to_string(double(frame.positions[i]) - rest_[i]) +
-                          " m from rest, beyond what quantize = " + std::to_string(options_.quantize) +
+                          std::to_string(i / 3) + " " + number_text(double(frame.positions[i]) - rest_[i]) +
+                          " m from rest, beyond what quantize = " + number_text(options_.quantize) +
                           " m holds in int32; raise quantize or leave it out");
       fits_int16 = fits_int16 && std::fabs(q) <= 32767.0;
       quantized_[i] = static_cast<int32_t>(q);

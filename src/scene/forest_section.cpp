@@ -3,10 +3,10 @@
 #include <array>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <unordered_map>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "common/random.h"
 #include "scene/forest.h"
 #include "scene/forest_layout.h"
@@ -36,12 +36,6 @@ bool is_file_safe(const std::string& name) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
            c == '.';
   });
-}
-
-std::string number_text(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
 }
 
 ForestVariant read_variant(SceneObject element, const ForestDefaults& defaults) {

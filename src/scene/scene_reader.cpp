@@ -2,21 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "common/did_you_mean.h"
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
 namespace {
-
-std::string format_number(double v) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 // Numbers in JSON may be integers or floats; both are accepted where a number is asked for.
 bool as_finite_number(const Json& v, double* out) {
@@ -36,10 +29,10 @@ bool Range::contains(double v) const {
 std::string Range::describe() const {
   const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
   if (!has_lo && !has_hi) return "a finite number";
-  if (has_lo && !has_hi) return std::string("a number ") + (lo_open ? "> " : ">= ") + format_number(lo);
-  if (!has_lo && has_hi) return std::string("a number ") + (hi_open ? "< " : "<= ") + format_number(hi);
-  return "a number in " + std::string(lo_open ? "(" : "[") + format_number(lo) + ", " +
-         format_number(hi) + (hi_open ? ")" : "]");
+  if (has_lo && !has_hi) return std::string("a number ") + (lo_open ? "> " : ">= ") + number_text(lo);
+  if (!has_lo && has_hi) return std::string("a number ") + (hi_open ? "< " : "<= ") + number_text(hi);
+  return "a number in " + std::string(lo_open ? "(" : "[") + number_text(lo) + ", " +
+         number_text(hi) + (hi_open ? ")" : "]");
 }
 
 std::string describe_json(const Json& value) {

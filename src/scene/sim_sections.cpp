@@ -28,23 +28,22 @@ const Range kWindTime = Range::between(-1e10, 1e10);
 // the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
 const Range kSolverFrequency = {0, 1.5e7, true, false};
 
-// A direction vector => unit vector; zero or non-finite => nullopt.
+// A direction vector => unit vector; zero or non-finite => nullopt. Scaled by its largest
+// component first: (1e300, 1e300, 0) has no finite norm, (1e-300, 0, 0) no normal one.
 std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
-  const double n = v.norm();
-  if (!(n > 0) || !std::isfinite(n)) return std::nullopt;
-  return Eigen::Vector3d(v / n);
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (!(largest > 0) || !std::isfinite(largest)) return std::nullopt;
+  const Eigen::Vector3d scaled = v / largest;
+  return Eigen::Vector3d(scaled / scaled.norm());
 }
 
 // One field of a CSV line => finite number within `range`; throws "name:line: column 'what': ...".
 double csv_number(const std::string& cell, const std::string& where, const std::string& column,
                   const Range& range = Range::any()) {
-  size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(cell, &used);
-  } catch (const std::logic_error&) {
-    used = 0;
-  }
+  // strtod, not stod: a subnormal such as 4e-320 is a number (stod throws on its ERANGE).
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  size_t used = static_cast<size_t>(end - cell.c_str());
   while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
   if (used == 0 || used != cell.size() || !std::isfinite(v))
     throw InputError(where + ": column '" + column + "': expected a finite number, got '" + excerpt(cell) + "'");
@@ -68,18 +67,12 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   return cells;
 }
 
-std::string format_number(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
 // Keys must have strictly increasing times (interpolation needs an order) => "" when key i
 // is in order, else the message.
 std::string order_error(const std::vector<WindKey>& keys, size_t i) {
   if (i == 0 || keys[i].time > keys[i - 1].time) return "";
-  return "time " + format_number(keys[i].time) + " must be greater than the previous key's time " +
-         format_number(keys[i - 1].time);
+  return "time " + number_text(keys[i].time) + " must be greater than the previous key's time " +
+         number_text(keys[i - 1].time);
 }
 
 // A frame pattern names the frame number at most once, as #### or %d / %0Nd (printf's, so

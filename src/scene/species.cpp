@@ -4,10 +4,10 @@
 #include <cctype>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 #include "common/did_you_mean.h"
+#include "common/message_text.h"
 #include "scene/sim_sections.h"
 #include "scene/tree_section.h"
 #include "species_library.h"
@@ -107,12 +107,6 @@ const Species* find_species(const std::string& name) {
   return nullptr;
 }
 
-std::string metres(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 // `parent`'s /tree/scale when it is a number > 0 (anything else is left to the tree's reader,
 // which refuses it).
 std::optional<double> given_scale(SceneObject& parent) {
@@ -129,7 +123,7 @@ bool outside_range(const Species& s, double height) { return height < s.min_heig
 
 // => "English oak (english_oak) grows from 10 to 40 m, got ", for a refusal outside it.
 std::string range_text(const Species& s) {
-  return s.common + " (" + s.name + ") grows from " + metres(s.min_height) + " to " + metres(s.max_height) + " m, got ";
+  return s.common + " (" + s.name + ") grows from " + number_text(s.min_height) + " to " + number_text(s.max_height) + " m, got ";
 }
 
 }  // namespace
@@ -149,10 +143,10 @@ std::optional<SpeciesChoice> read_species(SceneObject& parent) {
   auto scaled_height = [&](const Species& s) {
     const double height = s.default_height * (*scale / s.tree.scale);
     if (outside_range(s, height))
-      parent.object("tree").fail("scale", range_text(s) + metres(height) + " m from a scale of " + metres(*scale) +
+      parent.object("tree").fail("scale", range_text(s) + number_text(height) + " m from a scale of " + number_text(*scale) +
                                               ": give a scale from " +
-                                              metres(s.tree.scale * s.min_height / s.default_height) + " to " +
-                                              metres(s.tree.scale * s.max_height / s.default_height) +
+                                              number_text(s.tree.scale * s.min_height / s.default_height) + " to " +
+                                              number_text(s.tree.scale * s.max_height / s.default_height) +
                                               ", or the species' height");
     return height;
   };
@@ -173,7 +167,7 @@ std::optional<SpeciesChoice> read_species(SceneObject& parent) {
   choice.height_given = section.has("height");
   choice.height = section.number("height", scale && !choice.height_given ? scaled_height(s) : s.default_height,
                                  Range::positive());
-  if (outside_range(s, choice.height)) section.fail("height", range_text(s) + metres(choice.height));
+  if (outside_range(s, choice.height)) section.fail("height", range_text(s) + number_text(choice.height));
   return choice;
 }
 
@@ -184,7 +178,9 @@ void check_species_scale(const SpeciesChoice& choice, SceneObject tree) {
   const double grown = species_tree(choice).scale;
   if (choice.height_given && scale &&
       !(scale->is_number() && std::abs(scale->get<double>() - grown) <= 1e-12 * grown))
-    tree.fail("scale", "the species' height sets the tree's size: give the height or the scale, not both");
+    tree.fail("scale", "the species' height of " + number_text(choice.height) + " m grows it at a scale of " +
+                           number_text(grown) + ": give the height or the scale, or both as they agree (a resolved "
+                           "scene records both)");
 }
 
 TreeOptions species_tree(const SpeciesChoice& choice) {

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "common/message_text.h"
+
 namespace treeanim {
 
 namespace {
@@ -25,10 +27,19 @@ KernelIsa pick() {
   if (!asked) return std::min(KernelIsa::kAvx2, widest);
   for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
     if (std::string(asked) == kernel_isa_name(isa)) return isa < widest ? isa : widest;
-  return KernelIsa::kPortable;
+  return KernelIsa::kPortable;  // the command line refused it (asked_isa_error)
 }
 
 }  // namespace
+
+std::string asked_isa_error() {
+  const char* asked = std::getenv("TREEANIM_ISA");
+  if (!asked) return "";
+  for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
+    if (std::string(asked) == kernel_isa_name(isa)) return "";
+  return std::string("TREEANIM_ISA: expected portable, avx2 or avx512 (or none: the widest this CPU runs "
+                     "well), got '") + excerpt(asked) + "'";
+}
 
 KernelIsa kernel_isa() {
   static const KernelIsa isa = pick();

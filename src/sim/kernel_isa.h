@@ -3,6 +3,7 @@
 // "Instruction sets"). Every path gives the same bytes: the build never contracts a * b + c
 // (-ffp-contract=off), no loop is reassociated, and a wider vector only runs more lanes of
 // the same elementwise arithmetic.
+#include <string>
 #include <utility>
 
 namespace treeanim {
@@ -15,6 +16,9 @@ enum class KernelIsa { kPortable, kAvx2, kAvx512 };
 KernelIsa kernel_isa();
 // => "portable", "avx2" or "avx512".
 const char* kernel_isa_name(KernelIsa isa);
+// What is wrong with TREEANIM_ISA ("" when it is unset or names a set), for the command line
+// to refuse before kernel_isa() would fall back to portable unseen.
+std::string asked_isa_error();
 
 #if defined(__x86_64__) && defined(__GNUC__)
 // f() compiled for the set: `flatten` inlines everything it calls (the kernels, the lambdas)

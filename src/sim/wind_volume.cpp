@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
-#include <sstream>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "sim/volume_grids.h"
 
 namespace treeanim {
@@ -21,12 +21,6 @@ struct VolumeFrame {
 };
 
 namespace {
-
-std::string number_text(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 // The OpenVDB module's entry point, the module loaded from beside the running binary on first
 // use (volume_grids.h). Throws InputError when it cannot be loaded: the scene asks for a reader

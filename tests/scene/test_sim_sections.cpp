@@ -129,6 +129,19 @@ TEST(WindCsv, ErrorsNameFileAndLine) {
             "w.csv:1: expected at least one data line after the header");
 }
 
+// A direction whose norm overflows or underflows is still a direction, and a subnormal is a
+// number; infinity is not.
+TEST(WindCsv, DirectionsAndNumbersAtTheEndsOfTheDoubles) {
+  const std::vector<WindKey> keys =
+      parse_wind_csv("time,speed,dx,dy,dz\n0,5,1e300,1e300,0\n1,4e-320,0,1e-310,0\n", "w.csv");
+  ASSERT_EQ(keys.size(), 2u);
+  EXPECT_TRUE(keys[0].direction.isApprox(Eigen::Vector3d(1, 1, 0).normalized()));
+  EXPECT_EQ(keys[1].direction, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(keys[1].speed, 4e-320);
+  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1e999,1,0,0\n", "w.csv"); }),
+            "w.csv:2: column 'speed': expected a finite number, got '1e999'");
+}
+
 TEST(WindField, InterpolatesAndHoldsAtTheEnds) {
   WindOptions o;
   o.keys = {{1, 2, {1, 0, 0}, 0}, {3, 6, {0, 1, 0}, 0}};

@@ -150,7 +150,7 @@ TEST(SpeciesScene, BadChoicesNameThePointerAndWhatIsExpected) {
   EXPECT_NE(input_error_of([] { load(R"({"species": {"height": 12}})"); }).find("/species/name: expected a species' name"),
             std::string::npos);
   EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "english_oak", "height": 15}, "tree": {"scale": 2}})"); })
-                .find("/tree/scale: the species' height sets the tree's size"),
+                .find("/tree/scale: the species' height of 15 m grows it at a scale of "),
             std::string::npos);
   // Productions beside a species and no axiom would be left unread: the species' grammar grows.
   EXPECT_NE(input_error_of([] { load(R"({"species": "english_oak", "lsystem": {"productions": ["F --> FF"]}})"); })
