@@ -116,7 +116,7 @@ FrameJournal FrameJournal::create(const fs::path& path, const JournalLayout& lay
 
 FrameJournal FrameJournal::open(const fs::path& path, const JournalLayout& layout) {
   // A FIFO or a device would block the open, or read for ever.
-  if (std::error_code error; !fs::is_regular_file(path, error))
+  if (std::error_code error; fs::exists(path, error) && !fs::is_regular_file(path, error))
     throw InputError(path.string() + ": the frame journal is not a regular file");
   std::FILE* file = std::fopen(path.c_str(), "r+b");
   if (!file) throw InputError(io_failure(path, "cannot open the frame journal"));

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "bake/bake_forest.h"
+#include "bake/bake_plan.h"
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
@@ -62,6 +63,11 @@ int validate_command(const std::filesystem::path& scene_file,
     estimate_forest(scene);  // grows one tree of each variant
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
+    // What run refuses before it grows the tree: two outputs at one file, a folder or a device
+    // where one goes (the paths as run resolves them without -o).
+    const BakePlan plan = plan_bake(scene, BakeConfig{});
+    OutputTargets targets;
+    targets.add_outputs(scene.outputs, {}, plan.written.first, plan.written.count());
     print_counts(tree_summary(scene, prepare_tree(scene)));
   }
   if (scene.volume) print_volume(*scene.volume);

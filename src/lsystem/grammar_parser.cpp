@@ -9,6 +9,7 @@
 
 #include "common/errors.h"
 #include "common/did_you_mean.h"
+#include "common/direction.h"
 #include "common/message_text.h"
 #include "common/read_text_file.h"
 #include "lsystem/grammar.h"
@@ -426,7 +427,7 @@ class Parser {
     while (k < end && (is_space(text[k]) || text[k] == ',')) ++k;
     if (k < end) fail(line, k, "expected 4 values 'Tx Ty Tz e' after 'tropism:', got more");
     const Eigen::Vector3d t(values[0], values[1], values[2]);
-    if (t.norm() == 0.0) fail(line, begin, "expected a non-zero tropism direction");
+    if (!unit_direction(t)) fail(line, begin, "expected a non-zero tropism direction");
     g_.tropism = t;
     g_.tropism_elasticity = values[3];
   }

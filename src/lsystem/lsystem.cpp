@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "common/direction.h"
 #include "common/errors.h"
 #include "common/read_text_file.h"
 
@@ -57,10 +58,10 @@ void set_tropisms(const LsystemOptions& options, const Grammar& grammar, const V
   }
   const auto first = std::find_if(turtle.movements.begin(), turtle.movements.end(), [](const Movement& m) { return !m.torque; });
   if (first != turtle.movements.end()) {
-    if (options.tropism) first->direction = options.tropism->normalized() * first->direction.norm();
+    if (options.tropism) first->direction = *unit_direction(*options.tropism) * first->direction.norm();
     if (options.tropism_elasticity) first->elasticity = *options.tropism_elasticity;
   } else if (view.old_tropism || view.initial_elasticity) {
-    if (options.tropism) turtle.old_tropism = options.tropism->normalized();
+    if (options.tropism) turtle.old_tropism = *unit_direction(*options.tropism);
     if (options.tropism_elasticity) turtle.initial_elasticity = *options.tropism_elasticity;
   } else {
     if (options.tropism) turtle.tropism = *options.tropism;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <sstream>
 
+#include "common/direction.h"
 #include "common/errors.h"
 #include "common/read_text_file.h"
 
@@ -232,8 +233,8 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       if (v.size() != 3 || !Eigen::Vector3d(v[0], v[1], v[2]).allFinite())
         fail(name, i, "expected 'tropism direction: x,y,z' (three numbers)");
       // cpfg divides by the length and bends only at a non-zero elasticity: 0,0,0 is no
-      // tropism while the elasticity stays 0 (checked below), and normalized() keeps it 0.
-      view.old_tropism = Eigen::Vector3d(v[0], v[1], v[2]).normalized();
+      // tropism while the elasticity stays 0 (checked below), and stays 0.
+      view.old_tropism = unit_direction(Eigen::Vector3d(v[0], v[1], v[2])).value_or(Eigen::Vector3d::Zero());
       zero_tropism_line = view.old_tropism->isZero() ? std::optional<size_t>(i) : std::nullopt;
     } else if (key == "initial elasticity") view.initial_elasticity = number(name, i, rest, key.c_str());
     else if (key == "elasticity increment") view.elasticity_increment = number(name, i, rest, key.c_str());

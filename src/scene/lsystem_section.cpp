@@ -2,6 +2,8 @@
 
 #include <cctype>
 
+#include "common/direction.h"
+
 namespace treeanim {
 
 namespace {
@@ -66,14 +68,14 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, co
   options.view = section.optional_path("view");
   if (options.view && !options.grammar) section.fail("view", "a view file goes with a grammar file (/lsystem/grammar)");
   options.defines = read_defines(section);
-  if (auto n = section.optional_integer("iterations", 0, 10000)) options.iterations = static_cast<int>(*n);
+  if (auto n = section.optional_integer("iterations", 0, 100000)) options.iterations = static_cast<int>(*n);
   options.seed = static_cast<uint64_t>(section.integer("seed", static_cast<long long>(scene_seed), 0, 1LL << 53));
   options.step = section.number("step", 1.0, Range::positive());
   options.angle = section.optional_number("angle", Range::between(-360, 360));
   options.max_modules = static_cast<size_t>(section.integer("max_modules", 20'000'000, 1, 1LL << 29));
   options.width_factor = section.optional_number("width_factor", Range::positive());
   options.tropism = section.optional_vector3("tropism");
-  if (options.tropism && options.tropism->norm() == 0.0)
+  if (options.tropism && !unit_direction(*options.tropism))
     section.fail_expected("tropism", "a non-zero direction [x, y, z]");
   options.tropism_elasticity = section.optional_number("tropism_elasticity");
   if (auto n = section.optional_integer("surface_precision", 1, 10)) options.surface_precision = static_cast<int>(*n);

@@ -67,6 +67,9 @@ OutputOptions read_output_options(SceneObject element) {
                              "\"), got \"" + excerpt(*path) + "\"");
   options.frame_step = static_cast<int>(element.integer("frame_step", 1, 1, 1000000));
   for (const OutputKey& key : options.format->keys) read_format_key(element, key, options);
+  // Joints are a skinned output's: a plain USD has none to cap.
+  if (element.has("max_joints") && !options.format->skinned && !options.skinned)
+    element.fail("max_joints", "applies to a skinned output (skinned_glb, or usd with \"skinned\": true)");
   if (options.format->always_normals) options.normals = true;
   return options;
 }

@@ -91,6 +91,17 @@ std::optional<long long> SceneObject::optional_integer(const std::string& key, l
   if (!value || value->is_null()) return std::nullopt;
   const std::string expected =
       "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  // A JSON integer compared as one: 2^53 + 1 as a double is 2^53, within a bound of 2^53.
+  if (value->is_number_unsigned()) {
+    const uint64_t u = value->get<uint64_t>();
+    if (hi < 0 || u > uint64_t(hi) || (lo > 0 && u < uint64_t(lo))) fail_expected(key, expected);
+    return static_cast<long long>(u);
+  }
+  if (value->is_number_integer()) {
+    const int64_t i = value->get<int64_t>();
+    if (i < lo || i > hi) fail_expected(key, expected);
+    return i;
+  }
   double v = 0;
   if (!as_finite_number(*value, &v) || std::floor(v) != v || v < double(lo) || v > double(hi))
     fail_expected(key, expected);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "common/direction.h"
 #include "common/errors.h"
 #include "common/message_text.h"
 #include "common/read_text_file.h"
@@ -28,14 +29,6 @@ const Range kWindTime = Range::between(-1e10, 1e10);
 // the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
 const Range kSolverFrequency = {0, 1.5e7, true, false};
 
-// A direction vector => unit vector; zero or non-finite => nullopt. Scaled by its largest
-// component first: (1e300, 1e300, 0) has no finite norm, (1e-300, 0, 0) no normal one.
-std::optional<Eigen::Vector3d> unit(const Eigen::Vector3d& v) {
-  const double largest = v.cwiseAbs().maxCoeff();
-  if (!(largest > 0) || !std::isfinite(largest)) return std::nullopt;
-  const Eigen::Vector3d scaled = v / largest;
-  return Eigen::Vector3d(scaled / scaled.norm());
-}
 
 // One field of a CSV line => finite number within `range`; throws "name:line: column 'what': ...".
 double csv_number(const std::string& cell, const std::string& where, const std::string& column,
@@ -194,7 +187,7 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
     key.speed = csv_number(cells[1], where, "speed", kWindSpeed);
     const Eigen::Vector3d d(csv_number(cells[2], where, "dx"), csv_number(cells[3], where, "dy"),
                             csv_number(cells[4], where, "dz"));
-    const auto direction = unit(d);
+    const auto direction = unit_direction(d);
     if (!direction) throw InputError(where + ": columns 'dx,dy,dz': the direction must not be zero");
     key.direction = *direction;
     if (has_gust) {
@@ -220,7 +213,7 @@ WindOptions read_wind_options(SceneObject section, uint64_t scene_seed) {
     WindKey key;
     key.time = k.number("time", 0, kWindTime);
     key.speed = k.number("speed", 0, kWindSpeed);
-    const auto direction = unit(k.vector3("direction", key.direction));
+    const auto direction = unit_direction(k.vector3("direction", key.direction));
     if (!direction) k.fail("direction", "expected a non-zero vector");
     key.direction = *direction;
     key.gust = k.number("gust", 0, kWindSpeed);

@@ -34,6 +34,15 @@ TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {
   EXPECT_EQ(scene["lsystem"]["max_modules"], 20'000'000);
 }
 
+// A tropism is a direction: any length, however small, once it is not zero.
+TEST(LsystemOptions, TropismOfAnyLength) {
+  Json tiny = Json::parse(R"json({"lsystem": {"grammar": "tree.lsys", "tropism": [1e-300, 0, 0]}})json");
+  EXPECT_EQ(*read(tiny).tropism, Eigen::Vector3d(1e-300, 0, 0));
+  EXPECT_NE(error_of(R"json({"lsystem": {"grammar": "tree.lsys", "tropism": [0, 0, 0]}})json")
+                .find("/lsystem/tropism: expected a non-zero direction"),
+            std::string::npos);
+}
+
 TEST(LsystemOptions, InlineGrammar) {
   Json scene = Json::parse(R"json({"lsystem": {"axiom": "A(1)", "productions": ["A(x) --> F(x)A(x*k)"],
       "defines": {"k": 2}, "iterations": 4, "seed": 5, "step": 0.1, "angle": 30, "max_modules": 1000,
@@ -70,7 +79,7 @@ TEST(LsystemOptions, ErrorsAreJsonPointers) {
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "defines": {"2k": 1}}})"),
             "scene.json: /lsystem/defines/2k: expected a name of letters, digits and '_' (not starting with a digit)");
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "iterations": -1}})"),
-            "scene.json: /lsystem/iterations: expected an integer in [0, 10000], got -1");
+            "scene.json: /lsystem/iterations: expected an integer in [0, 100000], got -1");
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "step": 0}})"),
             "scene.json: /lsystem/step: expected a number > 0, got 0");
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "tropism": [0, 0, 0]}})"),
