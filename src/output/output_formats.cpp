@@ -82,9 +82,11 @@ const std::vector<OutputFormatRow> kFormats = {
      }},
     {.name = "gltf",
      .keys = {kSmoothNormalsKey},
-     // a file per frame: positions, triangles
+     // a file per frame, the whole mesh: positions, UVs (8 bytes a vertex), leaf colours (12, at
+     // most), triangles, and its JSON and headers (about 2 KB)
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
-       return vector_bytes(vertices) + normal_bytes(o, vertices) + 12.0 * double(triangles);
+       return vector_bytes(vertices) + normal_bytes(o, vertices) + 20.0 * double(vertices) + 12.0 * double(triangles) +
+              2048.0;
      }},
     {.name = "glb", .keys = {kSmoothNormalsKey}, .frame_bytes = vector_frame_bytes},
     {.name = "pc2", .frame_bytes = vector_frame_bytes},
