@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <mutex>
 
@@ -194,11 +196,79 @@ openvdb::GridBase::Ptr read_named_grid(openvdb::io::File& file, const std::strin
   return file.readGrid(name);
 }
 
+// The file's layout walked as OpenVDB's File::open reads it (header, file metadata, then each
+// grid's descriptor and its end), every length and position checked against the file's size.
+// OpenVDB reads a length at the cut of a truncated file into an uninitialised integer and
+// allocates that much: a file cut inside its metadata made it take 20 GB before it failed.
+class LayoutWalk {
+ public:
+  explicit LayoutWalk(const std::string& path) : in_(path, std::ios::binary), size_(std::filesystem::file_size(path)) {}
+
+  void walk() {
+    int64_t magic = 0;
+    uint32_t version = 0;
+    // Not a VDB file, or one OpenVDB no longer reads: its own message says so.
+    if (size_ < 12) return;
+    read(magic, "the header"), read(version, "the header");
+    if (magic != openvdb::OPENVDB_MAGIC || version < openvdb::OPENVDB_FILE_VERSION_FLOAT_FRUSTUM_BBOX) return;
+    skip(8, "the header");  // the library's major and minor version
+    char offsets = 0;
+    read(offsets, "the header");
+    // Versions 220 and 221 have a file-wide compression flag.
+    if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) skip(1, "the header");
+    skip(36, "the header's UUID");
+    metadata("the file's metadata");
+    if (!offsets) return;  // a stream's grids follow one another unindexed: OpenVDB reads them in order
+    int32_t grids = 0;
+    read(grids, "the grid count");
+    for (int32_t g = 0; g < grids; ++g) {
+      const std::string what = "grid " + std::to_string(g + 1);
+      for (int k = 0; k < 3; ++k) text(what + "'s descriptor");  // unique name, type, instance parent
+      int64_t grid = 0, block = 0, end = 0;
+      read(grid, what + "'s descriptor"), read(block, what + "'s descriptor"), read(end, what + "'s descriptor");
+      if (grid < int64_t(at_) || block < grid || end < block)
+        throw std::runtime_error(what + "'s descriptor places it outside its own bounds");
+      skip(uint64_t(end) - at_, what + ", which ends at byte " + std::to_string(end));
+    }
+  }
+
+ private:
+  std::ifstream in_;
+  uint64_t size_, at_ = 0;
+
+  std::string cut(const std::string& what) const {
+    return "the file is cut short: it ends at byte " + std::to_string(size_) + ", inside " + what;
+  }
+  void skip(uint64_t bytes, const std::string& what) {
+    if (bytes > size_ - at_) throw std::runtime_error(cut(what));
+    at_ += bytes;
+    in_.seekg(std::streamoff(at_));
+  }
+  template <typename T>
+  void read(T& value, const std::string& what) {
+    if (sizeof value > size_ - at_) throw std::runtime_error(cut(what));
+    in_.read(reinterpret_cast<char*>(&value), sizeof value);
+    at_ += sizeof value;
+  }
+  void text(const std::string& what) {  // a length, then that many bytes
+    uint32_t length = 0;
+    read(length, what);
+    skip(length, what);
+  }
+  void metadata(const std::string& what) {  // a count, then name, type and value of each item
+    uint32_t count = 0;
+    read(count, what);
+    for (uint32_t k = 0; k < count; ++k)
+      for (int part = 0; part < 3; ++part) text(what);
+  }
+};
+
 // Frame file, grid name => its grids read whole; throws std::runtime_error with what is wrong.
 std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::string& name) {
   std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
   auto frame = std::make_unique<OpenVdbGrids>();
   frame->name = name;
+  LayoutWalk(path).walk();
   openvdb::io::File file(path);
   file.open(false);
   if (file.hasGrid(name)) {

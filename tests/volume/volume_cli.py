@@ -64,6 +64,10 @@ def check_bad(treeanim, tmp):
     whole = open(os.path.join(vol, "vel.0003.vdb"), "rb").read()
     not_vdb = copy_with("not-vdb", b"time,speed\n0,1\n")
     truncated = copy_with("truncated", whole[: len(whole) // 2])
+    # Cut inside the grid's descriptor (its length-prefixed name): OpenVDB read a length past the
+    # cut as garbage and allocated gigabytes before it failed.
+    descriptor_cut = whole.index(b"\x03\x00\x00\x00vel") + 5
+    truncated_descriptor = copy_with("truncated-descriptor", whole[:descriptor_cut])
     nan = os.path.join(tmp, "nan")
     write_volume("uniform", "houdini", nan, "--frames", "1", "10", "--voxel", "1", "--nan-at", "3")
     fast = os.path.join(tmp, "fast")
@@ -101,7 +105,12 @@ def check_bad(treeanim, tmp):
         ("before-the-first-frame", volume(vol), {"fps": 24, "frames": 4, "start": -2, "substeps": 2},
          "vel.-001.vdb: the volume frame is missing"),
         ("not-a-vdb", volume(not_vdb), nine, "not-vdb/vel.0003.vdb: not a readable VDB file"),
-        ("truncated", volume(truncated), nine, "truncated/vel.0003.vdb: not a readable VDB file"),
+        ("truncated", volume(truncated), nine,
+         f"truncated/vel.0003.vdb: not a readable VDB file (the file is cut short: it ends at byte {len(whole) // 2}, "
+         f"inside grid 1, which ends at byte {len(whole)})"),
+        ("truncated-descriptor", volume(truncated_descriptor), nine,
+         f"vel.0003.vdb: not a readable VDB file (the file is cut short: it ends at byte {descriptor_cut}, inside "
+         "grid 1's descriptor)"),
         ("missing-grid", volume(vol, grid="velocity"), nine,
          "vel.0001.vdb: no grid 'velocity' (nor 'velocity.x', 'velocity.y', 'velocity.z'); its grids: 'vel' (vec3s)"),
         ("grid-of-another-type", volume(scalar), nine,
