@@ -12,7 +12,9 @@ double estimated_output_bytes(const OutputOptions& output, size_t vertices, size
   if (PlannedBytes* planned = find_planned_bytes(output.format->name))
     return planned(output, vertices, triangles, clusters, frames);
   const double written = double((frames + output.frame_step - 1) / output.frame_step);
-  return written * output.format->frame_bytes(output, vertices, triangles, clusters);
+  const OutputFormatRow& format = *output.format;
+  return written * format.frame_bytes(output, vertices, triangles, clusters) +
+         (format.fixed_bytes ? format.fixed_bytes(output, vertices, triangles, clusters) : 0.0);
 }
 
 }  // namespace treeanim

@@ -4,6 +4,7 @@
 #include "output/output_formats.h"
 
 #include <algorithm>
+#include <string>
 
 namespace treeanim {
 
@@ -32,6 +33,27 @@ double vector_frame_bytes(const OutputOptions& o, size_t vertices, size_t, size_
   return vector_bytes(vertices) + normal_bytes(o, vertices);
 }
 
+// An OBJ file of the whole mesh: "v x y z" lines of about 33 characters (shortest round-trip
+// floats), "vn" of about 37, "vt u v" of up to 20, and a face's three corners of two or three
+// indices of as many digits as the vertex count has (on the demo, 2026-11-30: 32.6, 36.4, 13
+// and 31 or 46 characters a line; the estimate is 8-11 % over).
+double obj_file_bytes(const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
+  const double digits = double(std::to_string(vertices).size()), indices = o.normals ? 3.0 : 2.0;
+  return (34.0 + (o.normals ? 38.0 : 0) + 20.0) * double(vertices) +
+         (2.0 + 3.0 * indices * (digits + 1.0)) * double(triangles);
+}
+
+// The rest OBJ beside a PC2 or MDD cache: positions, UVs and faces.
+double rest_obj_bytes(const OutputOptions&, size_t vertices, size_t triangles, size_t clusters) {
+  return obj_file_bytes(OutputOptions{}, vertices, triangles, clusters);
+}
+
+// A GLB's mesh, written once: positions, normals, UVs and leaf colours (44 bytes a vertex), the
+// triangles' indices (12).
+double glb_mesh_bytes(const OutputOptions&, size_t vertices, size_t triangles, size_t) {
+  return 45.0 * double(vertices) + 12.0 * double(triangles);
+}
+
 // Joints of a skinned output: one per cluster, or max_joints when fewer.
 double joint_count(const OutputOptions& o, size_t clusters) {
   return double(o.max_joints > 0 ? std::min(o.max_joints, clusters) : clusters);
@@ -40,6 +62,12 @@ double joint_count(const OutputOptions& o, size_t clusters) {
 // A skinned GLB's keys: a float translation and rotation per joint.
 double skinned_frame_bytes(const OutputOptions& o, size_t, size_t, size_t clusters) {
   return 28.0 * joint_count(o, clusters);
+}
+
+// A skinned GLB's mesh with four joints and weights a vertex (24 bytes), and per joint its
+// node, inverse bind matrix and animation channels (about 620 bytes with their JSON).
+double skinned_mesh_bytes(const OutputOptions& o, size_t vertices, size_t triangles, size_t clusters) {
+  return glb_mesh_bytes(o, vertices, triangles, clusters) + 24.0 * double(vertices) + 620.0 * joint_count(o, clusters);
 }
 
 // The joints a skinned output takes at most.
@@ -73,13 +101,16 @@ const std::vector<OutputFormatRow> kFormats = {
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        const double vectors = vector_bytes(vertices);
        return (o.quantize > 0 ? 0.5 : 1.0) * vectors + (o.velocities ? vectors : 0) + normal_bytes(o, vertices);
+     },
+     // the rest mesh, UVs and clusters: 36 bytes a vertex and 12 a triangle, fitted to the demo
+     // and table1-13548 (2026-11-30)
+     .fixed_bytes = [](const OutputOptions&, size_t vertices, size_t triangles, size_t) {
+       return 36.0 * double(vertices) + 12.0 * double(triangles);
      }},
     {.name = "obj",
      .keys = {kNormalsKey},
-     // text: "v x y z" lines of ~32 characters, faces of ~24
-     .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t) {
-       return 32.0 * double(vertices) + (o.normals ? 36.0 * double(vertices) : 0) + 24.0 * double(triangles);
-     }},
+     .frame_bytes = obj_file_bytes,
+     .fixed_bytes = obj_file_bytes},  // the rest OBJ
     {.name = "gltf",
      .keys = {kSmoothNormalsKey},
      // a file per frame, the whole mesh: positions, UVs (8 bytes a vertex), leaf colours (12, at
@@ -88,9 +119,9 @@ const std::vector<OutputFormatRow> kFormats = {
        return vector_bytes(vertices) + normal_bytes(o, vertices) + 20.0 * double(vertices) + 12.0 * double(triangles) +
               2048.0;
      }},
-    {.name = "glb", .keys = {kSmoothNormalsKey}, .frame_bytes = vector_frame_bytes},
-    {.name = "pc2", .frame_bytes = vector_frame_bytes},
-    {.name = "mdd", .frame_bytes = vector_frame_bytes},
+    {.name = "glb", .keys = {kSmoothNormalsKey}, .frame_bytes = vector_frame_bytes, .fixed_bytes = glb_mesh_bytes},
+    {.name = "pc2", .frame_bytes = vector_frame_bytes, .fixed_bytes = rest_obj_bytes},
+    {.name = "mdd", .frame_bytes = vector_frame_bytes, .fixed_bytes = rest_obj_bytes},
     {.name = "vat",
      .keys = {{.name = "texture_width",
                .type = Type::kInteger,
@@ -105,11 +136,13 @@ const std::vector<OutputFormatRow> kFormats = {
      // offsets and normals, RGBA texels
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t) {
        return (o.vat_half ? 8.0 : 16.0) * 2.0 * double(vertices);
-     }},
+     },
+     .fixed_bytes = glb_mesh_bytes},  // the mesh the textures move
     {.name = "skinned_glb",
      .keys = {kMaxJointsKey},
      .skinned = true,
-     .frame_bytes = skinned_frame_bytes},
+     .frame_bytes = skinned_frame_bytes,
+     .fixed_bytes = skinned_mesh_bytes},
     {.name = "usd",
      .keys = {kNormalsKey,
               {.name = "skinned",
@@ -121,6 +154,12 @@ const std::vector<OutputFormatRow> kFormats = {
      // text: ~36 characters a point, ~38 a normal; skinned: ~96 a joint's translation and rotation
      .frame_bytes = [](const OutputOptions& o, size_t vertices, size_t, size_t clusters) {
        return o.skinned ? 96.0 * joint_count(o, clusters) : (36.0 + (o.normals ? 38.0 : 0.0)) * double(vertices);
+     },
+     // text, fitted to the demo and table1-13548 (2026-11-30): the rest mesh, about 40 characters a
+     // vertex and 36 a triangle; skinned, 24 a vertex's joints and weights and 320 a joint more
+     .fixed_bytes = [](const OutputOptions& o, size_t vertices, size_t triangles, size_t clusters) {
+       return 40.0 * double(vertices) + 36.0 * double(triangles) +
+              (o.skinned ? 24.0 * double(vertices) + 320.0 * joint_count(o, clusters) : 0.0);
      }},
     {.name = "html",
      .keys = {{.name = "max_mib",

@@ -38,6 +38,8 @@ struct OutputFormatRow {
   const char* file_kind = nullptr;
   // options, mesh size => bytes of one written frame's data, uncompressed (formats/output_estimate.h)
   double (*frame_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
+  // the same => bytes written once, whatever the frame count (the rest mesh, joints); nullptr: none
+  double (*fixed_bytes)(const OutputOptions& options, size_t vertices, size_t triangles, size_t clusters) = nullptr;
 };
 
 // The output writes one joint per cluster (skinned, no limbs merged under max_joints).

@@ -112,12 +112,45 @@ TEST_F(Cli, InfoEstimatesEachOutput) {
   const auto info = nlohmann::json::parse(r.out);
   const auto& outputs = info["estimate"]["outputs"];
   ASSERT_EQ(outputs.size(), 3u);
-  const double vertices = info["mesh"]["vertices"].get<double>(), joints = info["model"]["clusters"].get<double>();
+  const double vertices = info["mesh"]["vertices"].get<double>(), triangles = info["mesh"]["triangles"].get<double>(),
+               joints = info["model"]["clusters"].get<double>();
   EXPECT_EQ(outputs[0]["format"], "hdf5");
-  EXPECT_EQ(outputs[0]["bytes"].get<double>(), 5 * 12 * vertices);
+  EXPECT_EQ(outputs[0]["bytes"].get<double>(), 5 * 12 * vertices + 36 * vertices + 12 * triangles);
   EXPECT_EQ(outputs[1]["path"], "t.usda");
-  EXPECT_EQ(outputs[1]["bytes"].get<double>(), 5 * 36 * vertices);
-  EXPECT_EQ(outputs[2]["bytes"].get<double>(), 5 * 96 * joints);
+  const double usd_mesh = 40 * vertices + 36 * triangles;
+  EXPECT_EQ(outputs[1]["bytes"].get<double>(), 5 * 36 * vertices + usd_mesh);
+  EXPECT_EQ(outputs[2]["bytes"].get<double>(), 5 * 96 * joints + usd_mesh + 24 * vertices + 320 * joints);
+}
+
+// What the free-space check and farm plan count against what a bake writes, for every format:
+// the demo tree for two frames (where what is written once weighs most) and for eight. An
+// estimate short of the bytes lets a bake start that its disk cannot hold.
+TEST_F(Cli, EstimatesAreCloseToTheBytesWritten) {
+  const std::string demo = std::string(TREEANIM_SOURCE_DIR) + "/configs/demo.json";
+  for (const char* output : {R"({"format": "hdf5", "path": "o.h5"})", R"({"format": "obj", "path": "f%04d.obj"})",
+                             R"({"format": "obj", "path": "n%04d.obj", "normals": true})",
+                             R"({"format": "gltf", "path": "g%04d.glb"})", R"({"format": "glb", "path": "o.glb"})",
+                             R"({"format": "pc2", "path": "o.pc2"})", R"({"format": "mdd", "path": "o.mdd"})",
+                             R"({"format": "vat", "path": "o.exr"})", R"({"format": "skinned_glb", "path": "s.glb"})",
+                             R"({"format": "usd", "path": "o.usda"})",
+                             R"({"format": "usd", "path": "s.usda", "skinned": true})",
+                             R"({"format": "html", "path": "o.html"})"})
+    for (int frames : {2, 8}) {
+      const std::string options =
+          demo + " --set time.frames=" + std::to_string(frames) + " --set 'outputs=[" + output + "]'";
+      Result r = run("info --json " + options);
+      ASSERT_EQ(r.code, 0) << r.err;
+      const double estimate = nlohmann::json::parse(r.out)["estimate"]["outputs"][0]["bytes"].get<double>();
+      const fs::path out = dir_ / ("out-" + std::to_string(frames));
+      fs::remove_all(out);
+      r = run("run " + options + " -o " + out.string() + " --quiet");
+      ASSERT_EQ(r.code, 0) << r.err;
+      double written = 0;
+      for (const auto& file : fs::recursive_directory_iterator(out))
+        if (file.is_regular_file()) written += double(file.file_size());
+      EXPECT_GE(estimate, 0.95 * written) << output << ", " << frames << " frames";
+      EXPECT_LE(estimate, 1.7 * written) << output << ", " << frames << " frames";
+    }
 }
 
 // A cpfg object (tests/data/cpfg): plant.v names leaf.s for ~l, a 3 x 2-quad patch of 12 points

@@ -19,19 +19,25 @@ TEST(OutputEstimate, SizeEstimatesPerFormat) {
   };
   auto plain = [](OutputOptions&) {};
   auto with_normals = [](OutputOptions& o) { o.normals = true; };
-  EXPECT_EQ(bytes("hdf5", plain), 4800);
-  EXPECT_EQ(bytes("hdf5", [](OutputOptions& o) { o.quantize = 1e-3, o.velocities = o.normals = true; }), 12000);
-  EXPECT_EQ(bytes("obj", plain), 17600);
-  EXPECT_EQ(bytes("obj", with_normals), 32000);
+  // What each writes once: the rest mesh (an HDF5's 36 bytes a vertex and 12 a triangle; a
+  // GLB's 45 and 12; an OBJ file's lines), a skinned output's weights and joints.
+  const double hdf5_mesh = 36 * 100 + 12 * 50, glb_mesh = 45 * 100 + 12 * 50, usd_mesh = 40 * 100 + 36 * 50;
+  const double obj_file = 54 * 100 + (2 + 3 * 2 * 4) * 50, obj_normals_file = 92 * 100 + (2 + 3 * 3 * 4) * 50;
+  EXPECT_EQ(bytes("hdf5", plain), 4800 + hdf5_mesh);
+  EXPECT_EQ(bytes("hdf5", [](OutputOptions& o) { o.quantize = 1e-3, o.velocities = o.normals = true; }),
+            12000 + hdf5_mesh);
+  EXPECT_EQ(bytes("obj", plain), 5 * obj_file);  // four frames and the rest OBJ
+  EXPECT_EQ(bytes("obj", with_normals), 5 * obj_normals_file);
   EXPECT_EQ(bytes("gltf", plain), 4 * (1200 + 20 * 100 + 12 * 50 + 2048));  // the whole mesh in each frame's file
-  for (const char* format : {"glb", "pc2", "mdd"}) EXPECT_EQ(bytes(format, with_normals), 9600) << format;
-  EXPECT_EQ(bytes("vat", plain), 12800);
-  EXPECT_EQ(bytes("vat", [](OutputOptions& o) { o.vat_half = true; }), 6400);
-  EXPECT_EQ(bytes("skinned_glb", plain), 4 * 28 * 7);  // a joint per cluster
-  EXPECT_EQ(bytes("skinned_glb", [](OutputOptions& o) { o.max_joints = 5; }), 4 * 28 * 5);
-  EXPECT_EQ(bytes("usd", plain), 4 * 36 * 100);
-  EXPECT_EQ(bytes("usd", with_normals), 4 * (36 + 38) * 100);
-  EXPECT_EQ(bytes("usd", [](OutputOptions& o) { o.skinned = true; }), 4 * 96 * 7);
+  EXPECT_EQ(bytes("glb", with_normals), 9600 + glb_mesh);
+  for (const char* format : {"pc2", "mdd"}) EXPECT_EQ(bytes(format, with_normals), 9600 + obj_file) << format;
+  EXPECT_EQ(bytes("vat", plain), 12800 + glb_mesh);
+  EXPECT_EQ(bytes("vat", [](OutputOptions& o) { o.vat_half = true; }), 6400 + glb_mesh);
+  EXPECT_EQ(bytes("skinned_glb", plain), 4 * 28 * 7 + glb_mesh + 24 * 100 + 620 * 7);  // a joint per cluster
+  EXPECT_EQ(bytes("skinned_glb", [](OutputOptions& o) { o.max_joints = 5; }), 4 * 28 * 5 + glb_mesh + 24 * 100 + 620 * 5);
+  EXPECT_EQ(bytes("usd", plain), 4 * 36 * 100 + usd_mesh);
+  EXPECT_EQ(bytes("usd", with_normals), 4 * (36 + 38) * 100 + usd_mesh);
+  EXPECT_EQ(bytes("usd", [](OutputOptions& o) { o.skinned = true; }), 4 * 96 * 7 + usd_mesh + 24 * 100 + 320 * 7);
   // The page's whole size as its sink plans it (the viewer, about 0.6 MB, included), at most its limit.
   const double page = bytes("html", [](OutputOptions& o) { o.max_page_bytes = 2 << 20; });
   EXPECT_GT(page, 4 * 1600 + 500000);
