@@ -74,7 +74,7 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
                         state.island_asleep[model.vertex_island[v]]);
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
-    block.half_damping[k] = still ? Real(1) : model.vertex_half_damping[v];
+    block.half_damping[k] = still ? Real(1) : attachment.vertex_half_damping[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
     block.flying[k] = still ? Real(0) : Real(attachment.vertex_flying[v]);
     Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
@@ -116,7 +116,7 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     VertexInputs<Real> in;
     if (direct) {
       in = {{corrections[0] + begin, corrections[1] + begin, corrections[2] + begin},
-            model.vertex_drag.data() + begin, model.vertex_half_damping.data() + begin,
+            model.vertex_drag.data() + begin, attachment.vertex_half_damping.data() + begin,
             attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
       std::fill(block.moving, block.moving + n, uint8_t(1));
       std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);

@@ -46,6 +46,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     if (!a.member_active[s] || tree.vertex_leaf[v] != static_cast<int32_t>(leaf) || tree.vertex_anchored[v]) continue;
     a.vertex_flying[v] = 1;
     a.vertex_global[v] = 0;  // the rest pose no longer holds a flying leaf
+    a.vertex_half_damping[v] = 1;  // nor does a limb's damping: gravity and drag alone act on its flight
   }
   a.leaf_attached[leaf] = 0;
 }

@@ -322,8 +322,8 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
     chain = build_bar_chain(t, o, rates.cluster_compliance_share);
   for (size_t c = 0; c < C; ++c) chain.cluster_compliance[c] *= rates.cluster_compliance_share[c];
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
-  vertex_half_damping.resize(V);
-  for (size_t v = 0; v < V; ++v) vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
+  a.vertex_half_damping.resize(V);
+  for (size_t v = 0; v < V; ++v) a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
   precompute_drag(*this, w);
   precompute_beam(*this, w);
   precompute_islands(*this);

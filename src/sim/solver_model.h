@@ -90,6 +90,9 @@ struct Attachment {
   Eigen::Matrix3Xd cluster_drag_arm;
   // --- per vertex (V) ---
   std::vector<Real> vertex_global;         // (V) global rate per step (0: off, anchored, flying)
+  // (V) velocity factor per half step of the limb's structural damping (the step's damping is
+  // two); 1 on a flying leaf, whose rigid flight no limb damps
+  std::vector<Real> vertex_half_damping;
   std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
@@ -139,7 +142,6 @@ struct SolverModel {
   // split evenly (balanced_range): a cluster's memberships weigh less than its fit, and a pinned
   // leaf's fit comes after the pass
   std::vector<uint32_t> match_work_offsets;
-  std::vector<Real> vertex_half_damping;   // (V) velocity factor per half step (the step's damping is two)
   // (V) 1: a branch vertex with the beam, whose mean correction is a kick of the next step;
   // 0: a projection (leaves, the per_step stiffness)
   std::vector<uint8_t> vertex_shape_kick;
