@@ -65,8 +65,10 @@ int scan_values(std::string_view text, size_t* offset, std::string_view format, 
     }
     const std::string rest(text.substr(at, 64));  // a number is never longer
     char* end = nullptr;
-    const double value = format[k] == 'd' || format[k] == 'i' ? static_cast<double>(std::strtoll(rest.c_str(), &end, 10))
-                                                             : std::strtod(rest.c_str(), &end);
+    // %d is decimal, %i takes C's prefixes (0x16 hexadecimal, 010 octal), as fscanf reads them.
+    const double value = format[k] == 'd' || format[k] == 'i'
+                             ? static_cast<double>(std::strtoll(rest.c_str(), &end, format[k] == 'i' ? 0 : 10))
+                             : std::strtod(rest.c_str(), &end);
     if (end == rest.c_str()) break;
     at += static_cast<size_t>(end - rest.c_str());
     converted = true;

@@ -65,7 +65,12 @@ class Deriver {
     std::string where = "while deriving step " + std::to_string(step_);
     if (step_ == 0) where = "while evaluating the axiom";
     if (step_ > settings_.iterations) where = "while applying the homomorphism";
-    if (rule_) where += " (rule at " + std::to_string(rule_->pos.line) + ":" + std::to_string(rule_->pos.column) + ")";
+    // The rule by its place: line:column in a file, the element and column of an inline grammar.
+    if (rule_)
+      where += " (rule at " +
+               (rule_->pos.line == 0 ? g_.where(rule_->pos)
+                                     : std::to_string(rule_->pos.line) + ":" + std::to_string(rule_->pos.column)) +
+               ")";
     throw InputError(g_.where(error.pos) + ": " + error.message + " " + where);
   }
 
@@ -117,8 +122,10 @@ class Deriver {
       expand_all(&Lsystem::decomposition, word, kDecomposition, &out);
       word = std::move(out);
     }
+    // A '%' may come from a rule or stand in the axiom (cpfg cuts any it finds in the string).
     if (std::any_of(g_.lsystems.begin(), g_.lsystems.end(),
-                    [](const Lsystem& ls) { return ls.productions.any_cut || ls.decomposition.any_cut; }))
+                    [](const Lsystem& ls) { return ls.productions.any_cut || ls.decomposition.any_cut; }) ||
+        std::any_of(g_.axiom.begin(), g_.axiom.end(), [](const SuccessorModule& m) { return m.symbol == '%'; }))
       cut_branches(&word);
     if (g_.calls) {  // every call names an L-system (the next step, or the turtle, follows them)
       enter(0);
@@ -149,13 +156,23 @@ class Deriver {
     }
   }
 
+  // Parameters a string may hold per module of its cap: a module takes up to 255, and 20 million
+  // of those (40 GB) filled the memory before the module cap was reached.
+  static constexpr size_t kParamsPerModule = 4;
+  bool past_cap(const ModuleString& word) const {
+    return word.size() > settings_.max_modules || word.params.size() > kParamsPerModule * settings_.max_modules;
+  }
   void check_cap(const ModuleString& word) const {
-    if (word.size() <= settings_.max_modules) return;
+    if (!past_cap(word)) return;
     const std::string when = step_ == 0 ? std::string("the axiom")
                                         : "derivation step " + std::to_string(step_) + " of " +
                                               std::to_string(settings_.iterations);
-    throw InputError(g_.sources.at(0) + ": " + when + " reached " + std::to_string(word.size()) +
-                     " modules, more than lsystem.max_modules = " + std::to_string(settings_.max_modules) +
+    const bool modules = word.size() > settings_.max_modules;
+    throw InputError(g_.sources.at(0) + ": " + when + " reached " +
+                     (modules ? std::to_string(word.size()) + " modules, more than"
+                              : std::to_string(word.params.size()) + " parameters, more than " +
+                                    std::to_string(kParamsPerModule) + " x") +
+                     " lsystem.max_modules = " + std::to_string(settings_.max_modules) +
                      " (lower lsystem.iterations or raise lsystem.max_modules)");
   }
 
@@ -203,7 +220,7 @@ class Deriver {
       else copy_module(word, i, next);
       if constexpr (kCalls) set = &follow_calls(word, i, used)->productions;
       i += used - 1;
-      if (next->size() > settings_.max_modules) check_cap(*next);
+      if (past_cap(*next)) check_cap(*next);
     }
   }
 
@@ -436,7 +453,7 @@ class Deriver {
                         static_cast<uint32_t>(out->size()));
       if (g_.calls) set = &(follow_calls(word, i, used)->*section);
       i += used;
-      if (out->size() > settings_.max_modules) check_cap(*out);
+      if (past_cap(*out)) check_cap(*out);
     }
   }
 
@@ -479,7 +496,7 @@ class Deriver {
       }
       params_.assign(scratch_.begin(), scratch_.end());
       begin_module(set, module.symbol, params_, index, depth, random, out);
-      if (out->size() > settings_.max_modules) check_cap(*out);
+      if (past_cap(*out)) check_cap(*out);
     }
     word_ = nullptr;
     derived_ = false;

@@ -193,21 +193,28 @@ class Compiler {
     program_.code_pos.push_back(where);
   }
 
-  // c ? a : b (right-associative, below ||), compiled with jumps so that only one side runs.
+  // c ? a : b (right-associative, below ||), compiled with jumps so that only one side runs. A
+  // chain c1 ? a1 : c2 ? a2 : ... is a loop (every side's end jumps past the whole chain); a
+  // '?' inside a then-side nests, as a parenthesis does (a recursion per '?' overflowed the
+  // stack on a chain of 60,000).
   void parse_conditional() {
-    parse_or();
-    skip_space();
-    const size_t where = pos_;
-    if (!accept("?")) return;
-    const size_t skip_then = emit_jump(Op::kJumpIfZero, where);
-    parse_conditional();
-    skip_space();
-    if (!accept(":")) fail(pos_, "expected ':' of the '?' at column " + std::to_string(where + 1) + ", got " + describe_next());
-    const size_t skip_else = emit_jump(Op::kJump, where);
-    --depth_;  // one of the two sides is on the stack
-    land(skip_then);
-    parse_conditional();
-    land(skip_else);
+    std::vector<size_t> skips_else;
+    for (;;) {
+      parse_or();
+      skip_space();
+      const size_t where = pos_;
+      if (!accept("?")) break;
+      const size_t skip_then = emit_jump(Op::kJumpIfZero, where);
+      if (++nesting_ > kMaxNesting) fail(where, "expression too deeply nested");
+      parse_conditional();
+      --nesting_;
+      skip_space();
+      if (!accept(":")) fail(pos_, "expected ':' of the '?' at column " + std::to_string(where + 1) + ", got " + describe_next());
+      skips_else.push_back(emit_jump(Op::kJump, where));
+      --depth_;  // one of the two sides is on the stack
+      land(skip_then);
+    }
+    for (const size_t skip : skips_else) land(skip);
   }
 
   void parse_or() {

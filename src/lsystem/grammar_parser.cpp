@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <sstream>
 
 #include "common/errors.h"
@@ -89,6 +90,14 @@ class Parser {
   // time; a statement continues over lines while parentheses or a block's braces are open, and
   // a rule's successor or the axiom continues on lines that start no other statement.
   void parse_text(const GrammarText& text) {
+    if (!preprocessor_) preprocessor_.emplace(hooks());
+    if (g_.sources.empty()) first_pos_ = {0, text.single_line ? 0 : 1, 1};
+    preprocessor_->run(text.name, text.text, text.single_line);
+    flush();
+  }
+
+  // What the preprocessor hands the parser, and asks of it.
+  PreprocessHooks hooks() {
     PreprocessHooks hooks;
     hooks.add_source = [this](const std::string& name) { return add_source(name); };
     hooks.include = [this](const std::string& path, const std::string& from, SourcePos at) {
@@ -101,9 +110,7 @@ class Parser {
       return std::any_of(g_.defines.begin(), g_.defines.end(), [&](const auto& d) { return d.first == name; });
     };
     hooks.line = [this](const SourceLine& line) { feed(line); };
-    if (g_.sources.empty()) first_pos_ = {0, text.single_line ? 0 : 1, 1};
-    Preprocessor(hooks).run(text.name, text.text, text.single_line);
-    flush();
+    return hooks;
   }
 
   // An inline axiom (the whole text is the axiom's modules).
@@ -114,6 +121,7 @@ class Parser {
 
   // Checks what needs the whole grammar, then indexes the rules.
   void finish() {
+    if (preprocessor_) preprocessor_->finish();
     if (!axiom_seen_) throw GrammarError{first_pos_, "expected an 'axiom:' line; the grammar has none"};
     for (Lsystem& ls : g_.lsystems) {
       for (RuleSet* set : {&ls.productions, &ls.decomposition, &ls.homomorphism}) {
@@ -189,18 +197,28 @@ class Parser {
     };
   }
 
-  // Nesting of parentheses everywhere and of braces before the arrow (blocks of a rule's head,
-  // Start: blocks): a statement with some open goes on to the next line.
-  static bool open_nesting(std::string_view text) {
-    int parens = 0, braces = 0;
-    const size_t arrow = find_arrow(text, 0, text.size());
-    for (size_t k = 0; k < text.size(); ++k) {
-      if (text[k] == '(') ++parens;
-      else if (text[k] == ')') --parens;
-      else if (k < arrow && text[k] == '{') ++braces;
-      else if (k < arrow && text[k] == '}') --braces;
+  // Whether the pending statement has parentheses open, or braces before its arrow (blocks of a
+  // rule's head, Start: blocks): then it goes on to the next line. An axiom has no head: its
+  // braces are polygons ("F{.+F.A", closed by a rule), which never join the next line. Read as
+  // lines join the statement, each character once (a rule of a million lines was read again
+  // for each).
+  bool pending_open() {
+    PendingNesting& n = nesting_;
+    const std::string& t = pending_.text;
+    if (n.scanned == 0 && !t.empty()) {
+      size_t b = 0, e = t.size(), value = 0;
+      trim(t, &b, &e);
+      n.axiom = match_keyword(t, b, e, "axiom", true, &value);
     }
-    return parens > 0 || braces > 0;
+    for (; n.scanned < t.size(); ++n.scanned) {
+      const size_t k = n.scanned;
+      if (t[k] == '(') ++n.parens;
+      else if (t[k] == ')') --n.parens;
+      else if (t[k] == '>' && k > 0 && t[k - 1] == '-') n.past_arrow = true;
+      else if (!n.axiom && !n.past_arrow && t[k] == '{') ++n.braces;
+      else if (!n.axiom && !n.past_arrow && t[k] == '}') --n.braces;
+    }
+    return n.parens > 0 || n.braces > 0;
   }
 
   // Whether text starts with a directive keyword ("name:" or a section word).
@@ -231,7 +249,7 @@ class Parser {
       return;
     }
     if (begin == end) {  // a blank line ends a statement, unless it has open parentheses or blocks
-      if (!open_nesting(pending_.text)) flush();
+      if (!pending_open()) flush();
       return;
     }
     if (!pending_.text.empty() && continues(line.text, begin, end)) {
@@ -245,9 +263,9 @@ class Parser {
     pending_ = line;
   }
 
-  bool continues(std::string_view text, size_t begin, size_t end) const {
+  bool continues(std::string_view text, size_t begin, size_t end) {
     const std::string_view last = pending_.text;
-    if (open_nesting(last)) return true;
+    if (pending_open()) return true;
     if (text.substr(begin, 2) == "->" || text.substr(begin, 3) == "-->") return true;
     size_t b = 0, e = last.size(), value = 0;
     trim(last, &b, &e);
@@ -271,6 +289,7 @@ class Parser {
     if (pending_.text.empty()) return;
     const SourceLine statement = std::move(pending_);
     pending_ = SourceLine{};
+    nesting_ = PendingNesting{};
     parse_line(statement.text, TextOrigin{statement.start, &statement.columns});
   }
 
@@ -588,8 +607,11 @@ class Parser {
     }
     labelled_ = true;
     int label = 0;
-    for (size_t k = begin; k < end && std::isdigit(static_cast<unsigned char>(text[k])) && label < 100'000'000; ++k)
+    size_t digits = 0;
+    for (size_t k = begin; k < end && std::isdigit(static_cast<unsigned char>(text[k])); ++k, ++digits) {
+      if (digits == 9) fail(line, begin, "expected a label of at most 9 digits (a call names it as a number)");
       label = label * 10 + (text[k] - '0');
+    }
     lsystem().label = label;
   }
 
@@ -911,6 +933,12 @@ class Parser {
   bool ended_ = false;  // after "endlsystem"
   SourcePos first_pos_;  // the first text's start, for errors about what is missing
   SourceLine pending_;   // the statement being joined from lines
+  struct PendingNesting {
+    size_t scanned = 0;  // characters of pending_ read
+    int parens = 0, braces = 0;
+    bool axiom = false, past_arrow = false;
+  } nesting_;            // of pending_, as pending_open() read it
+  std::optional<Preprocessor> preprocessor_;  // one for all texts: an inline grammar's lines share its #defines
 };
 
 }  // namespace

@@ -122,6 +122,19 @@ TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& gra
   return turtle;
 }
 
+bool seed_shapes_growth(const LsystemOptions& options) {
+  const Grammar grammar = load_grammar(options, load_view(options));
+  for (const Instruction& instruction : grammar.program.code)
+    if (instruction.op == Op::kRan || instruction.op == Op::kNran || instruction.op == Op::kBran ||
+        instruction.op == Op::kBiran)
+      return true;
+  for (const Lsystem& lsystem : grammar.lsystems)
+    for (const RuleSet* set : {&lsystem.productions, &lsystem.decomposition, &lsystem.homomorphism})
+      for (const Rule& rule : set->rules)
+        if (rule.probability.present()) return true;
+  return false;
+}
+
 Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
   const ViewSettings view = load_view(options);
   const Grammar grammar = load_grammar(options, view);

@@ -35,6 +35,10 @@ TurtleSettings turtle_settings(const LsystemOptions& options, const Grammar& gra
 // scene's inline rules ("scene.json: /lsystem").
 std::string grammar_name(const LsystemOptions& options);
 
+// options => whether the seed changes what grows: a stochastic rule, or an expression that
+// draws (ran, nran, bran, biran); else every seed grows the same tree.
+bool seed_shapes_growth(const LsystemOptions& options);
+
 // options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).
 // Throws InputError with file:line:column for grammar errors, and at the module cap.
 Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats);

@@ -13,6 +13,10 @@ namespace {
 constexpr int kMaxExpansion = 32;  // nested macro expansions
 constexpr int kMaxIncludes = 16;   // nested #include
 constexpr size_t kMaxLineLength = 1 << 20;  // one line after expansion
+// The whole grammar after expansion, far past any real one: #includes that each include the next
+// twice, or macros of macros, multiply a few kilobytes into gigabytes, and the parsed rules take
+// some 20 times their text.
+constexpr size_t kMaxGrammarBytes = size_t(64) << 20;
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 bool starts_name(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
@@ -31,9 +35,9 @@ std::string strip_comments(const std::string& text, int32_t source, bool single_
       continue;
     }
     if (out[k] != '/' || k + 1 >= out.size()) continue;
-    // "//" is a comment at a line's start or after a space, unless more '/' follow: runs of '/'
-    // are roll modules (ABOP's "/////").
-    const bool line_comment = out[k + 1] == '/' && (k == 0 || is_space(out[k - 1]) || out[k - 1] == '\n') &&
+    // "//" starts a comment, as cpp (which cpfg runs) reads it, after a module too ("FF// x");
+    // a run of three or more '/' is roll modules (ABOP's "/////").
+    const bool line_comment = out[k + 1] == '/' && (k == 0 || out[k - 1] != '/') &&
                               (k + 2 >= out.size() || out[k + 2] != '/');
     if (line_comment) {
       while (k < out.size() && out[k] != '\n') out[k++] = ' ';
@@ -125,14 +129,22 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
           directive(directive_name, line, hash);
       }
     } else if (active) {
-      hooks_.line(expand(line, 0));
+      const SourceLine expanded = expand(line);
+      read_ += expanded.text.size() + 1;
+      if (read_ > kMaxGrammarBytes)
+        fail(line.start, "the grammar grows past 64 MiB with its #includes and macros expanded");
+      hooks_.line(expanded);
     }
     if (stop == clean.size()) break;
     start = stop + 1;
     ++number;
   }
-  if (conditions_.size() != open_conditions)
+  if (!single_line && conditions_.size() != open_conditions)
     fail(conditions_.back().at, "#ifdef or #ifndef is never closed (expected #endif)");
+}
+
+void Preprocessor::finish() const {
+  if (!conditions_.empty()) fail(conditions_.back().at, "#ifdef or #ifndef is never closed (expected #endif)");
 }
 
 void Preprocessor::directive(const std::string& name, const SourceLine& line, size_t hash) {
@@ -144,7 +156,7 @@ void Preprocessor::directive(const std::string& name, const SourceLine& line, si
     while (end < line.text.size() && in_name(line.text[end])) ++end;
     if (end == k) fail(line.columns[std::min(k, line.columns.size() - 1)], "expected a name after '#" + name + "'");
     const std::string macro = line.text.substr(k, end - k);
-    const bool defined = find(macro) != nullptr || hooks_.is_number(macro);
+    const bool defined = find(macro, {}) != nullptr || hooks_.is_number(macro);
     conditions_.push_back({defined == (name == "ifdef"), false, at});
     return;
   }
@@ -205,20 +217,26 @@ void Preprocessor::define(const SourceLine& line, size_t k) {
          "expected a value after '#define " + macro.name + "'");
   for (const Macro& m : macros_)
     if (m.name == macro.name) fail(after, "'" + macro.name + "' is already defined");
-  macro.body = expand(slice(line, k, body_end), 0);
+  macro.body = expand(slice(line, k, body_end));
   if (!macro.function_like && hooks_.define_number(macro.name, macro.body, after)) return;
   macros_.push_back(std::move(macro));
 }
 
-const Preprocessor::Macro* Preprocessor::find(const std::string& name) const {
+const Preprocessor::Macro* Preprocessor::find(const std::string& name,
+                                               const std::vector<const Macro*>& expanding) const {
   for (const Macro& m : macros_)
-    if (m.name == name) return &m;
+    if (m.name == name) return std::find(expanding.begin(), expanding.end(), &m) == expanding.end() ? &m : nullptr;
   return nullptr;
 }
 
-SourceLine Preprocessor::expand(const SourceLine& line, int depth) const {
+SourceLine Preprocessor::expand(const SourceLine& line) const {
+  std::vector<const Macro*> expanding;
+  return expand_within(line, expanding);
+}
+
+SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const Macro*>& expanding) const {
   if (macros_.empty()) return line;
-  if (depth > kMaxExpansion) fail(line.start, "macros expand more than 32 levels deep");
+  if (expanding.size() > size_t(kMaxExpansion)) fail(line.start, "macros expand more than 32 levels deep");
   SourceLine out;
   out.start = line.start;
   const std::string& t = line.text;
@@ -231,7 +249,7 @@ SourceLine Preprocessor::expand(const SourceLine& line, int depth) const {
     }
     size_t end = k;
     while (end < t.size() && in_name(t[end])) ++end;
-    const Macro* macro = find(t.substr(k, end - k));
+    const Macro* macro = find(t.substr(k, end - k), expanding);
     const SourcePos at = line.columns[k];
     size_t open = skip_spaces(t, end);
     if (!macro || (macro->function_like && (open >= t.size() || t[open] != '('))) {
@@ -282,9 +300,9 @@ SourceLine Preprocessor::expand(const SourceLine& line, int depth) const {
     }
     std::fill(body.columns.begin(), body.columns.end(), at);
     // The expansion is expanded again without this macro (cpp's rule against self-reference).
-    Preprocessor inner(*this);
-    inner.macros_.erase(inner.macros_.begin() + (macro - macros_.data()));
-    const SourceLine expanded = inner.expand(body, depth + 1);
+    expanding.push_back(macro);
+    const SourceLine expanded = expand_within(body, expanding);
+    expanding.pop_back();
     out.text += expanded.text;
     out.columns.insert(out.columns.end(), expanded.columns.size(), at);
     if (out.text.size() > kMaxLineLength) fail(at, "a line grows past 1 MiB when its macros are expanded");

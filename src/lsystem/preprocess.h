@@ -38,7 +38,11 @@ struct PreprocessHooks {
 class Preprocessor {
  public:
   explicit Preprocessor(PreprocessHooks hooks) : hooks_(std::move(hooks)) {}
+  // One text: a file's (its #ifdefs closed in it), or a line of the scene's inline grammar,
+  // whose #defines and #ifdefs go on into the next lines, as a file's lines do.
   void run(const std::string& name, const std::string& text, bool single_line);
+  // After the last text: every #ifdef closed.
+  void finish() const;
 
  private:
   struct Macro {
@@ -49,8 +53,10 @@ class Preprocessor {
   };
   void directive(const std::string& name, const SourceLine& line, size_t hash);
   void define(const SourceLine& line, size_t begin);
-  SourceLine expand(const SourceLine& line, int depth) const;
-  const Macro* find(const std::string& name) const;
+  SourceLine expand(const SourceLine& line) const;
+  // `expanding`: the macros whose expansion this is, innermost last, which it does not expand again.
+  SourceLine expand_within(const SourceLine& line, std::vector<const Macro*>& expanding) const;
+  const Macro* find(const std::string& name, const std::vector<const Macro*>& expanding) const;
 
   PreprocessHooks hooks_;
   std::vector<Macro> macros_;
@@ -61,6 +67,7 @@ class Preprocessor {
   };
   std::vector<Condition> conditions_;  // open #ifdef / #ifndef, innermost last
   int include_depth_ = 0;
+  size_t read_ = 0;  // bytes handed to the parser, after expansion
   std::string current_;  // name of the text being read (includes are found beside it)
 };
 

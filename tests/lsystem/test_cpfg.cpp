@@ -163,6 +163,67 @@ TEST(Cpfg, ConditionalsContinuationsAndHashInsideALine) {
   EXPECT_EQ(error_of("axiom: A\n#else\n"), "plant.l:2:1: '#else' without #ifdef or #ifndef");
 }
 
+// What cpp (which cpfg runs) reads as comments and what stays modules; an axiom's unclosed
+// polygon brace, closed by a rule, does not join the next line; a '%' in the axiom cuts as one a
+// rule wrote (cpfg cuts any it finds); a label is a 9-digit number at most.
+TEST(Cpfg, CommentsCutsPolygonsAndLabels) {
+  EXPECT_EQ(derive_text("axiom: A\nA --> FF// twice\n", 1), "FF");
+  EXPECT_EQ(derive_text("axiom: A\nA --> F/////F\n", 1), "F/////F");
+  EXPECT_EQ(derive_text("axiom: F{.+F.A\nA --> F.}\n", 1), "F{.+F.F.}");
+  EXPECT_EQ(derive_text("axiom: F[+A%FF]F\nA --> AF\n", 2), "F[+AFF]F");
+  EXPECT_EQ(derive_text("lsystem: 123456789\naxiom: A\n", 0), "A");
+  EXPECT_EQ(error_of("lsystem: 1000000001\naxiom: A\n"),
+            "plant.l:1:10: expected a label of at most 9 digits (a call names it as a number)");
+}
+
+// The scene's inline grammar is a file's lines, one an element: a #define, text or number, and
+// an #ifdef go on into the elements after them.
+TEST(Cpfg, InlineLinesShareTheirDefinesAndConditions) {
+  const auto inline_text = [](const std::vector<std::string>& lines) {
+    std::vector<GrammarText> texts;
+    for (size_t k = 0; k < lines.size(); ++k)
+      texts.push_back({"s.json: /lsystem/productions/" + std::to_string(k), lines[k], true});
+    return text_of(derive(parse_grammar(texts, {}), {1, 1, 100}));
+  };
+  EXPECT_EQ(inline_text({"axiom: A(1)", "#define TWIG F(l)[+F(l)]", "A(l) --> TWIG A(l)"}), "F(1)[+F(1)]A(1)");
+  EXPECT_EQ(inline_text({"axiom: A(1)", "#ifdef TALL", "A(l) --> F(l) A(l)", "#else", "A(l) --> B", "#endif"}), "B");
+  EXPECT_EQ(input_error_of([&] { inline_text({"axiom: A(1)", "#ifdef TALL", "A(l) --> B"}); }),
+            "s.json: /lsystem/productions/1, column 1: #ifdef or #ifndef is never closed (expected #endif)");
+}
+
+// A chain of conditionals is as long as it needs (a recursion per '?' overflowed the stack at
+// 60,000); conditionals nested in then-sides stop at the nesting limit, as parentheses do.
+TEST(Cpfg, ConditionalChainsAndNesting) {
+  std::string chain = "axiom: A(";
+  for (int k = 0; k < 100000; ++k) chain += "0?1:";
+  EXPECT_EQ(derive_text(chain + "7)\n", 0), "A(7)");
+  std::string nested = "axiom: A(";
+  for (int k = 0; k < 300; ++k) nested += "1?";
+  nested += "1";
+  for (int k = 0; k < 300; ++k) nested += ":0";
+  EXPECT_NE(error_of(nested + ")\n", 0).find("expression too deeply nested"), std::string::npos);
+}
+
+// What a grammar may grow to: a module's parameters count against lsystem.max_modules (4 a
+// module), and the text #includes and macros expand to is 64 MiB at most.
+TEST(Cpfg, ParametersAndExpandedTextAreBounded) {
+  std::string many = "axiom: A\nA --> AA B(";
+  for (int k = 0; k < 100; ++k) many += k ? ",1" : "1";
+  const Grammar g = parse(many + ")\n");
+  EXPECT_EQ(input_error_of([&] { derive(g, {10, 1, 10000}); }),
+            "plant.l: derivation step 9 of 10 reached 40100 parameters, more than 4 x lsystem.max_modules = 10000 "
+            "(lower lsystem.iterations or raise lsystem.max_modules)");
+  // 16 macros each twice the one before, each use a line of half a megabyte.
+  std::string doubling = "#define M0 FFFFFFFFFFFFFFFF\n";
+  for (int k = 1; k < 16; ++k)
+    doubling += "#define M" + std::to_string(k) + " M" + std::to_string(k - 1) + " M" + std::to_string(k - 1) + "\n";
+  std::string uses;
+  for (int k = 0; k < 200; ++k) uses += "A --> M15\n";
+  EXPECT_NE(error_of(doubling + "axiom: A\n" + uses, 0).find(": the grammar grows past 64 MiB with its #includes and "
+                                                             "macros expanded"),
+            std::string::npos);
+}
+
 // #include finds the file beside the including one (a vlab object folder), and errors in it
 // name the included file.
 TEST(Cpfg, IncludeReadsTheFileBesideTheGrammar) {
@@ -341,6 +402,11 @@ TEST(Cpfg, FscanReadsADataFileBesideTheGrammar) {
       "End: {fclose(fp);}\n";
   EXPECT_EQ(grow(reader, 2), "C(7,2)B(5)B(6)A");
   EXPECT_EQ(grow(reader, 3), "C(7,2)B(5)B(6)E(-1,0)");  // the end of the file: -1, x keeps its value
+  // %i takes C's prefixes, %d does not.
+  std::ofstream(dir / "integers.txt") << "0x10 010 010\n";
+  EXPECT_EQ(grow("Start: {fp = fopen(\"integers.txt\", \"r\"); n = fscan(fp, \"%i %i %d\", &a, &b, &c);}\n"
+                 "axiom: A(a, b, c)\n", 0),
+            "A(16,8,10)");
   const auto refused = [&](const std::string& text) {
     try {
       parse_grammar({{grammar, text, false}}, {});
