@@ -12,7 +12,7 @@
 namespace treeanim {
 
 struct ForestBakeResult {
-  int exit_code = 0;   // 0, or 130/143 when a tree's bake was interrupted
+  int exit_code = 0;   // 0, or 130/143/129 when a tree's bake was interrupted
   size_t baked = 0;    // trees baked by this process
   size_t skipped = 0;  // trees complete before (--resume)
 };

@@ -58,7 +58,7 @@ struct LoopSummary {
 
 // What a finished bake did and wrote: its summary and the forest manifest's part.
 struct TreeBakeResult {
-  int exit_code = 0;                                      // 0, or 130/143 when interrupted
+  int exit_code = 0;                                      // 0, or 130/143/129 when interrupted
   FrameRange written;                                     // the frames written
   size_t vertices = 0;
   size_t samples = 0;                                     // hsm.particles "samples": the particles simulated; 0 otherwise
@@ -95,7 +95,7 @@ void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart
                     std::FILE* notes);
 
 // Run: frames start.frame to written.last simulated and pushed (a placed tree's in its own frame),
-// journalled and checkpointed when the plan says. Returns 0, or 130/143 after a signal, the
+// journalled and checkpointed when the plan says. Returns 0, or 130/143/129 after a signal, the
 // outputs then removed.
 int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
                const TreePlacement* placement, const BakeLog& log);

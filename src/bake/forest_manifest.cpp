@@ -6,6 +6,7 @@
 
 #include "common/json_text.h"
 #include "common/read_text_file.h"
+#include "files/output_lock.h"
 #include "files/text_output.h"
 #include "formats/html_forest.h"
 #include "formats/usd_forest.h"
@@ -157,6 +158,7 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
 
 void add_forest_targets(const Scene& scene, const fs::path& out_dir, OutputTargets& targets, bool written) {
   targets.add_file(forest_manifest_path(out_dir), "the forest's manifest", written);
+  targets.add_lock(lock_path(forest_manifest_path(out_dir)), "the forest's manifest");
   if (first_output(scene, "usd")) targets.add_file(forest_stage_path(out_dir), "the forest's USD stage", written);
   if (first_output(scene, "html")) targets.add_file(forest_page_path(out_dir), "the forest's page", written);
 }

@@ -7,6 +7,8 @@
 #include "bake/checkpoint.h"
 #include "bake/frame_journal.h"
 #include "bake/prepare_tree.h"
+#include "common/errors.h"
+#include "lsystem/lsystem.h"
 #include "formats/output_estimate.h"
 
 namespace treeanim {
@@ -63,13 +65,39 @@ std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost,
   return assigned;
 }
 
+namespace {
+
+// The listed trees of variants whose growth depends on the seed (seed_shapes_growth), each grown
+// from its own seed: what a tree's seed makes the grammar do (pass lsystem.max_modules, divide by
+// zero) is bad input before the first tree's files are written, not after. A variant that every
+// seed grows alike grew in estimate_forest.
+void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees) {
+  const Forest& forest = *scene.forest;
+  std::vector<int> seeded(forest.variants.size(), -1);  // -1: not asked yet
+  for (size_t t : trees) {
+    const Scene one = tree_scene(scene, t);
+    int& variant = seeded[forest.trees[t].variant];
+    if (variant < 0) variant = seed_shapes_growth(one.lsystem) ? 1 : 0;
+    if (!variant) continue;
+    try {
+      grow_skeleton(one.lsystem, nullptr);
+    } catch (const InputError& e) {
+      throw InputError("tree " + forest.trees[t].id + " (L-system seed " + std::to_string(one.lsystem.seed) + "): " + e.what());
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard) {
-  // Every variant grows here, with or without shards: a later variant's bad grammar, view or
-  // leaf mesh is bad input before the first tree's files are written.
+  // Every variant grows here, with or without shards, and every tree whose seed shapes it: a
+  // later tree's bad grammar, view or leaf mesh is bad input before the first tree's files are
+  // written.
   const ForestEstimate estimate = estimate_forest(scene);
-  if (shard) return assign_tasks(estimate.tree_cost, shard->count)[shard->index];
   std::vector<size_t> trees(scene.forest->trees.size());
   std::iota(trees.begin(), trees.end(), size_t{0});
+  if (shard) trees = assign_tasks(estimate.tree_cost, shard->count)[shard->index];
+  grow_seeded_trees(scene, trees);
   return trees;
 }
 

@@ -32,7 +32,8 @@ ForestEstimate estimate_forest(const Scene& scene);
 std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost, size_t tasks);
 
 // A forest, a shard (none: every tree) => the trees that this process bakes, ascending, once
-// every variant has grown (estimate_forest: InputError for a variant that cannot).
+// every variant has grown (estimate_forest: InputError for a variant that cannot), and each of
+// those trees whose seed shapes its growth.
 std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard);
 
 }  // namespace treeanim

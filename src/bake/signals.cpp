@@ -17,20 +17,40 @@ std::atomic<int> received_signal{0};
 std::atomic<int> deferring{0};  // spans alive (DeferredInterrupts)
 static_assert(std::atomic<int>::is_always_lock_free);
 
+// The signals a bake is interrupted by, each with its exit code and the line said when no
+// output was open (a constant: the handler may only write).
+struct Interrupt {
+  int number;
+  const char* name;
+  int exit_code;
+  const char* unopened;
+};
+#define TREEANIM_INTERRUPT(signal, code) \
+  {signal, #signal, code, "treeanim: interrupted by " #signal " while no output was open; none was left half-written\n"}
+constexpr Interrupt kInterrupts[] = {
+    TREEANIM_INTERRUPT(SIGINT, kExitSigint),
+    TREEANIM_INTERRUPT(SIGTERM, kExitSigterm),
+    TREEANIM_INTERRUPT(SIGHUP, kExitSighup),
+};
+#undef TREEANIM_INTERRUPT
+
+const Interrupt& find_interrupt(int signal_number) {
+  for (const Interrupt& interrupt : kInterrupts)
+    if (interrupt.number == signal_number) return interrupt;
+  return kInterrupts[1];  // not reached: only these have the handler
+}
+
 // Only async-signal-safe calls here: write and _exit.
 extern "C" void record_signal(int signal_number) {
   if (deferring.load() > 0) {
     received_signal.store(signal_number);
     return;
   }
-  static constexpr char kSigint[] =
-      "treeanim: interrupted by SIGINT while no output was open; none was left half-written\n";
-  static constexpr char kSigterm[] =
-      "treeanim: interrupted by SIGTERM while no output was open; none was left half-written\n";
-  const bool sigint = signal_number == SIGINT;
-  [[maybe_unused]] const ssize_t written =
-      write(STDERR_FILENO, sigint ? kSigint : kSigterm, sigint ? sizeof kSigint - 1 : sizeof kSigterm - 1);
-  _exit(interrupted_exit_code(signal_number));
+  const Interrupt& interrupt = find_interrupt(signal_number);
+  size_t length = 0;
+  while (interrupt.unopened[length]) ++length;
+  [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, interrupt.unopened, length);
+  _exit(interrupt.exit_code);
 }
 
 }  // namespace
@@ -40,8 +60,7 @@ void install_interrupt_handlers() {
   action.sa_handler = record_signal;
   sigemptyset(&action.sa_mask);
   action.sa_flags = 0;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const Interrupt& interrupt : kInterrupts) sigaction(interrupt.number, &action, nullptr);
   // A file-size limit (ulimit -f) must fail the write (EFBIG => exit 4, temporaries removed),
   // not kill the process with SIGXFSZ and strand the temporaries.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -51,7 +70,9 @@ void install_interrupt_handlers() {
 
 int pending_signal() { return received_signal.load(); }
 
-int interrupted_exit_code(int signal_number) { return signal_number == SIGINT ? kExitSigint : kExitSigterm; }
+int interrupted_exit_code(int signal_number) { return find_interrupt(signal_number).exit_code; }
+
+const char* interrupt_name(int signal_number) { return find_interrupt(signal_number).name; }
 
 DeferredInterrupts::DeferredInterrupts() { deferring.fetch_add(1); }
 

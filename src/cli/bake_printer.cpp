@@ -1,10 +1,10 @@
 #include "cli/bake_printer.h"
 
-#include <csignal>
 #include <cstdio>
 #include <string>
 
 #include "bake/bake_tree.h"
+#include "bake/signals.h"
 #include "bake/forest_manifest.h"
 #include "bake/prepare_tree.h"
 #include "common/message_text.h"
@@ -27,7 +27,7 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
   log_.frame_done = [this](long long done) { progress_->update(done); };
   log_.frames_end = [this] { progress_->finish(); };
   log_.interrupted = [this](int signal_number, long long frame) {
-    const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+    const char* name = interrupt_name(signal_number);
     if (frame < 0) {
       std::fprintf(stderr, "treeanim: interrupted by %s between two trees; the trees baked are kept (--resume "
                    "skips them)\n", name);

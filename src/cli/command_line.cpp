@@ -2,9 +2,12 @@
 // cli/commands.h, and the error types of common/errors.h mapped to the exit codes of docs/design.md.
 #include "cli/command_line.h"
 
+#include <omp.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "cli/commands.h"
 #include "common/errors.h"
@@ -15,6 +18,9 @@
 namespace treeanim {
 
 namespace {
+
+// The most threads a bake takes (--threads, --cpus-per-task, OMP_NUM_THREADS).
+constexpr int kMaxThreads = 1024;
 
 // What the subcommands parse into.
 struct Arguments {
@@ -49,7 +55,7 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
                       "Write only frames START:END (inclusive); the simulation still starts at "
                       "time.start");
   run_app->add_option("--threads", args.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
-      ->check(CLI::Range(1, 1024));
+      ->check(CLI::Range(1, kMaxThreads));
   run_app->add_option("--set", args.run.overrides,
                       "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
                       "JSON or a plain string; repeatable");
@@ -57,7 +63,8 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
                       "Write the complete simulation state every N frames (docs/checkpoint.md)")
       ->check(CLI::Range(1LL, 1'000'000'000LL));
   run_app->add_option("--checkpoint-dir", args.run.checkpoint_dir,
-                      "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)");
+                      "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)")
+      ->check([](const std::string& folder) { return folder.empty() ? std::string("expected a folder, got ''") : ""; });
   run_app->add_flag("--resume", args.run.resume,
                     "Continue from the newest usable checkpoint and complete every output; without "
                     "one, bake from the start");
@@ -131,7 +138,7 @@ void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
   submit->add_flag("--wait", farm.wait, "Wait for the gather job and exit with its status (slurm)");
   submit->add_option("--checkpoint-every", farm.checkpoint_every, "Frames between checkpoints (default: frames / 8)")
       ->check(CLI::Range(1LL, 1'000'000'000LL));
-  submit->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(CLI::Range(1, 1024));
+  submit->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(CLI::Range(1, kMaxThreads));
   submit->add_option("--sbatch-arg", farm.sbatch_args, "An extra #SBATCH option, e.g. --partition=bake; repeatable");
   submit->footer(
       "Examples:\n"
@@ -181,9 +188,19 @@ int report(const char* kind, const std::exception& error, int code) {
 }
 
 // Runs the subcommand; a failure's exception => its message and exit code.
+// libgomp takes OMP_NUM_THREADS as it stands, and a count past --threads' range crashed it as
+// it made the threads (99999: SIGSEGV in the first parallel region) => what is wrong, or "".
+std::string omp_threads_error(const Arguments& args) {
+  const int asked = omp_get_max_threads();
+  if (args.run.threads > 0 || asked <= kMaxThreads) return "";
+  return "OMP_NUM_THREADS asks for " + std::to_string(asked) + " threads: expected 1 ... " +
+         std::to_string(kMaxThreads) + " (or give run --threads N)";
+}
+
 int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   try {
     if (const std::string isa = asked_isa_error(); !isa.empty()) throw InputError(isa);
+    if (const std::string threads = omp_threads_error(args); !threads.empty()) throw InputError(threads);
     return dispatch(commands, args);
   } catch (const InputError& error) {
     return report("error: ", error, kExitInput);
@@ -212,7 +229,7 @@ int run_command_line(int argc, char** argv) {
   app.set_version_flag("--version", "treeanim " TREEANIM_VERSION);
   app.require_subcommand(1);
   app.footer(
-      "Exit codes: 0 success, 2 bad input, 3 simulation failed, 4 output failed, 130/143 "
+      "Exit codes: 0 success, 2 bad input, 3 simulation failed, 4 output failed, 130/143/129 "
       "interrupted.\nRun 'treeanim SUBCOMMAND --help' for examples.");
   Arguments args;
   Subcommands commands;

@@ -4,7 +4,7 @@
 namespace treeanim {
 
 // argv => the subcommand run, its exit code (docs/design.md): 0, 2 bad input or usage, 3 simulation
-// failed, 4 output failed, 130/143 interrupted.
+// failed, 4 output failed, 130/143/129 interrupted.
 int run_command_line(int argc, char** argv);
 
 }  // namespace treeanim

@@ -26,7 +26,7 @@ struct RunRequest {
 };
 
 // Bakes the scene (bake/): simulate and write every output, with checkpoints and resume
-// (docs/checkpoint.md); prints its progress and summary. Returns 0, or 130/143 on a signal.
+// (docs/checkpoint.md); prints its progress and summary. Returns 0, or 130/143/129 on a signal.
 int run_command(const RunRequest& request);
 // Loads, derives and builds the model without simulating; prints counts.
 int validate_command(const std::filesystem::path& scene, const std::vector<std::string>& overrides);

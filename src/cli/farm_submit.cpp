@@ -219,10 +219,11 @@ int farm_submit_command(const FarmRequest& request) {
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");
   const fs::path script = job.farm / (job.name + ".sh");
   write_text_output(script, plain_script(job), true);
-  const std::string shown = printable_text(script.string());
+  // The commands as shell words, to copy as they are (a ' or $( in the path stays text).
+  const std::string shown = printable_text(script.string()), word = printable_text(shell_word(script.string()));
   std::printf("wrote %s: %zu tasks then the gather; run it (every task in turn), or give your queue one job per "
-              "task ('%s I', I = 0 to %zu) and then '%s gather'\n",
-              shown.c_str(), job.tasks, shown.c_str(), job.tasks - 1, shown.c_str());
+              "task (%s I, I = 0 to %zu) and then %s gather\n",
+              shown.c_str(), job.tasks, word.c_str(), job.tasks - 1, word.c_str());
   return 0;
 }
 

@@ -37,19 +37,20 @@ void print_counts(const Json& summary) {
 Json volume_json(const VolumeSummary& volume) {
   return {{"frames", {volume.first_frame, volume.last_frame}},
           {"layout", volume.layout},
-          {"bounds_min", {volume.lower.x(), volume.lower.y(), volume.lower.z()}},
-          {"bounds_max", {volume.upper.x(), volume.upper.y(), volume.upper.z()}},
+          {"bounds_min", volume.active ? Json{volume.lower.x(), volume.lower.y(), volume.lower.z()} : Json()},
+          {"bounds_max", volume.active ? Json{volume.upper.x(), volume.upper.y(), volume.upper.z()} : Json()},
           {"voxel_size", volume.voxel_size},
           {"largest_speed", volume.largest_speed}};
 }
 
 // The same as a line of text.
 void print_volume(const VolumeSummary& volume) {
-  std::printf("wind volume: frames %lld to %lld, %s, bounds [%g %g %g] .. [%g %g %g] m, voxel %g m, "
-              "largest speed %.3g m/s\n",
-              volume.first_frame, volume.last_frame, volume.layout.c_str(), volume.lower.x(), volume.lower.y(),
-              volume.lower.z(), volume.upper.x(), volume.upper.y(), volume.upper.z(), volume.voxel_size,
-              volume.largest_speed);
+  char bounds[160] = "no active voxel (every point is outside it)";
+  if (volume.active)
+    std::snprintf(bounds, sizeof bounds, "bounds [%g %g %g] .. [%g %g %g] m", volume.lower.x(), volume.lower.y(),
+                  volume.lower.z(), volume.upper.x(), volume.upper.y(), volume.upper.z());
+  std::printf("wind volume: frames %lld to %lld, %s, %s, voxel %g m, largest speed %.3g m/s\n", volume.first_frame,
+              volume.last_frame, volume.layout.c_str(), bounds, volume.voxel_size, volume.largest_speed);
 }
 
 }  // namespace
@@ -57,18 +58,19 @@ void print_volume(const VolumeSummary& volume) {
 int validate_command(const std::filesystem::path& scene_file,
                      const std::vector<std::string>& overrides) {
   const Scene scene = load_scene(scene_file, overrides);
-  check_output_paths(scene.outputs);
   if (scene.forest) {
     check_forest_writers(scene);
-    estimate_forest(scene);  // grows one tree of each variant
+    shard_trees(scene, std::nullopt);  // grows one tree of each variant, and every tree a seed shapes
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
-    // What run refuses before it grows the tree: two outputs at one file, a folder or a device
-    // where one goes (the paths as run resolves them without -o).
+    // What run refuses before it simulates: two outputs at one file, a folder or a device where
+    // one goes (the paths as run resolves them without -o), then each output's own limits.
     const BakePlan plan = plan_bake(scene, BakeConfig{});
     OutputTargets targets;
     targets.add_outputs(scene.outputs, {}, plan.written.first, plan.written.count());
-    print_counts(tree_summary(scene, prepare_tree(scene)));
+    const PreparedTree tree = prepare_tree(scene);
+    check_output_limits(scene.outputs, tree.model, bake_info(scene, plan, tree.model, nullptr));
+    print_counts(tree_summary(scene, tree));
   }
   if (scene.volume) print_volume(*scene.volume);
   std::printf("%s: OK\n", printable_text(scene_file.string()).c_str());

@@ -29,6 +29,7 @@ enum ExitCode : int {
   kExitInput = 2,
   kExitSimulation = 3,
   kExitOutput = 4,
+  kExitSighup = 129,
   kExitSigint = 130,
   kExitSigterm = 143,
 };

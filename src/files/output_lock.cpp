@@ -72,8 +72,9 @@ void OutputLocks::lock(const fs::path& output) {
 
 void OutputLocks::release() noexcept {
   // Removed before closed: whoever opens the name afterwards gets a new file and a free lock.
+  // Only while the name is still this lock: a file that took its place is another's.
   for (const Held& held : held_) {
-    ::unlink(held.path.c_str());
+    if (still_linked(held.fd, held.path)) ::unlink(held.path.c_str());
     ::close(held.fd);
   }
   held_.clear();

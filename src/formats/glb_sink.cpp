@@ -25,6 +25,7 @@
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
+#include "formats/sink_factories.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/vertex_normals.h"
 
@@ -410,6 +411,7 @@ std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs:
                       " frames of this bake fit at frame_step " + std::to_string(options.frame_step) +
                       " (raise frame_step, shorten the bake, or use hdf5/pc2)");
   }
+  check_float32_key_times(options, info, "glTF animations");
   return std::make_unique<GlbSink>(options, path, model, info);
 }
 

@@ -141,8 +141,9 @@ fs::path lock_target(const OutputFiles& output) {
 
 }  // namespace
 
-void check_output_paths(const std::vector<OutputOptions>& outputs) {
-  for (const OutputFiles& output : output_files(outputs, {}, 0, 0)) output.for_each([](const fs::path&) {});
+void check_output_limits(const std::vector<OutputOptions>& outputs, const TreeModel& model, const BakeInfo& info) {
+  for (const OutputFiles& output : output_files(outputs, {}, info.frame_start, info.frame_count))
+    find_sink_factory(output.options.format->name)(output.options, output.path, model, info);
 }
 
 // A sequence has a target per frame, so the checks run on strings: path comparisons per
@@ -158,6 +159,10 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
   }
   const fs::path& file = resolved.file;
   const std::string absolute = file.is_absolute() ? file.string() : (cwd_ / file).string();
+  if (const auto lock = locks_.find(absolute); lock != locks_.end())
+    throw InputError(refused + "writes " + file.string() + ", the lock file of " + lock->second);
+  if (const auto owner = owned_.find(absolute); owner != owned_.end() && owner->second != writer)
+    throw InputError(refused + "writes " + file.string() + ", the folder of " + owner->second);
   const auto [it, inserted] = writer_.emplace(absolute, writer);
   if (!inserted) throw InputError(refused + "writes " + file.string() + ", which " + it->second + " writes too");
   const std::string folder = absolute.substr(0, absolute.rfind('/'));
@@ -180,6 +185,7 @@ void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const
     output.for_each([&](const fs::path& target) {
       add(target, writer, refused, "an output path must name a regular file or a new one", written);
     });
+    if (written) add_lock(lock_path(lock_target(output)), writer);
   }
 }
 
@@ -193,7 +199,18 @@ void OutputTargets::add_folder(const fs::path& folder, const std::string& writer
   if (absolute.size() > 1 && absolute.back() == '/') absolute.pop_back();
   if (const auto other = in_folder_.find(absolute); other != in_folder_.end() && other->second != writer)
     throw InputError(other->second + ": writes in " + folder.string() + ", the folder of " + writer);
+  if (const auto other = writer_.find(absolute); other != writer_.end() && other->second != writer)
+    throw InputError(other->second + ": writes " + folder.string() + ", the folder of " + writer);
   owned_.emplace(absolute, writer);
+  add_lock(lock_path(folder), writer);
+}
+
+void OutputTargets::add_lock(const fs::path& lock, const std::string& holder) {
+  const fs::path normal = lock.lexically_normal();
+  const std::string absolute = (normal.is_absolute() ? normal : cwd_ / normal).string();
+  if (const auto other = writer_.find(absolute); other != writer_.end() && other->second != holder)
+    throw InputError(other->second + ": writes " + lock.string() + ", the lock file of " + holder);
+  locks_.emplace(absolute, holder);
 }
 
 void OutputTargets::probe(MadeFolders& made) const {

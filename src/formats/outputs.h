@@ -62,9 +62,10 @@ struct FrameData {
 // probe(), every folder able to take a file. OutputSet checks its outputs so; a forest checks
 // every tree's outputs, parts and manifest before it grows the first, so that a later tree's
 // target cannot fail the forest after earlier trees were written.
-// The outputs' paths read as their writers will read them (a sequence's frame-number field),
-// without looking at the disk => InputError as a bake gives it.
-void check_output_paths(const std::vector<OutputOptions>& outputs);
+// Each output's own limits as a bake meets them before it opens a file (a VAT's texture size,
+// a preview page's max_mib, glTF's 4 GiB): its writer built for this model and dropped. Throws
+// the InputError or OutputError the bake would.
+void check_output_limits(const std::vector<OutputOptions>& outputs, const TreeModel& model, const BakeInfo& info);
 
 class OutputTargets {
  public:
@@ -79,6 +80,9 @@ class OutputTargets {
   // A folder whose files only `writer` writes (a bake's checkpoints: it removes what it does not
   // read back), refused to every other writer's files, added before or after it.
   void add_folder(const std::filesystem::path& folder, const std::string& writer);
+  // The lock file that keeps other bakes off `holder`'s files (files/output_lock.h), which no
+  // writer may take: its output would be unlinked as the lock is released.
+  void add_lock(const std::filesystem::path& lock, const std::string& holder);
   // Each folder made when missing (into `made`, which the caller undoes when it gives up: a
   // folder another process may be writing into is not removed while it bakes) and a file
   // created and removed in it. Throws OutputError naming the path.
@@ -94,6 +98,7 @@ class OutputTargets {
   std::unordered_map<std::string, std::string> writer_;  // absolute file written => its writer
   std::unordered_map<std::string, std::string> in_folder_;  // absolute folder => a writer of a file in it
   std::unordered_map<std::string, std::string> owned_;      // absolute folder => its only writer
+  std::unordered_map<std::string, std::string> locks_;      // absolute lock file => what it locks
   std::unordered_set<std::string> folders_;              // absolute folders seen
   std::vector<std::filesystem::path> probes_;            // the first file of each folder
 };

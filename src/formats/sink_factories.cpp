@@ -1,7 +1,11 @@
 // The sinks of the format table's rows (formats/sink_factories.h): a line per format.
 #include "formats/sink_factories.h"
 
+#include <algorithm>
+#include <cmath>
 
+#include "common/errors.h"
+#include "common/message_text.h"
 #include "formats/frame_sink.h"
 
 namespace treeanim {
@@ -69,6 +73,18 @@ SinkTargets* find_sink_targets(std::string_view format) {
 PlannedBytes* find_planned_bytes(std::string_view format) {
   const SinkRow* row = find_sink(format);
   return row ? row->planned_bytes : nullptr;
+}
+
+void check_float32_key_times(const OutputOptions& options, const BakeInfo& info, const char* keys) {
+  const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
+  const double last = double(selection.start + (selection.written() - 1) * selection.step);
+  const double farthest = std::max(std::fabs(double(selection.start)), std::fabs(last)) / info.fps;  // s
+  const double float_step = farthest > 0 ? std::ldexp(1.0, std::ilogb(farthest) - 23) : 0;  // float32's, there
+  const double frame_step = double(selection.step) / info.fps;
+  if (float_step <= frame_step / 2) return;
+  throw InputError(options.pointer + ": " + keys + " keep their times in float32, whose step at " +
+                   number_text(farthest) + " s is " + number_text(float_step) + " s, more than half the " +
+                   number_text(frame_step) + " s between written frames: bake nearer time 0 (time.start)");
 }
 
 }  // namespace treeanim

@@ -13,6 +13,7 @@
 #include "formats/frame_sink.h"
 #include "formats/glb_size.h"
 #include "formats/gltf_mesh.h"
+#include "formats/sink_factories.h"
 #include "formats/rest_positions_f32.h"
 #include "formats/skin_fit.h"
 #include "formats/skin_track.h"
@@ -192,6 +193,7 @@ uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frame
 
 std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const fs::path& path,
                                                  const TreeModel& model, const BakeInfo& info) {
+  check_float32_key_times(options, info, "glTF animations");
   return std::make_unique<SkinnedGlbSink>(options, path, model, info);
 }
 

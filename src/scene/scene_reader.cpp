@@ -258,7 +258,8 @@ void SceneReader::check_object(const Json& node, const std::string& pointer) con
     const auto& keys = known->second;
     if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
       const std::string near = closest_match(it.key(), keys);
-      fail(child, "unknown key" + (near.empty() ? std::string()
+      // The key as text: a NUL in it ended the message (what() is a C string).
+      fail(printable_text(child), "unknown key" + (near.empty() ? std::string()
                                                 : " (did you mean " + pointer + "/" +
                                                       escape_pointer_token(near) + "?)"));
     }

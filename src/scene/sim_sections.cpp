@@ -38,7 +38,9 @@ double csv_number(const std::string& cell, const std::string& where, const std::
   const double v = std::strtod(cell.c_str(), &end);
   size_t used = static_cast<size_t>(end - cell.c_str());
   while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
-  if (used == 0 || used != cell.size() || !std::isfinite(v))
+  // strtod also reads C's hexadecimal ("0x10", "0x1p4"), which no CSV writer means.
+  const bool hexadecimal = cell.find_first_of("xXpP") != std::string::npos;
+  if (used == 0 || used != cell.size() || !std::isfinite(v) || hexadecimal)
     throw InputError(where + ": column '" + column + "': expected a finite number, got '" + excerpt(cell) + "'");
   if (!range.contains(v))
     throw InputError(where + ": column '" + column + "': expected " + range.describe() + ", got '" + excerpt(cell) +

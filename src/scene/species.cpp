@@ -121,6 +121,14 @@ std::optional<double> given_scale(SceneObject& parent) {
 // A height => whether the species grows to it in the field (its range).
 bool outside_range(const Species& s, double height) { return height < s.min_height || height > s.max_height; }
 
+// A bound of a range at six significant digits, as messages write numbers, rounded into the
+// range (up for its lower end, down for its upper): the rounded upper bound of a scale was refused.
+double inward(double bound, bool lower) {
+  if (bound == 0 || !std::isfinite(bound)) return bound;
+  const double unit = std::pow(10.0, std::floor(std::log10(std::fabs(bound))) - 5);
+  return (lower ? std::ceil(bound / unit) : std::floor(bound / unit)) * unit;
+}
+
 // => "English oak (english_oak) grows from 10 to 40 m, got ", for a refusal outside it.
 std::string range_text(const Species& s) {
   return s.common + " (" + s.name + ") grows from " + number_text(s.min_height) + " to " + number_text(s.max_height) + " m, got ";
@@ -145,8 +153,9 @@ std::optional<SpeciesChoice> read_species(SceneObject& parent) {
     if (outside_range(s, height))
       parent.object("tree").fail("scale", range_text(s) + number_text(height) + " m from a scale of " + number_text(*scale) +
                                               ": give a scale from " +
-                                              number_text(s.tree.scale * s.min_height / s.default_height) + " to " +
-                                              number_text(s.tree.scale * s.max_height / s.default_height) +
+                                              number_text(inward(s.tree.scale * s.min_height / s.default_height, true)) +
+                                              " to " +
+                                              number_text(inward(s.tree.scale * s.max_height / s.default_height, false)) +
                                               ", or the species' height");
     return height;
   };

@@ -169,7 +169,7 @@ VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double 
   summary.first_frame = first.first;
   summary.last_frame = last.second;
   const WindVolume volume(options);
-  bool bounded = false;
+  bool& bounded = summary.active;
   for (long long number = summary.first_frame; number <= summary.last_frame; ++number) {
     const std::string path = volume_frame_path(options.path, number);
     if (!std::filesystem::exists(path))
@@ -189,22 +189,24 @@ VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double 
       summary.layout = frame.grids->layout();
     }
     // Every active value, and the background the inactive ones read: finite and within the
-    // wind's range, in m/s.
-    auto check = [&](const std::string& where, double speed, bool finite) {
-      if (!finite) throw InputError(where + ": the velocity is not finite");
+    // wind's range, in m/s. `where` names the value, built only for a failure (a string per
+    // voxel took seconds a frame on a dense cache).
+    auto check = [&](auto where, double speed, bool finite) {
+      if (!finite) throw InputError(where() + ": the velocity is not finite");
       speed *= options.units;
       if (speed > max_speed)
-        throw InputError(where + ": a speed of " + number_text(speed) + " m/s, beyond the wind's " +
+        throw InputError(where() + ": a speed of " + number_text(speed) + " m/s, beyond the wind's " +
                          number_text(max_speed) + " m/s (is `units` right?)");
       summary.largest_speed = std::max(summary.largest_speed, speed);
     };
     const Eigen::Vector3d background = frame.grids->background();
-    check(path + ": the background of " + frame.grids->layout() + " (the inactive voxels' value)",
+    check([&] { return path + ": the background of " + frame.grids->layout() + " (the inactive voxels' value)"; },
           background.allFinite() ? background.norm() : 0, background.allFinite());
     frame.grids->visit_active([&](const std::string& grid, const std::array<int, 3>& ijk, double speed, bool finite) {
-      check(path + ": grid '" + grid + "', voxel (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +
-                std::to_string(ijk[2]) + ")",
-            speed, finite);
+      check([&] {
+        return path + ": grid '" + grid + "', voxel (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +
+               std::to_string(ijk[2]) + ")";
+      }, speed, finite);
     });
   }
   return summary;

@@ -44,8 +44,9 @@ std::string volume_frame_path(const std::filesystem::path& pattern, long long nu
 // What `info` prints and `validate` checks (check_wind_volume).
 struct VolumeSummary {
   long long first_frame = 0, last_frame = 0;  // the frames the bake reads
-  // m, the scene's box around every frame's active voxels
+  // m, the scene's box around every frame's active voxels; `active` false: no frame has one
   Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
+  bool active = false;
   double voxel_size = 0;                      // m, the first frame's largest voxel edge
   double largest_speed = 0;                   // m/s, over every voxel of every frame read
   std::string layout;                         // "vec3s grid 'vel'" or "float grids 'vel.x', 'vel.y', 'vel.z'"

@@ -122,7 +122,8 @@ class OpenVdbGrids final : public VolumeGrids {
     std::array<openvdb::FloatGrid::ConstAccessor, 3> access{split[0]->getConstAccessor(), split[1]->getConstAccessor(),
                                                            split[2]->getConstAccessor()};
     const char* axes[3] = {".x", ".y", ".z"};
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 3; ++k) {
+      const std::string grid = name + axes[k];
       for (auto it = split[k]->cbeginValueOn(); it; ++it) {
         double squared = 0;
         bool finite = true;
@@ -131,8 +132,9 @@ class OpenVdbGrids final : public VolumeGrids {
           finite = finite && std::isfinite(c);
           squared += double(c) * c;
         }
-        visit(name + axes[k], coordinates(it.getCoord()), finite ? std::sqrt(squared) : 0, finite);
+        visit(grid, coordinates(it.getCoord()), finite ? std::sqrt(squared) : 0, finite);
       }
+    }
   }
 
  private:
@@ -184,16 +186,16 @@ void clear_inactive(Grid& grid) {
   for (auto it = grid.tree().beginValueOff(); it; ++it) it.setValue(background);
 }
 
-// The grid named `name` in the file, read whole; one of that name only (OpenVDB would pick one
-// and print a warning on stdout).
-openvdb::GridBase::Ptr read_named_grid(openvdb::io::File& file, const std::string& name) {
+// The file's grids named `name` (OpenVDB's own lookup picks one and prints a warning on stdout
+// when there are more) => whether there is one; throws when there are several.
+bool has_one_grid(openvdb::io::File& file, const std::string& name) {
   size_t count = 0;
   const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
   for (const openvdb::GridBase::Ptr& grid : *grids) count += grid->getName() == name;
   if (count > 1)
     throw std::invalid_argument(std::to_string(count) + " grids are named '" + name +
                                 "': which one is the velocity is not clear");
-  return file.readGrid(name);
+  return count == 1;
 }
 
 // The file's layout walked as OpenVDB's File::open reads it (header, file metadata, then each
@@ -271,8 +273,8 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
   LayoutWalk(path).walk();
   openvdb::io::File file(path);
   file.open(false);
-  if (file.hasGrid(name)) {
-    openvdb::GridBase::Ptr grid = read_named_grid(file, name);
+  if (has_one_grid(file, name)) {
+    openvdb::GridBase::Ptr grid = file.readGrid(name);
     const openvdb::Vec3SGrid::Ptr vector = openvdb::GridBase::grid<openvdb::Vec3SGrid>(grid);
     if (!vector)
       throw std::invalid_argument("grid '" + name + "' holds " + grid_type(*grid) +
@@ -285,10 +287,10 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
     const char* axes[3] = {".x", ".y", ".z"};
     for (int k = 0; k < 3; ++k) {
       const std::string component = name + axes[k];
-      if (!file.hasGrid(component))
+      if (!has_one_grid(file, component))
         throw std::invalid_argument("no grid '" + name + "' (nor '" + name + ".x', '" + name + ".y', '" + name +
                                     ".z'); its grids: " + grid_list(file));
-      openvdb::GridBase::Ptr grid = read_named_grid(file, component);
+      openvdb::GridBase::Ptr grid = file.readGrid(component);
       const openvdb::FloatGrid::Ptr split = openvdb::GridBase::grid<openvdb::FloatGrid>(grid);
       if (!split)
         throw std::invalid_argument("grid '" + component + "' holds " + grid_type(*grid) +

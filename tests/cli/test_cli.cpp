@@ -122,6 +122,33 @@ TEST_F(Cli, InfoEstimatesEachOutput) {
   EXPECT_EQ(outputs[2]["bytes"].get<double>(), 5 * 96 * joints + usd_mesh + 24 * vertices + 320 * joints);
 }
 
+// validate refuses what run refuses before it simulates, each writer's own limits too (it said
+// OK to a VAT narrower than a frame, a page under its max_mib and a GLB past 4 GiB).
+TEST_F(Cli, ValidateMeetsTheWritersLimits) {
+  const std::string demo = std::string(TREEANIM_SOURCE_DIR) + "/configs/demo.json";
+  const struct {
+    const char* options;
+    int code;
+    const char* message;
+  } cases[] = {
+      {R"(--set 'outputs=[{"format": "vat", "path": "v.exr", "texture_width": 1}]')", 2,
+       "/outputs/0/texture_width: 1 texels a row put a frame's 9797 vertices on 9797 rows, over 8192; expected at "
+       "least 2 (or 0: as wide as the vertices)"},
+      {R"(--set 'outputs=[{"format": "html", "path": "p.html", "max_mib": 2}]' --set tree.ring_sides=64)", 2,
+       "/outputs/0/max_mib: the page needs"},
+      {R"(--set time.frames=200000 --set 'outputs=[{"format": "glb", "path": "big.glb"}]')", 4,
+       "over glTF's 4 GiB GLB limit"},
+  };
+  for (const auto& c : cases) {
+    for (const std::string& command : {std::string("validate "), "run --no-space-check -o " + (dir_ / "out").string() + " "}) {
+      const Result r = run(command + demo + " " + c.options);
+      EXPECT_EQ(r.code, c.code) << command << c.options << ": " << r.err;
+      EXPECT_NE(r.err.find(c.message), std::string::npos) << command << c.options << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << c.options;
+  }
+}
+
 // What the free-space check and farm plan count against what a bake writes, for every format:
 // the demo tree for two frames (where what is written once weighs most) and for eight. An
 // estimate short of the bytes lets a bake start that its disk cannot hold.

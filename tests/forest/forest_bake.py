@@ -11,6 +11,7 @@
           and --engine script run as a plain shell script
   targets a folder where the second tree's output, its part or the manifest goes: exit 2 naming
           it before the first tree is baked, every file there before left as it was
+  seeded  a tree whose own seed makes its variant's grammar fail: exit 2 before any tree is baked
 
 usage: forest_bake.py TREEANIM CASE      (exit 0 pass, 1 fail)
 """
@@ -307,8 +308,37 @@ def case_targets(treeanim, tmp):
     run(treeanim, "run", SCENE, "-o", out, "-q", "--shard", "0/16")
 
 
+def case_seeded(treeanim, tmp):
+    """A stochastic variant whose third tree's seed grows past lsystem.max_modules: validate and
+    run refuse it (exit 2, naming the tree) before the first tree is baked; it wrote the first
+    two trees, replacing an earlier bake's, then failed."""
+    grammar = os.path.join(HERE, "..", "..", "grammars", "abop-1.27-stochastic.lsys")
+    scene = {"lsystem": {"axiom": "F", "iterations": 0}, "time": {"frames": 3},
+             "wind": {"keys": [{"time": 0, "speed": 5, "direction": [1, 0, 0]}]},
+             "forest": {"variants": [{"name": "a", "lsystem": {"grammar": grammar, "iterations": 4,
+                                                               "max_modules": 400}}],
+                        "trees": [{"id": "t%d" % k, "position": [3 * k, 0, 0], "seed": seed}
+                                  for k, seed in enumerate([7, 3, 1])]},
+             "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]}
+    path = os.path.join(tmp, "seeded.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    out = os.path.join(tmp, "out")
+    os.makedirs(out)
+    with open(os.path.join(out, "t0.h5"), "wb") as f:
+        f.write(b"earlier bake")
+    before = folder_state(out)
+    message = "tree t2 (L-system seed 1): %s: derivation step 4 of 4 reached" % grammar
+    for command in (["validate", path], ["run", path, "-o", out, "-q"]):
+        done = run(treeanim, *command, check=False)
+        if done.returncode != 2 or message not in done.stderr:
+            raise Failed("%s: exit %d, expected 2 and %r: %s" % (command[0], done.returncode, message, done.stderr))
+    if folder_state(out) != before:
+        raise Failed("the refused forest changed its output folder: %s" % sorted(folder_state(out)))
+
+
 CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit,
-         "targets": case_targets, "locked": case_locked}
+         "targets": case_targets, "locked": case_locked, "seeded": case_seeded}
 
 
 def main():

@@ -114,6 +114,35 @@ def output_directory_in_the_way(bake):
         raise Failed("the output folder holds more than the directory: %s" % os.listdir(bake.out))
 
 
+def output_at_a_lock_or_the_checkpoints(bake):
+    """An output at another's lock file (.bake.h5.lock), or at the checkpoints' (.checkpoints.lock):
+    bad input naming both (it was baked, reported written, then unlinked as the lock was
+    released); and checkpoints in a folder at an output's path: bad input before the bake (the
+    whole bake ran, then failed to place the output)."""
+    lock = os.path.join(bake.out, ".bake.h5.lock")
+    expect(bake.run(24, ["--set", "outputs.1={\"format\": \"hdf5\", \"path\": \".bake.h5.lock\"}"]), 2,
+           "/outputs/1/path: writes %s, the lock file of /outputs/0" % lock, bake.out)
+    checkpoints = os.path.join(bake.out, "checkpoints")
+    expect(bake.run(24, ["--set", "outputs.1.path=.checkpoints.lock", "--set", "outputs.1.format=hdf5",
+                         "--checkpoint-every", "4"]), 2,
+           "/outputs/1/path: writes %s.lock, the lock file of the checkpoints" % os.path.join(bake.out, ".checkpoints"),
+           bake.out)
+    output = os.path.join(bake.out, "bake.h5")
+    expect(bake.run(24, ["--checkpoint-every", "4", "--checkpoint-dir", output]), 2,
+           "/outputs/0/path: writes %s, the folder of the checkpoints" % output, bake.out)
+
+
+def omp_threads_past_the_limit(bake):
+    """OMP_NUM_THREADS past --threads' range (1 ... 1024): bad input naming it (libgomp crashed
+    making 99999 threads: SIGSEGV); with --threads given, the variable is not read."""
+    env = dict(os.environ, OMP_NUM_THREADS="99999")
+    done = subprocess.run(bake.args(4), capture_output=True, text=True, env=env, timeout=120)
+    expect(done, 2, "OMP_NUM_THREADS asks for 99999 threads: expected 1 ... 1024 (or give run --threads N)", bake.out)
+    done = subprocess.run(bake.args(4, ["--threads", "2"]), capture_output=True, text=True, env=env, timeout=120)
+    if done.returncode != 0:
+        raise Failed("with --threads 2: exit %d: %s" % (done.returncode, done.stderr[-2000:]))
+
+
 def node_state(path):
     """What stands at path, without opening anything but a regular file: type, device, size, bytes."""
     info = os.lstat(path)
@@ -627,6 +656,8 @@ SCENARIOS = {
     "output-below-a-file": output_below_a_file,
     "output-in-proc": output_in_proc,
     "output-directory-in-the-way": output_directory_in_the_way,
+    "output-at-a-lock-or-the-checkpoints": output_at_a_lock_or_the_checkpoints,
+    "omp-threads-past-the-limit": omp_threads_past_the_limit,
     "output-read-only-folder": output_read_only_folder,
     "output-not-a-regular-file": output_not_a_regular_file,
     "output-symbolic-links-followed": output_symbolic_links_followed,
@@ -641,6 +672,7 @@ SCENARIOS = {
     "disk-full-gltf": disk_full_gltf,
     "sigint": interrupted(signal.SIGINT, 130, "SIGINT"),
     "sigterm": interrupted(signal.SIGTERM, 143, "SIGTERM"),
+    "sighup": interrupted(signal.SIGHUP, 129, "SIGHUP"),  # a terminal closed under the bake
     "interrupted-removes-made-folders": interrupted_removes_made_folders,
     "interrupted-while-growing": interrupted_while_growing,
     "wind-file-deleted": wind_file_deleted,

@@ -56,6 +56,18 @@ TEST(ForestLayout, AFullAreaStopsAtWhatFits) {
   EXPECT_GE(nearest_pair(placed), 2.0);
 }
 
+// Spacings far below the grid's 1 mm cells, and coordinates far beyond, are kept exactly:
+// 1e-300 m places the trees as no spacing does (a cell index once overflowed there), and two
+// trees 0.1 mm apart, 0.05 mm apart or 1e9 m from the origin are told apart.
+TEST(ForestLayout, SpacingsBelowTheCellsAndFarCoordinates) {
+  const ScatterArea area{{-1e4, -1e4}, {1e4, 1e4}};
+  EXPECT_EQ(scatter_points(5, 2000, area, 1e-300, 10, {}), scatter_points(5, 2000, area, 0, 10, {}));
+  EXPECT_FALSE(closer_than({{0, 0}, {1e-4, 0}}, 1e-4));
+  EXPECT_TRUE(closer_than({{0, 0}, {0.5e-4, 0}}, 1e-4));
+  EXPECT_TRUE(closer_than({{1e9, -1e9}, {1e9 + 0.5, -1e9}}, 1.0));
+  EXPECT_FALSE(closer_than({{1e300, 0}, {-1e300, 0}}, 1e-300));
+}
+
 TEST(ForestLayout, CloserThanNamesThePair) {
   const auto pair = closer_than({{0, 0}, {10, 0}, {10.5, 0}}, 1.0);
   ASSERT_TRUE(pair);
