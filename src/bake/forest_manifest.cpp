@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "common/json_text.h"
+#include "common/message_text.h"
 #include "common/read_text_file.h"
 #include "files/output_lock.h"
 #include "files/text_output.h"
@@ -137,7 +138,9 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
   try {
     part = parse_json_text(text, path.string());
     if (part.at("bake").get<std::string>() != key) {
-      why = path.string() + " is of another scene or treeanim version";
+      const std::string of = part.at("id").get<std::string>();
+      why = path.string() + (of != id ? " is the part of tree " + printable_text(of) + ", copied here"
+                                      : " is of another scene or treeanim version");
       return std::nullopt;
     }
     for (const Json& output : part.at("outputs"))

@@ -94,6 +94,13 @@ def case_shards(treeanim, tmp):
     rerun = "treeanim run '%s' --shard I/3 -o '%s' --set 'time.frames=24' --resume" % (SCENE, shards)
     if done.returncode != 4 or trees[3]["id"] not in done.stderr or rerun not in done.stderr:
         raise Failed("gather with a missing file: exit %d, %s" % (done.returncode, done.stderr))
+    # A part copied from another tree is named as that tree's, not as another scene's.
+    parts = os.path.join(shards, "forest.parts")
+    shutil.copy(os.path.join(parts, trees[1]["id"] + ".json"), os.path.join(parts, trees[2]["id"] + ".json"))
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, check=False)
+    copied = "%s.json is the part of tree %s, copied here" % (trees[2]["id"], trees[1]["id"])
+    if done.returncode != 4 or copied not in done.stderr:
+        raise Failed("gather with a copied part: exit %d, %s" % (done.returncode, done.stderr))
 
 
 def listed(folder):
