@@ -1,5 +1,6 @@
 #include "cli/bake_arguments.h"
 
+#include <charconv>
 #include <cstdlib>
 
 #include "common/errors.h"
@@ -12,16 +13,14 @@ FrameRange parse_frame_range(const std::string& text, long long first, long long
                                std::to_string(last) + " (the scene's time.start and time.frames)";
   const size_t colon = text.find(':');
   if (colon == std::string::npos) throw InputError(expected);
+  // Each side a whole integer, nothing around it (stoll skipped leading blanks but not trailing ones).
+  auto integer = [&](const char* begin, const char* stop, long long& value) {
+    const auto [at, error] = std::from_chars(begin, stop, value);
+    if (error != std::errc() || at != stop || begin == stop) throw InputError(expected);
+  };
   long long start = 0, end = 0;
-  try {
-    size_t used = 0;
-    start = std::stoll(text.substr(0, colon), &used);
-    if (used != colon) throw InputError(expected);
-    end = std::stoll(text.substr(colon + 1), &used);
-    if (used != text.size() - colon - 1) throw InputError(expected);
-  } catch (const std::logic_error&) {
-    throw InputError(expected);
-  }
+  integer(text.data(), text.data() + colon, start);
+  integer(text.data() + colon + 1, text.data() + text.size(), end);
   if (start < first || end > last || start > end) throw InputError(expected);
   return {start, end};
 }
