@@ -71,7 +71,9 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
   const bool velocities = frames.outputs.wants_velocities();
   FrameData data = frames.outputs.spare_frame();
   data.frame = frame;
-  data.time = state.time;
+  // The frame's time as docs/scene.md gives it, frame x (1 / fps): the state's sums a step per
+  // frame (2.8e-17 s off at frame 0 from a negative start), and a loop's warm-up ran periods ahead.
+  data.time = frame_time(plan, frame);
   data.leaf_attached = state.leaf_attached;
   if (frames.skin && !placement) {
     // Each vertex rounded to float as the skin places it, in its parallel loops.
@@ -84,7 +86,6 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
   }
   if (frames.cluster_motions) add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
   else data.cluster_motions.clear();
-  if (plan.loop) data.time = frame_time(plan, frame);  // the warm-up ran periods ahead
   if (plan.checkpoints.every > 0) start.journal->append(data);
   frames.push(std::move(data));
 }

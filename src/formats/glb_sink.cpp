@@ -411,7 +411,7 @@ std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs:
                       " frames of this bake fit at frame_step " + std::to_string(options.frame_step) +
                       " (raise frame_step, shorten the bake, or use hdf5/pc2)");
   }
-  check_float32_key_times(options, info, "glTF animations");
+  check_float32_key_times(options, info, "glTF animations", true);
   return std::make_unique<GlbSink>(options, path, model, info);
 }
 

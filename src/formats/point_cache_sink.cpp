@@ -124,7 +124,7 @@ std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const fs:
 
 std::unique_ptr<FrameSink> make_mdd_sink(const OutputOptions& options, const fs::path& path,
                                          const TreeModel& model, const BakeInfo& info) {
-  check_float32_key_times(options, info, "MDD frames");
+  check_float32_key_times(options, info, "MDD frames", false);
   return std::make_unique<PointCacheSink>(CacheFormat::kMdd, options, path, model, info);
 }
 

@@ -75,8 +75,13 @@ PlannedBytes* find_planned_bytes(std::string_view format) {
   return row ? row->planned_bytes : nullptr;
 }
 
-void check_float32_key_times(const OutputOptions& options, const BakeInfo& info, const char* keys) {
+void check_float32_key_times(const OutputOptions& options, const BakeInfo& info, const char* keys,
+                             bool from_zero) {
   const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
+  if (from_zero && selection.start < 0)
+    throw InputError(options.pointer + ": " + keys + " start at time 0, and this bake's first frame is at " +
+                     number_text(double(selection.start) / info.fps) + " s (time.start " +
+                     std::to_string(selection.start) + "): bake from time.start 0 or later");
   const double last = double(selection.start + (selection.written() - 1) * selection.step);
   const double farthest = std::max(std::fabs(double(selection.start)), std::fabs(last)) / info.fps;  // s
   const double float_step = farthest > 0 ? std::ldexp(1.0, std::ilogb(farthest) - 23) : 0;  // float32's, there

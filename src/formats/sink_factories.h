@@ -46,7 +46,9 @@ PlannedBytes* find_planned_bytes(std::string_view format);
 
 // A format whose frames' times are float32 keys (glTF animations, MDD): InputError naming the
 // output unless every written frame's key keeps its place within a quarter of the step between
-// written frames (a start of 999999999 at 24 fps made every key 41666668 s).
-void check_float32_key_times(const OutputOptions& options, const BakeInfo& info, const char* keys);
+// written frames (a start of 999999999 at 24 fps made every key 41666668 s), and, where the
+// format's times start at 0 (glTF's), none is negative.
+void check_float32_key_times(const OutputOptions& options, const BakeInfo& info, const char* keys,
+                             bool from_zero);
 
 }  // namespace treeanim

@@ -193,7 +193,7 @@ uint64_t skinned_glb_bytes(const TreeModel& model, size_t joints, uint64_t frame
 
 std::unique_ptr<FrameSink> make_skinned_glb_sink(const OutputOptions& options, const fs::path& path,
                                                  const TreeModel& model, const BakeInfo& info) {
-  check_float32_key_times(options, info, "glTF animations");
+  check_float32_key_times(options, info, "glTF animations", true);
   return std::make_unique<SkinnedGlbSink>(options, path, model, info);
 }
 

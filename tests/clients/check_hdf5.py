@@ -157,6 +157,9 @@ def main():
         check(set(f[group].keys()) == names, f"/{group} members {sorted(f[group].keys())}, expected {sorted(names)}")
 
     frame_index = np.rint(time * f.attrs["fps"]).astype(np.int64)
+    # Each frame at its own time, frame x (1 / fps) (a sum of steps drifted 1.5e-11 s by frame 8191).
+    check(np.array_equal(time, frame_index * (1.0 / f.attrs["fps"])), "/frames/time is not frame x (1 / fps)")
+    check(frames == 0 or frame_index[0] == f.attrs["frame_start"], "/frames/time does not start at frame_start")
     compared = 0
     if args.obj:
         obj_materials = []
