@@ -129,16 +129,6 @@ std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs,
   return files;
 }
 
-// The file an output's lock stands beside: its first file, through any links, so that a link to
-// another output's file, or another spelling of the same sequence, takes the same lock.
-fs::path lock_target(const OutputFiles& output) {
-  fs::path first;
-  output.for_each([&](const fs::path& file) {
-    if (first.empty()) first = file;
-  });
-  return resolve_output_target(first.empty() ? output.path : first).file;
-}
-
 }  // namespace
 
 void check_output_limits(const std::vector<OutputOptions>& outputs, const TreeModel& model, const BakeInfo& info) {
@@ -182,10 +172,17 @@ void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const
     const std::string& pointer = output.options.pointer;
     const std::string writer = owner.empty() ? pointer : pointer + " of " + owner;
     const std::string refused = (owner.empty() ? "" : owner + ": ") + pointer + "/path: ";
+    fs::path first;
     output.for_each([&](const fs::path& target) {
+      if (first.empty()) first = target;
       add(target, writer, refused, "an output path must name a regular file or a new one", written);
     });
-    if (written) add_lock(lock_path(lock_target(output)), writer);
+    if (!written) continue;
+    // Its lock stands beside its first file, through any links, so that a link to another
+    // output's file, or another spelling of the same sequence, takes the same lock.
+    const fs::path file = resolve_output_target(first.empty() ? output.path : first).file;
+    add_lock(lock_path(file), writer);
+    lock_files_.push_back(file);
   }
 }
 
@@ -241,7 +238,7 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     if (!checkpoints.empty()) targets.add_folder(checkpoints, "the checkpoints");
     targets.add_outputs(outputs, out_dir, info.frame_start, info.frame_count);
     targets.probe(impl_->folders);
-    for (const OutputFiles& output : impl_->files) impl_->locks.lock(lock_target(output));
+    for (const fs::path& file : targets.lock_files()) impl_->locks.lock(file);
     // And the checkpoints' folder, before the bake reads or clears it: two bakes there would
     // write over each other's journal and checkpoints.
     if (!checkpoints.empty()) {

@@ -83,6 +83,8 @@ class OutputTargets {
   // The lock file that keeps other bakes off `holder`'s files (files/output_lock.h), which no
   // writer may take: its output would be unlinked as the lock is released.
   void add_lock(const std::filesystem::path& lock, const std::string& holder);
+  // The file each written output's lock stands beside (files/output_lock.h), in the order added.
+  const std::vector<std::filesystem::path>& lock_files() const { return lock_files_; }
   // Each folder made when missing (into `made`, which the caller undoes when it gives up: a
   // folder another process may be writing into is not removed while it bakes) and a file
   // created and removed in it. Throws OutputError naming the path.
@@ -99,6 +101,7 @@ class OutputTargets {
   std::unordered_map<std::string, std::string> in_folder_;  // absolute folder => a writer of a file in it
   std::unordered_map<std::string, std::string> owned_;      // absolute folder => its only writer
   std::unordered_map<std::string, std::string> locks_;      // absolute lock file => what it locks
+  std::vector<std::filesystem::path> lock_files_;            // see lock_files()
   std::unordered_set<std::string> folders_;              // absolute folders seen
   std::vector<std::filesystem::path> probes_;            // the first file of each folder
 };

@@ -186,12 +186,11 @@ void clear_inactive(Grid& grid) {
   for (auto it = grid.tree().beginValueOff(); it; ++it) it.setValue(background);
 }
 
-// The file's grids named `name` (OpenVDB's own lookup picks one and prints a warning on stdout
-// when there are more) => whether there is one; throws when there are several.
-bool has_one_grid(openvdb::io::File& file, const std::string& name) {
+// The file's grids (their metadata, read once), `name` => whether one has that name; throws when
+// several have (OpenVDB's own lookup picks one and prints a warning on stdout).
+bool has_one_grid(const openvdb::GridPtrVec& grids, const std::string& name) {
   size_t count = 0;
-  const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
-  for (const openvdb::GridBase::Ptr& grid : *grids) count += grid->getName() == name;
+  for (const openvdb::GridBase::Ptr& grid : grids) count += grid->getName() == name;
   if (count > 1)
     throw std::invalid_argument(std::to_string(count) + " grids are named '" + name +
                                 "': which one is the velocity is not clear");
@@ -273,7 +272,8 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
   LayoutWalk(path).walk();
   openvdb::io::File file(path);
   file.open(false);
-  if (has_one_grid(file, name)) {
+  const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+  if (has_one_grid(*grids, name)) {
     openvdb::GridBase::Ptr grid = file.readGrid(name);
     const openvdb::Vec3SGrid::Ptr vector = openvdb::GridBase::grid<openvdb::Vec3SGrid>(grid);
     if (!vector)
@@ -287,7 +287,7 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
     const char* axes[3] = {".x", ".y", ".z"};
     for (int k = 0; k < 3; ++k) {
       const std::string component = name + axes[k];
-      if (!has_one_grid(file, component))
+      if (!has_one_grid(*grids, component))
         throw std::invalid_argument("no grid '" + name + "' (nor '" + name + ".x', '" + name + ".y', '" + name +
                                     ".z'); its grids: " + grid_list(file));
       openvdb::GridBase::Ptr grid = file.readGrid(component);
