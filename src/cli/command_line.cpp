@@ -187,7 +187,6 @@ int report(const char* kind, const std::exception& error, int code) {
   return code;
 }
 
-// Runs the subcommand; a failure's exception => its message and exit code.
 // libgomp takes OMP_NUM_THREADS as it stands, and a count past --threads' range crashed it as
 // it made the threads (99999: SIGSEGV in the first parallel region) => what is wrong, or "".
 std::string omp_threads_error(const Arguments& args) {
@@ -197,6 +196,7 @@ std::string omp_threads_error(const Arguments& args) {
          std::to_string(kMaxThreads) + " (or give run --threads N)";
 }
 
+// Runs the subcommand; a failure's exception => its message and exit code.
 int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   try {
     if (const std::string isa = asked_isa_error(); !isa.empty()) throw InputError(isa);
