@@ -14,6 +14,7 @@
 #include "common/message_text.h"
 #include "common/read_text_file.h"
 #include "lsystem/grammar.h"
+#include "lsystem/lsystem_options.h"
 #include "lsystem/preprocess.h"
 
 namespace treeanim {
@@ -390,8 +391,16 @@ class Parser {
       else if (keyword == "derivation length") {
         const auto length = static_cast<int>(integer_value(text, vbegin, vend, line, 0, 100000));
         if (first) g_.derivation_length = length;
-      } else if (keyword == "angle") g_.angle = constant_value(text, vbegin, vend, line);
-      else if (keyword == "width factor") g_.width_factor = constant_value(text, vbegin, vend, line);
+      } else if (keyword == "angle") {
+        const double angle = constant_value(text, vbegin, vend, line);
+        if (!(std::abs(angle) <= 360)) fail(line, vbegin, "expected an angle in [-360, 360] degrees, as lsystem.angle");
+        g_.angle = angle;
+      } else if (keyword == "width factor") {
+        const double factor = constant_value(text, vbegin, vend, line);
+        if (!(factor > 0 && std::isfinite(factor)))
+          fail(line, vbegin, "expected a width factor above 0, as lsystem.width_factor");
+        g_.width_factor = factor;
+      }
       else if (keyword == "seed") {
         // After "homomorphism" it seeds the homomorphism's own draws (CPFG manual 4.3.3); the
         // decomposition draws with the productions (4.4).
@@ -434,9 +443,10 @@ class Parser {
   // "tropism: Tx Ty Tz e" (spaces or commas between the four values).
   void parse_tropism(std::string_view text, size_t begin, size_t end, const TextOrigin& line) {
     double values[4];
-    size_t k = begin;
+    size_t k = begin, elasticity = begin;
     for (int i = 0; i < 4; ++i) {
       while (k < end && (is_space(text[k]) || text[k] == ',')) ++k;
+      elasticity = k;
       if (k >= end) fail(line, k, "expected 4 values 'Tx Ty Tz e' after 'tropism:', got " + std::to_string(i));
       size_t stop = k;
       while (stop < end && !is_space(text[stop]) && text[stop] != ',') ++stop;
@@ -446,7 +456,10 @@ class Parser {
     while (k < end && (is_space(text[k]) || text[k] == ',')) ++k;
     if (k < end) fail(line, k, "expected 4 values 'Tx Ty Tz e' after 'tropism:', got more");
     const Eigen::Vector3d t(values[0], values[1], values[2]);
-    if (!unit_direction(t)) fail(line, begin, "expected a non-zero tropism direction");
+    if (!unit_direction(t) || !(t.norm() <= kMaxTropism))
+      fail(line, begin, "expected a non-zero tropism direction at most 1e6 long");
+    if (!(std::abs(values[3]) <= kMaxTropism))
+      fail(line, elasticity, "expected an elasticity in [-1e6, 1e6]");
     g_.tropism = t;
     g_.tropism_elasticity = values[3];
   }

@@ -17,6 +17,10 @@ struct GrammarText {
   bool single_line = false;
 };
 
+// The longest tropism direction and the largest elasticity, in a grammar's "tropism:" or the
+// scene: the turn of e |H x T| rad a segment stays finite (ABOP's e is below 1, T a unit vector).
+inline constexpr double kMaxTropism = 1e6;
+
 struct LsystemOptions {
   std::optional<std::filesystem::path> grammar;  // grammar file, resolved against the scene folder
   std::optional<GrammarText> library_grammar;    // a species' grammar (in memory), when no file or inline one is given

@@ -218,10 +218,13 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
   for (size_t i = 0; i < lines.size(); ++i) {
     std::string key, rest;
     if (!split_key(lines[i], &key, &rest)) continue;
-    if (key == "angle increment") view.angle = number(name, i, rest, "angle increment");
-    else if (key == "angle factor") {
+    if (key == "angle increment") {
+      view.angle = number(name, i, rest, "angle increment");
+      if (!(std::abs(*view.angle) <= 360))
+        fail(name, i, "expected an 'angle increment:' in [-360, 360] degrees, as lsystem.angle");
+    } else if (key == "angle factor") {
       const double n = number(name, i, rest, "angle factor");
-      if (n == 0) fail(name, i, "expected a non-zero 'angle factor:'");
+      if (!(std::abs(n) >= 1)) fail(name, i, "expected an 'angle factor:' of at least 1 in size (360 / it is the angle)");
       view.angle = 360.0 / n;
     } else if (key == "initial line width") {
       if (rest.find('p') == std::string::npos) view.initial_width = number(name, i, rest, key.c_str());

@@ -75,9 +75,9 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, co
   options.max_modules = static_cast<size_t>(section.integer("max_modules", 20'000'000, 1, 1LL << 29));
   options.width_factor = section.optional_number("width_factor", Range::positive());
   options.tropism = section.optional_vector3("tropism");
-  if (options.tropism && !unit_direction(*options.tropism))
-    section.fail_expected("tropism", "a non-zero direction [x, y, z]");
-  options.tropism_elasticity = section.optional_number("tropism_elasticity");
+  if (options.tropism && (!unit_direction(*options.tropism) || !(options.tropism->norm() <= kMaxTropism)))
+    section.fail_expected("tropism", "a non-zero direction [x, y, z] at most 1e6 long");
+  options.tropism_elasticity = section.optional_number("tropism_elasticity", Range::between(-kMaxTropism, kMaxTropism));
   if (auto n = section.optional_integer("surface_precision", 1, 10)) options.surface_precision = static_cast<int>(*n);
   if (options.surface_precision && !options.view)
     section.fail("surface_precision", "the precision of surfaces goes with a view file that names them (/lsystem/view)");

@@ -128,7 +128,7 @@ TEST_F(ViewFile, FunctionFilesInBothFormatsAreFoundBesideTheViewFile) {
 
 TEST_F(ViewFile, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(error_of("viewpoint: 0,0,1\nangle increment: wide\n"), "plant.v:2:1: expected a number after 'angle increment:'");
-  EXPECT_EQ(error_of("angle factor: 0\n"), "plant.v:1:1: expected a non-zero 'angle factor:'");
+  EXPECT_EQ(error_of("angle factor: 0\n"), "plant.v:1:1: expected an 'angle factor:' of at least 1 in size (360 / it is the angle)");
   EXPECT_EQ(error_of("line width increment: nan\n"), "plant.v:1:1: expected a number after 'line width increment:'");
   EXPECT_EQ(error_of("\ntropism: T: 0,0,0 E: 1\n"), "plant.v:2:1: 'tropism:' expected a non-zero 'T:' vector (or E: and S: 0, no tropism)");
   EXPECT_EQ(error_of("tropism: T: 0,1,0 E: stiff\n"), "plant.v:1:1: 'tropism:' expected a number after 'E:'");

@@ -83,7 +83,7 @@ TEST(LsystemOptions, ErrorsAreJsonPointers) {
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "step": 0}})"),
             "scene.json: /lsystem/step: expected a number > 0, got 0");
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "tropism": [0, 0, 0]}})"),
-            "scene.json: /lsystem/tropism: expected a non-zero direction [x, y, z], got [0,0,0]");
+            "scene.json: /lsystem/tropism: expected a non-zero direction [x, y, z] at most 1e6 long, got [0,0,0]");
   EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "iteration": 3}})"),
             "scene.json: /lsystem/iteration: unknown key (did you mean /lsystem/iterations?)");
 }
