@@ -3,6 +3,8 @@
 #include <fstream>
 #include <utility>
 
+#include "common/input_files.h"
+
 namespace treeanim {
 
 bool read_text_file(const std::filesystem::path& path, std::string& text, std::string& reason,
@@ -37,6 +39,7 @@ bool read_text_file(const std::filesystem::path& path, std::string& text, std::s
       if (!(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) text[kept++] = text[i];
     text.resize(kept);
   }
+  note_input_file(path);
   return true;
 }
 

@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "common/ordered_worker.h"
 #include "files/output_lock.h"
 #include "files/staged_files.h"
@@ -136,6 +137,23 @@ void check_output_limits(const std::vector<OutputOptions>& outputs, const TreeMo
     find_sink_factory(output.options.format->name)(output.options, output.path, model, info);
 }
 
+std::string OutputTargets::real_folder(const fs::path& folder) {
+  const auto [known, inserted] = real_folders_.try_emplace(folder.string());
+  if (inserted) {
+    std::error_code error;
+    const fs::path absolute = folder.empty() ? cwd_ : folder.is_absolute() ? folder : cwd_ / folder;
+    const fs::path real = fs::weakly_canonical(absolute, error);
+    known->second = (error ? absolute.lexically_normal() : real).string();
+    if (known->second.size() > 1 && known->second.back() == '/') known->second.pop_back();
+  }
+  return known->second;
+}
+
+std::string OutputTargets::identity(const fs::path& file) {
+  const std::string folder = real_folder(file.parent_path());
+  return (folder == "/" ? "" : folder) + "/" + file.filename().string();
+}
+
 // A sequence has a target per frame, so the checks run on strings: path comparisons per
 // component cost ~20 us a target, a minute for a million-frame sequence.
 void OutputTargets::add(const fs::path& target, const std::string& writer, const std::string& refused,
@@ -148,7 +166,7 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
     throw InputError(refused + e.what());
   }
   const fs::path& file = resolved.file;
-  const std::string absolute = file.is_absolute() ? file.string() : (cwd_ / file).string();
+  const std::string absolute = identity(file);
   if (const auto lock = locks_.find(absolute); lock != locks_.end())
     throw InputError(refused + "writes " + file.string() + ", the lock file of " + lock->second);
   if (const auto owner = owned_.find(absolute); owner != owned_.end() && owner->second != writer)
@@ -163,6 +181,9 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
   if (!resolved.kind.empty())
     throw InputError(refused + target.string() + (file == target ? " is " : " links to " + file.string() + ", ") +
                      resolved.kind + ", left untouched; " + expected);
+  if (const std::string input = input_file_at(file); !input.empty())
+    throw InputError(refused + "writes " + target.string() + ", which is " +
+                     (input == target.string() ? "" : input + ", ") + "an input of this bake, left untouched");
   if (folders_.insert(folder).second) probes_.push_back(file);
 }
 
@@ -191,9 +212,7 @@ void OutputTargets::add_file(const fs::path& file, const std::string& writer, bo
 }
 
 void OutputTargets::add_folder(const fs::path& folder, const std::string& writer) {
-  const fs::path normal = folder.lexically_normal();
-  std::string absolute = (normal.is_absolute() ? normal : cwd_ / normal).string();
-  if (absolute.size() > 1 && absolute.back() == '/') absolute.pop_back();
+  const std::string absolute = real_folder(folder);
   if (const auto other = in_folder_.find(absolute); other != in_folder_.end() && other->second != writer)
     throw InputError(other->second + ": writes in " + folder.string() + ", the folder of " + writer);
   if (const auto other = writer_.find(absolute); other != writer_.end() && other->second != writer)
@@ -203,8 +222,7 @@ void OutputTargets::add_folder(const fs::path& folder, const std::string& writer
 }
 
 void OutputTargets::add_lock(const fs::path& lock, const std::string& holder) {
-  const fs::path normal = lock.lexically_normal();
-  const std::string absolute = (normal.is_absolute() ? normal : cwd_ / normal).string();
+  const std::string absolute = identity(lock);
   if (const auto other = writer_.find(absolute); other != writer_.end() && other->second != holder)
     throw InputError(other->second + ": writes " + lock.string() + ", the lock file of " + holder);
   locks_.emplace(absolute, holder);

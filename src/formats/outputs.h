@@ -96,7 +96,15 @@ class OutputTargets {
   void add(const std::filesystem::path& target, const std::string& writer, const std::string& refused,
            const std::string& expected, bool written);
 
+  // A folder => its absolute path with its links followed, as the system resolves it (the part
+  // that exists; the rest lexically), once per folder: another spelling of a folder, or a link
+  // to it, is the same folder.
+  std::string real_folder(const std::filesystem::path& folder);
+  // A file => real_folder of its folder, then its name: the string the checks compare.
+  std::string identity(const std::filesystem::path& file);
+
   std::filesystem::path cwd_ = std::filesystem::current_path();
+  std::unordered_map<std::string, std::string> real_folders_;  // a folder as given => real_folder
   std::unordered_map<std::string, std::string> writer_;  // absolute file written => its writer
   std::unordered_map<std::string, std::string> in_folder_;  // absolute folder => a writer of a file in it
   std::unordered_map<std::string, std::string> owned_;      // absolute folder => its only writer

@@ -36,7 +36,9 @@ class UsdSink final : public FrameSink {
   void begin() override {
     temporary_ = staged_.stage(path_);
     file_.emplace(temporary_, path_);
-    scratch_path_ = temporary_path(path_.string() + ".normals");
+    // Named after the layer's temporary, not as one: ".NAME.normals.tmp-PID" is the temporary of
+    // an output named NAME.normals.
+    scratch_path_ = temporary_.string() + ".normals";
     if (normals_) scratch_.emplace(scratch_path_, path_);
     std::string out = usd_layer_header(info_, selection_, "");
     out += "def Xform \"Tree\" (\n    kind = \"component\"\n)\n{\n";

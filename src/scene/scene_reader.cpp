@@ -5,6 +5,7 @@
 
 #include "common/did_you_mean.h"
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "common/message_text.h"
 
 namespace treeanim {
@@ -190,7 +191,9 @@ std::optional<std::filesystem::path> SceneObject::optional_path(const std::strin
   // The system reads a path only up to a NUL: the file opened would not be the one named.
   if (text->find('\0') != std::string::npos) fail_expected(key, "a path without a NUL character");
   std::filesystem::path p(*text);
-  return p.is_absolute() ? p : (reader_->scene_dir() / p).lexically_normal();
+  if (!p.is_absolute()) p = (reader_->scene_dir() / p).lexically_normal();
+  note_input_file(p);  // a scene's paths name its inputs, which no output may replace: a forest looks before it grows
+  return p;
 }
 
 Json& SceneObject::declared_or(const std::string& key, Json empty) {

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "common/message_text.h"
 #include "sim/volume_grids.h"
 
@@ -55,6 +56,7 @@ VolumeFrame read_frame(const std::string& path, const std::string& name) {
   VolumeFrame frame;
   frame.grids.reset(read(path, name, what));
   if (!frame.grids) throw InputError(path + ": " + what);
+  note_input_file(path);
   return frame;
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "tree/tree_build_steps.h"
 
 namespace treeanim {
@@ -135,6 +136,7 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   // here, where the triangulation asserted or crashed on it.
   check_ply_header(file);
   const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);
+  note_input_file(file);
   if (scene) scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());

@@ -132,6 +132,76 @@ def output_at_a_lock_or_the_checkpoints(bake):
            "/outputs/0/path: writes %s, the folder of the checkpoints" % output, bake.out)
 
 
+def output_at_an_input(bake):
+    """An output at the scene file, at its wind file through a link, or at a grammar it includes:
+    bad input, each input left as it was (the scene was overwritten with the HDF5 and exit 0)."""
+    with open(os.path.join(bake.tmp, "part.lsys"), "w") as f:
+        f.write("B --> F\n")
+    with open(os.path.join(bake.tmp, "tree.lsys"), "w") as f:
+        f.write("derivation length: 2\naxiom: A\nA --> FA[+B]\n#include \"part.lsys\"\n")
+    os.symlink(bake.wind, os.path.join(bake.tmp, "wind.h5"))
+    inputs = {path: open(path, "rb").read() for path in (bake.scene, bake.wind, os.path.join(bake.tmp, "part.lsys"))}
+    expect(bake.run(12, ["--set", "outputs.0.path=" + bake.scene]), 2,
+           "/outputs/0/path: writes %s, which is an input of this bake, left untouched" % bake.scene, bake.out)
+    expect(bake.run(12, ["--set", "outputs.0.path=../wind.h5"]), 2,
+           "which is %s, an input of this bake, left untouched" % bake.wind, bake.out)
+    grammar = ["--set", "lsystem={\"grammar\": \"tree.lsys\"}"]
+    expect(bake.run(12, grammar + ["--set", "outputs.2.path=../part.lsys"]), 2,
+           "an input of this bake, left untouched", bake.out)
+    for path, content in inputs.items():
+        if open(path, "rb").read() != content:
+            raise Failed(path + " was changed")
+
+
+def output_through_folder_links(bake):
+    """Two outputs that reach the same files through a linked folder, and an output in the
+    checkpoints' folder named "." or through a link: bad input before the bake, and the old
+    files stay (the bake ran, replaced some of them, then failed with exit 4; or wrote its output
+    among the checkpoints)."""
+    real = os.path.join(bake.out, "real")
+    os.makedirs(real)
+    os.symlink("real", os.path.join(bake.out, "link"))
+    old = {}
+    for name in ("t.pc2", "t.rest.obj", "t.rest.mtl"):
+        old[name] = os.path.join(real, name)
+        with open(old[name], "w") as f:
+            f.write("an old bake")
+    twice = "outputs=[{\"format\": \"pc2\", \"path\": \"real/t\"}, {\"format\": \"pc2\", \"path\": \"link/t\"}]"
+    done = bake.run(12, ["--set", twice])
+    if done.returncode != 2 or "which /outputs/0 writes too" not in done.stderr:
+        raise Failed("two outputs through a linked folder: exit %d: %s" % (done.returncode, done.stderr))
+    for path in old.values():
+        if open(path).read() != "an old bake":
+            raise Failed(path + " was replaced")
+    os.symlink("real", os.path.join(bake.out, "checkpoints"))
+    # The checkpoints in real/ as "real/." and as the link checkpoints/, the output in real/.
+    for checkpoints, out, path in ((os.path.join(real, "."), real, "x.h5"),
+                                   (os.path.join(bake.out, "checkpoints"), bake.out, "real/x.h5")):
+        done = bake.run(12, ["--set", "outputs=[{\"format\": \"hdf5\", \"path\": \"%s\"}]" % path,
+                             "--checkpoint-every", "4", "--checkpoint-dir", checkpoints], out=out)
+        if done.returncode != 2 or "in the folder of the checkpoints" not in done.stderr:
+            raise Failed("checkpoints in %s: exit %d: %s" % (checkpoints, done.returncode, done.stderr))
+    if sorted(os.listdir(real)) != sorted(old):
+        raise Failed("the folder holds more than the old files: %s" % os.listdir(real))
+
+
+def output_named_as_a_scratch(bake):
+    """A USD layer's normals wait in a scratch file beside it; an output named after the layer
+    plus ".normals" is another file (its temporary was the scratch: exit 4 after the bake, the
+    layer already replaced)."""
+    outputs = ("outputs=[{\"format\": \"usd\", \"path\": \"t.usda\", \"normals\": true}, "
+               "{\"format\": \"hdf5\", \"path\": \"t.usda.normals\"}]")
+    done = bake.run(12, ["--set", outputs])
+    if done.returncode != 0:
+        raise Failed("exit %d: %s" % (done.returncode, done.stderr))
+    for name, start in (("t.usda", b"#usda 1.0"), ("t.usda.normals", b"\x89HDF\r\n\x1a\n")):
+        with open(os.path.join(bake.out, name), "rb") as f:
+            if not f.read(len(start)) == start:
+                raise Failed(name + " does not hold its output")
+    if sorted(files_under(bake.out)) != ["t.usda", "t.usda.normals"]:
+        raise Failed("files left: %s" % files_under(bake.out))
+
+
 def omp_threads_past_the_limit(bake):
     """OMP_NUM_THREADS past --threads' range (1 ... 1024): bad input naming it (libgomp crashed
     making 99999 threads: SIGSEGV); with --threads given, the variable is not read."""
@@ -658,6 +728,9 @@ SCENARIOS = {
     "output-directory-in-the-way": output_directory_in_the_way,
     "output-at-a-lock-or-the-checkpoints": output_at_a_lock_or_the_checkpoints,
     "omp-threads-past-the-limit": omp_threads_past_the_limit,
+    "output-at-an-input": output_at_an_input,
+    "output-through-folder-links": output_through_folder_links,
+    "output-named-as-a-scratch": output_named_as_a_scratch,
     "output-read-only-folder": output_read_only_folder,
     "output-not-a-regular-file": output_not_a_regular_file,
     "output-symbolic-links-followed": output_symbolic_links_followed,

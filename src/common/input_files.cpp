@@ -1,0 +1,44 @@
+#include "common/input_files.h"
+
+#include <sys/stat.h>
+
+#include <cstdint>
+#include <mutex>
+#include <unordered_map>
+
+namespace treeanim {
+
+namespace {
+
+struct InputFiles {
+  std::mutex mutex;
+  std::unordered_map<uint64_t, std::unordered_map<uint64_t, std::string>> named;  // device => inode => name
+};
+
+InputFiles& input_files() {
+  static InputFiles files;
+  return files;
+}
+
+}  // namespace
+
+void note_input_file(const std::filesystem::path& path) {
+  struct stat status;
+  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return;
+  InputFiles& files = input_files();
+  const std::lock_guard<std::mutex> lock(files.mutex);
+  files.named[status.st_dev].emplace(status.st_ino, path.string());
+}
+
+std::string input_file_at(const std::filesystem::path& path) {
+  struct stat status;
+  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return "";
+  InputFiles& files = input_files();
+  const std::lock_guard<std::mutex> lock(files.mutex);
+  const auto device = files.named.find(status.st_dev);
+  if (device == files.named.end()) return "";
+  const auto file = device->second.find(status.st_ino);
+  return file == device->second.end() ? "" : file->second;
+}
+
+}  // namespace treeanim
