@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <unordered_map>
+#include <vector>
 
 #include "common/errors.h"
 #include "common/message_text.h"
@@ -159,10 +160,20 @@ ScatterSettings read_scatter(SceneObject& scatter, uint64_t scene_seed) {
 // so that a change of spacing or area moves trees without changing what they are.
 void scatter_trees(const SceneObject& scatter, const ScatterSettings& settings, long long count, Forest& forest) {
   const auto& [area, seed, attempts, rotation, scale] = settings;
+  // Only the weights' ratios count: they are drawn from scaled by a power of two (exactly) to
+  // a largest of 1 ... 2, so that no sum overflows (1e308 twice) and a subnormal weight is
+  // not lost beside 0; a zero weight is never drawn, not even by a sum's round-off.
+  double largest = 0;
+  size_t last_drawn = 0;
+  for (size_t i = 0; i < forest.variants.size(); ++i) {
+    largest = std::max(largest, forest.variants[i].weight);
+    if (forest.variants[i].weight > 0) last_drawn = i;
+  }
+  if (!(largest > 0)) scatter.fail("count", "the variants' weights sum to 0: give a variant a weight > 0 to scatter");
+  std::vector<double> weight;
+  for (const ForestVariant& v : forest.variants) weight.push_back(std::ldexp(v.weight, -std::ilogb(largest)));
   double total_weight = 0;
-  for (const ForestVariant& v : forest.variants) total_weight += v.weight;
-  if (!(total_weight > 0))
-    scatter.fail("count", "the variants' weights sum to 0: give a variant a weight > 0 to scatter");
+  for (const double w : weight) total_weight += w;
 
   std::vector<Eigen::Vector2d> listed;
   for (const ForestTree& tree : forest.trees) listed.emplace_back(tree.position.x(), tree.position.z());
@@ -180,9 +191,8 @@ void scatter_trees(const SceneObject& scatter, const ScatterSettings& settings, 
     RandomStream random{(seed * 0x9e3779b97f4a7c15ull) ^ (uint64_t(k) + 0x5ca77e4ull)};  // the tree's stream
     double pick = random.uniform() * total_weight;
     tree.variant = 0;
-    while (tree.variant + 1 < forest.variants.size() &&
-           (pick >= forest.variants[tree.variant].weight || forest.variants[tree.variant].weight == 0)) {
-      pick -= forest.variants[tree.variant].weight;
+    while (tree.variant < last_drawn && (pick >= weight[tree.variant] || weight[tree.variant] == 0)) {
+      pick -= weight[tree.variant];
       ++tree.variant;
     }
     tree.rotation = rotation[0] + random.uniform() * (rotation[1] - rotation[0]);

@@ -47,6 +47,11 @@ void check_mesh(const TreeModel& m) {
   expect_range("vertex_segment", m.vertex_segment, -1, (long long)m.segment_count());
   expect_range("vertex_leaf", m.vertex_leaf, -1, (long long)m.leaf_count());
   if (!m.rest_positions.allFinite()) fail("rest_positions are not all finite");
+  // The outputs keep positions and velocities in float32 (at most 3.4e38): a tree past this
+  // would write inf, moving or not.
+  constexpr double kFarthest = 1e24;  // m
+  if (V > 0 && !(m.rest_positions.cwiseAbs().maxCoeff() <= kFarthest))
+    fail("rest_positions reach past 1e24 m, beyond what the float32 outputs hold for its motion");
 }
 
 void check_masses(const TreeModel& m) {

@@ -107,6 +107,26 @@ TEST(Forest, ListedAndScatteredTrees) {
   }
 }
 
+// Only the weights' ratios count, at any size: equal weights of 1e308 (whose sum overflows)
+// draw as 1 and 1, a subnormal weight beside 0 takes every tree, and a weight 0 none.
+TEST(Forest, WeightsDrawByTheirRatiosAlone) {
+  auto variants_of = [](const std::string& a, const std::string& b) {
+    const Scene scene = load(R"({"spacing": 1, "variants": [{"name": "a", "weight": )" + a +
+                             R"(}, {"name": "b", "weight": )" + b +
+                             R"(}], "scatter": {"count": 30, "min": [-10, -10], "max": [10, 10], "seed": 3}})");
+    std::vector<size_t> variants;
+    for (const ForestTree& tree : scene.forest->trees) variants.push_back(tree.variant);
+    return variants;
+  };
+  const std::vector<size_t> even = variants_of("1", "1");
+  EXPECT_EQ(variants_of("1e308", "1e308"), even);
+  EXPECT_EQ(variants_of("5e-324", "5e-324"), even);
+  EXPECT_EQ(variants_of("3", "3"), even);
+  EXPECT_EQ(variants_of("5e-324", "0"), std::vector<size_t>(30, 0));
+  EXPECT_EQ(variants_of("0", "1e-310"), std::vector<size_t>(30, 1));
+  EXPECT_EQ(variants_of("1.7e308", "0"), std::vector<size_t>(30, 0));
+}
+
 // A scatter of no trees (a count set to 0 to leave it out for a while) holds the keys of one of
 // more, checked as they are there, and places nothing.
 TEST(Forest, ScatterOfNoTreesKeepsItsKeys) {
