@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -65,13 +66,26 @@ class Deriver {
     std::string where = "while deriving step " + std::to_string(step_);
     if (step_ == 0) where = "while evaluating the axiom";
     if (step_ > settings_.iterations) where = "while applying the homomorphism";
-    // The rule by its place: line:column in a file, the element and column of an inline grammar.
-    if (rule_)
-      where += " (rule at " +
-               (rule_->pos.line == 0 ? g_.where(rule_->pos)
-                                     : std::to_string(rule_->pos.line) + ":" + std::to_string(rule_->pos.column)) +
-               ")";
-    throw InputError(g_.where(error.pos) + ": " + error.message + " " + where);
+    throw InputError(g_.where(error.pos) + ": " + error.message + " " + where + rule_place());
+  }
+
+  // The rule being applied by its place, " (rule at line:column)" in a file, the element and
+  // column of an inline grammar; "" outside a rule.
+  std::string rule_place() const {
+    if (!rule_) return "";
+    return " (rule at " +
+           (rule_->pos.line == 0 ? g_.where(rule_->pos)
+                                 : std::to_string(rule_->pos.line) + ":" + std::to_string(rule_->pos.column)) +
+           ")";
+  }
+
+  // A call '?(label, s)' to an L-system the file does not have => what is wrong, and when.
+  std::string unknown_call(double label) const {
+    std::ostringstream value;
+    value << label;
+    return "'?(" + value.str() + ", ...)' calls L-system " + value.str() + " " +
+           (step_ == 0 ? std::string("in the axiom") : "while deriving step " + std::to_string(step_)) +
+           ", but the file has no 'lsystem: " + value.str() + "'";
   }
 
  private:
@@ -164,16 +178,20 @@ class Deriver {
   }
   void check_cap(const ModuleString& word) const {
     if (!past_cap(word)) return;
-    const std::string when = step_ == 0 ? std::string("the axiom")
-                                        : "derivation step " + std::to_string(step_) + " of " +
-                                              std::to_string(settings_.iterations);
+    const bool homomorphism = step_ > settings_.iterations;
+    const std::string when = step_ == 0     ? std::string("the axiom")
+                             : homomorphism ? "the homomorphism"
+                                            : "derivation step " + std::to_string(step_) + " of " +
+                                                  std::to_string(settings_.iterations);
     const bool modules = word.size() > settings_.max_modules;
     throw InputError(g_.sources.at(0) + ": " + when + " reached " +
                      (modules ? std::to_string(word.size()) + " modules, more than"
                               : std::to_string(word.params.size()) + " parameters, more than " +
                                     std::to_string(kParamsPerModule) + " x") +
                      " lsystem.max_modules = " + std::to_string(settings_.max_modules) +
-                     " (lower lsystem.iterations or raise lsystem.max_modules)");
+                     (homomorphism ? " (lower lsystem.iterations or the homomorphism's 'maximum depth:', or raise "
+                                     "lsystem.max_modules)"
+                                   : " (lower lsystem.iterations or raise lsystem.max_modules)"));
   }
 
   static void copy_module(const ModuleString& in, size_t i, ModuleString* out) {
@@ -239,13 +257,7 @@ class Deriver {
       if (word.symbols[k] != '?' || word.params_of(k).empty()) continue;
       const double label = word.params_of(k)[0];
       const int index = g_.lsystem_index(label);
-      if (index < 0) {
-        std::ostringstream value;
-        value << label;
-        throw InputError(g_.sources.at(0) + ": '?(" + value.str() + ", ...)' calls L-system " + value.str() + " " +
-                         (step_ == 0 ? std::string("in the axiom") : "while deriving step " + std::to_string(step_)) +
-                         ", but the file has no 'lsystem: " + value.str() + "'");
-      }
+      if (index < 0) throw InputError(g_.sources.at(0) + ": " + unknown_call(label));
       calls_.push_back(static_cast<uint32_t>(index));
     }
     return ls_ = &g_.lsystems[calls_.back()];
@@ -286,7 +298,7 @@ class Deriver {
       rule_ = &rule;
       const double weight = evaluate(g_.program, rule.probability, slots, random, variables_.data());
       if (weight < 0)
-        throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + std::to_string(weight)};
+        throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + number_text(weight)};
       weights_.resize(candidates + 1);
       chosen_.resize(candidates + 1);
       chosen_slots_.resize((candidates + 1) * kMaxSlots);
@@ -429,6 +441,11 @@ class Deriver {
         out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
                                        variables_.data()));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
+      // A call whose label is computed is checked where its rule writes it.
+      if (g_.calls && module.symbol == '?' && module.arity > 0) {
+        const double label = out->params[out->params.size() - module.arity];
+        if (g_.lsystem_index(label) < 0) throw InputError(g_.where(module.pos) + ": " + unknown_call(label) + rule_place());
+      }
     }
   }
 

@@ -488,28 +488,40 @@ class Parser {
     if (std::find(g_.file_defines.begin(), g_.file_defines.end(), name) != g_.file_defines.end())
       throw GrammarError{at, "'" + name + "' is already defined"};
     g_.file_defines.push_back(name);
-    for (const auto& entry : overrides_)
-      if (entry.first == name) return true;  // the scene's value wins
+    // The scene's value wins over a constant, even one that cannot be computed; a text macro
+    // it cannot replace (the text would be dropped for a number, silently).
+    const bool overridden = std::any_of(overrides_.begin(), overrides_.end(), [&](const auto& e) { return e.first == name; });
     const ExprScope scope{nullptr, &g_.defines, nullptr};
     const TextOrigin origin{body.start, &body.columns};
     const size_t code_size = g_.program.code.size(), constants = g_.program.constants.size();
+    auto forget_code = [&] {
+      g_.program.code.resize(code_size);
+      g_.program.code_pos.resize(code_size);
+      g_.program.constants.resize(constants);
+    };
     try {
       size_t pos = 0;
       const Expr expr = compile_expression(g_.program, body.text, &pos, origin, scope);
       double value = 0;
       if (pos == body.text.size() && g_.program.is_constant(expr, &value)) {
-        g_.defines.emplace_back(name, value);
+        if (!overridden) g_.defines.emplace_back(name, value);
+        else forget_code();
         return true;
       }
     } catch (const GrammarError& error) {
       // A constant that cannot be computed (division by zero...) is an error where it is
       // written; anything else is text.
-      if (error.message.find("division by zero") != std::string::npos || error.message.find("finite") != std::string::npos)
-        throw;
+      if (error.message.find("division by zero") != std::string::npos || error.message.find("finite") != std::string::npos) {
+        if (!overridden) throw;
+        forget_code();
+        return true;
+      }
     }
-    g_.program.code.resize(code_size);
-    g_.program.code_pos.resize(code_size);
-    g_.program.constants.resize(constants);
+    forget_code();
+    if (overridden)
+      throw GrammarError{at, "lsystem.defines gives '" + name + "' a value, but this #define is text (" +
+                                 excerpt(body.text) + "), not a constant: only a constant #define takes the scene's "
+                                 "value"};
     return false;
   }
 
@@ -811,6 +823,12 @@ class Parser {
     const size_t prob = find_last_top_level(text, arrow_end, end, ':');
     if (prob != kNone) {
       rule.probability = optional_expression(text, prob + 1, end, line, scope, "probability");
+      double weight = 0;
+      if (rule.probability.present() && g_.program.is_constant(rule.probability, &weight) && !(weight >= 0)) {
+        size_t at = prob + 1;
+        while (at < end && is_space(text[at])) ++at;
+        fail(line, at, "expected a probability >= 0, got " + number_text(weight));
+      }
       succ_end = prob;
     }
     size_t sb = arrow_end, se = succ_end;

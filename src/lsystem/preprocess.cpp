@@ -231,12 +231,12 @@ const Preprocessor::Macro* Preprocessor::find(const std::string& name,
 
 SourceLine Preprocessor::expand(const SourceLine& line) const {
   std::vector<const Macro*> expanding;
-  return expand_within(line, expanding);
+  return expand_within(line, expanding, 0);
 }
 
-SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const Macro*>& expanding) const {
+SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const Macro*>& expanding, int depth) const {
   if (macros_.empty()) return line;
-  if (expanding.size() > size_t(kMaxExpansion)) fail(line.start, "macros expand more than 32 levels deep");
+  if (depth > kMaxExpansion) fail(line.start, "macros expand more than 32 levels deep");
   SourceLine out;
   out.start = line.start;
   const std::string& t = line.text;
@@ -276,6 +276,11 @@ SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const
       if (args.size() != macro->parameters.size())
         fail(at, "macro '" + macro->name + "' expects " + std::to_string(macro->parameters.size()) + " arguments, got " +
                      std::to_string(args.size()));
+      // Each argument is expanded first, as cpp does, this macro still allowed in it: D(D(1)).
+      for (std::string& arg : args) {
+        const SourceLine whole{arg, std::vector<SourcePos>(arg.size(), at), at};
+        arg = expand_within(whole, expanding, depth + 1).text;
+      }
       SourceLine substituted;
       const std::string& b = macro->body.text;
       for (size_t q = 0; q < b.size();) {
@@ -301,7 +306,7 @@ SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const
     std::fill(body.columns.begin(), body.columns.end(), at);
     // The expansion is expanded again without this macro (cpp's rule against self-reference).
     expanding.push_back(macro);
-    const SourceLine expanded = expand_within(body, expanding);
+    const SourceLine expanded = expand_within(body, expanding, depth + 1);
     expanding.pop_back();
     out.text += expanded.text;
     out.columns.insert(out.columns.end(), expanded.columns.size(), at);

@@ -54,8 +54,9 @@ class Preprocessor {
   void directive(const std::string& name, const SourceLine& line, size_t hash);
   void define(const SourceLine& line, size_t begin);
   SourceLine expand(const SourceLine& line) const;
-  // `expanding`: the macros whose expansion this is, innermost last, which it does not expand again.
-  SourceLine expand_within(const SourceLine& line, std::vector<const Macro*>& expanding) const;
+  // `expanding`: the macros whose expansion this is, innermost last, which it does not expand
+  // again; `depth`: how many expansions (of a body or an argument) this one is nested in.
+  SourceLine expand_within(const SourceLine& line, std::vector<const Macro*>& expanding, int depth) const;
   const Macro* find(const std::string& name, const std::vector<const Macro*>& expanding) const;
 
   PreprocessHooks hooks_;

@@ -42,6 +42,29 @@ TEST(Cpfg, HeadersCommentsMacrosAndRulesOverLines) {
             "FFA(2)");
 }
 
+// A macro's arguments are expanded before they are put in, as cpp does, the macro itself
+// included (it is not expanding yet); its body is then expanded without it.
+TEST(Cpfg, MacroArgumentsAreExpandedFirst) {
+  EXPECT_EQ(derive_text("#define D(a) (a*2)\naxiom: F(D(D(1)))\n", 0), "F(4)");
+  EXPECT_EQ(derive_text("#define D(a) (a*2)\n#define E(a) D(a)+1\naxiom: F(E(D(3)))\n", 0), "F(13)");
+  EXPECT_EQ(derive_text("#define N 3\n#define D(a) (a*2)\naxiom: F(D(N))\n", 0), "F(6)");
+  std::string deep = "1";
+  for (int i = 0; i < 40; ++i) deep = "D(" + deep + ")";
+  EXPECT_NE(input_error_of([&] { parse("#define D(a) (a+1)\naxiom: F(" + deep + ")\n"); }).find("macros expand more than 32 levels deep"),
+            std::string::npos);
+}
+
+// A scene define replaces a constant #define, even one that cannot be computed, and refuses a
+// text one, which it would have dropped for a number.
+TEST(Cpfg, SceneDefinesReplaceConstantsOnly) {
+  const std::string grammar = "#define K F(2)\n#define L (1/0)\naxiom: F(1) K F(L)\n";
+  EXPECT_EQ(text_of(derive(parse_grammar({{"plant.l", "#define L (1/0)\naxiom: F(L)\n", false}}, {{"L", 3}}), {0, 1, 100})),
+            "F(3)");
+  EXPECT_EQ(input_error_of([&] { parse_grammar({{"plant.l", grammar, false}}, {{"K", 5}, {"L", 3}}); }),
+            "plant.l:1:9: lsystem.defines gives 'K' a value, but this #define is text (F(2)), not a constant: only a "
+            "constant #define takes the scene's value");
+}
+
 // Spaces may come between a module and its parameters, in the axiom, predecessors and successors.
 TEST(Cpfg, SpacesBeforeParameters) {
   EXPECT_EQ(derive_text("axiom: A (1)\nA (n) --> F (n) \\ (90) [ B] A(n + 1)\n", 1), "F(1)\\(90)[B]A(2)");
@@ -88,7 +111,7 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(error_of("axiom: A\nA --> B ?(3, 0.5) C $\n"),
             "plant.l:2:9: '?(3, ...)' calls L-system 3, but the file has no 'lsystem: 3' (it has 0)");
   EXPECT_EQ(error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
-            "plant.l: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4'");
+            "plant.l:3:10: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4' (rule at 3:1)");
   EXPECT_EQ(error_of("axiom: A\nA --> B(\"x\")\n"),
             "plant.l:2:9: a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
   EXPECT_EQ(error_of("axiom: A ?E(1)\n"),

@@ -244,7 +244,7 @@ TEST(Derive, NegativeProbabilityIsAnError) {
     run("axiom: A(1)\nA(x) --> B : x - 2\nA(x) --> C : 1\n", 1);
     FAIL() << "expected an error";
   } catch (const InputError& error) {
-    EXPECT_STREQ(error.what(), "g.lsys:2:14: expected a probability >= 0, got -1.000000 while deriving step 1 (rule at 2:1)");
+    EXPECT_STREQ(error.what(), "g.lsys:2:14: expected a probability >= 0, got -1 while deriving step 1 (rule at 2:1)");
   }
 }
 
