@@ -12,6 +12,8 @@ struct TreeBakeResult;
 
 struct BakeLog {
   std::FILE* notes = nullptr;  // resumes, removed checkpoints, warm-up periods; null: quiet
+  // Derivation step `step` of `steps` made `modules` modules (a grammar may derive for minutes).
+  std::function<void(int step, int steps, size_t modules)> grown_step;
   std::function<void(const PreparedTree&)> prepared = [](const PreparedTree&) {};  // grown and built
   std::function<void(long long total)> frames_begin = [](long long) {};  // the frame loop will simulate `total`
   std::function<void(long long done)> frame_done = [](long long) {};     // `done` frames of the loop are complete

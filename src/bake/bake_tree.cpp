@@ -243,7 +243,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   // built without its surface, and its model goes back as the samples are drawn, so the bake
   // holds the samples alone.
   const bool give_up_mesh = sampled && !plan.reads_mesh;
-  PreparedTree tree = prepare_tree(scene, give_up_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt);
+  PreparedTree tree = prepare_tree(scene, give_up_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt, log.grown_step);
   tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
   // From the outputs' locks on, a signal waits for the frame loop, which removes what they made.

@@ -17,10 +17,11 @@ Json to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()
 
 }  // namespace
 
-PreparedTree prepare_tree(const Scene& scene, MeshSurface surface) {
+PreparedTree prepare_tree(const Scene& scene, MeshSurface surface,
+                          const std::function<void(int step, int steps, size_t modules)>& grown_step) {
   PreparedTree tree;
   auto start = std::chrono::steady_clock::now();
-  tree.skeleton = grow_skeleton(scene.lsystem, &tree.growth);
+  tree.skeleton = grow_skeleton(scene.lsystem, &tree.growth, grown_step);
   tree.grow_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
   try {

@@ -14,9 +14,10 @@ namespace treeanim {
 
 BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std::filesystem::path& scene_file,
                          Verbosity verbosity)
-    : scene_(scene), config_(config), scene_file_(scene_file), verbosity_(verbosity) {
+    : scene_(scene), config_(config), scene_file_(scene_file), verbosity_(verbosity), growth_(verbosity, stderr) {
   const bool quiet = verbosity == Verbosity::kQuiet;
   log_.notes = quiet ? nullptr : stderr;
+  log_.grown_step = [this](int step, int steps, size_t modules) { growth_.update(step, steps, modules); };
   if (verbosity == Verbosity::kVerbose)
     log_.prepared = [](const PreparedTree& tree) {
       std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters; solver loops: %s\n",

@@ -36,6 +36,7 @@ class BakePrinter {
   std::filesystem::path scene_file_;
   Verbosity verbosity_;
   std::optional<Progress> progress_;
+  GrowthProgress growth_;
   BakeLog log_;
 };
 

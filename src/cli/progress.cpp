@@ -64,4 +64,14 @@ void Progress::finish() {
   if (enabled_ && terminal_) std::fprintf(out_, "\n");
 }
 
+void GrowthProgress::update(int step, int steps, size_t modules) {
+  if (!enabled_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (step == 1) next_ = now + std::chrono::seconds(2);
+  if (now < next_) return;
+  std::fprintf(out_, "growing: step %d of %d, %zu modules\n", step, steps, modules);
+  std::fflush(out_);
+  next_ = now + std::chrono::seconds(5);
+}
+
 }  // namespace treeanim

@@ -2,6 +2,7 @@
 // Progress of a bake on stderr: a redrawn bar with frames/s and ETA on a terminal, one line
 // about every 5% in a log (not a TTY), nothing when quiet.
 #include <chrono>
+#include <cstddef>
 #include <cstdio>
 
 namespace treeanim {
@@ -26,6 +27,20 @@ class Progress {
   int last_percent_step_ = 0;    // log mode: last 5% step printed (0%: nothing to say yet)
   double last_draw_ = -1;        // terminal mode: seconds at the last redraw
   std::chrono::steady_clock::time_point start_;
+};
+
+// Progress of a long derivation on stderr: "growing: step S of N, M modules" once a tree has
+// grown for 2 s, then every 5 s; nothing when quiet, or for a tree that grows sooner.
+class GrowthProgress {
+ public:
+  GrowthProgress(Verbosity verbosity, std::FILE* out) : out_(out), enabled_(verbosity != Verbosity::kQuiet) {}
+  // Derivation step `step` of `steps` made `modules` modules; step 1 starts a tree's clock.
+  void update(int step, int steps, size_t modules);
+
+ private:
+  std::FILE* out_;
+  bool enabled_;
+  std::chrono::steady_clock::time_point next_;  // when the next line is due
 };
 
 }  // namespace treeanim

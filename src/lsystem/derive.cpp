@@ -31,7 +31,7 @@ class Deriver {
 
   // Start, then per step StartEach / productions / decomposition / EndEach, then End (CPFG
   // manual 4.1).
-  ModuleString derive() {
+  ModuleString derive(const DerivationStepped& stepped) {
     ModuleString word;
     word.clear();
     run_block(g_.start_block);
@@ -44,6 +44,7 @@ class Deriver {
       std::swap(word, next);
       word = finish_step(std::move(word), step_);
       run_block(g_.end_each_block);
+      if (stepped) stepped(step_, word.size());
     }
     step_ = settings_.iterations;
     run_block(g_.end_block);
@@ -584,10 +585,10 @@ class Deriver {
 }  // namespace
 
 ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle,
-                    std::vector<double>* variables) {
+                    std::vector<double>* variables, const DerivationStepped& stepped) {
   Deriver deriver(grammar, settings, turtle);
   try {
-    ModuleString word = deriver.derive();
+    ModuleString word = deriver.derive(stepped);
     if (variables) *variables = deriver.variables();
     return word;
   } catch (const EvalError& error) {

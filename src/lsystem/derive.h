@@ -3,6 +3,7 @@
 // contexts, stochastic choice, decomposition after every step, homomorphism on demand.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "lsystem/grammar.h"
@@ -17,6 +18,9 @@ struct DerivationSettings {
   size_t max_modules = 20'000'000;   // InputError as soon as a string grows past this
 };
 
+// Told after each derivation step: its number and the modules it made (progress).
+using DerivationStepped = std::function<void(int step, size_t modules)>;
+
 // grammar + settings => the word after settings.iterations steps; decomposition rules are
 // applied to the axiom and after every step, and '%' removes the rest of its branch. When the
 // grammar writes query modules, the turtle interprets the word (through the homomorphism)
@@ -24,9 +28,10 @@ struct DerivationSettings {
 // Throws InputError at the module cap and on runtime errors (division by zero...), naming the
 // step and the production.
 // `turtle` is the one that answers the query modules. `variables`, when given, receives the
-// global variables as the End block leaves them (the homomorphism reads them).
+// global variables as the End block leaves them (the homomorphism reads them); `stepped`, when
+// set, is told of each step.
 ModuleString derive(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {},
-                    std::vector<double>* variables = nullptr);
+                    std::vector<double>* variables = nullptr, const DerivationStepped& stepped = {});
 
 // word => word with the homomorphism rules applied (what the turtle reads; the derivation
 // never sees it), its expressions reading `variables` (derive's; when null, their values

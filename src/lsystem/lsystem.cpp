@@ -135,13 +135,16 @@ bool seed_shapes_growth(const LsystemOptions& options) {
   return false;
 }
 
-Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats) {
+Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats,
+                       const std::function<void(int step, int steps, size_t modules)>& stepped) {
   const ViewSettings view = load_view(options);
   const Grammar grammar = load_grammar(options, view);
   const DerivationSettings settings = derivation_settings(options, grammar);
   const TurtleSettings turtle = turtle_settings(options, grammar, view);
   std::vector<double> variables;  // as the derivation leaves them, for the homomorphism (CPFG manual 4.3.1)
-  const ModuleString word = derive(grammar, settings, turtle, &variables);
+  DerivationStepped step_done;
+  if (stepped) step_done = [&](int step, size_t modules) { stepped(step, settings.iterations, modules); };
+  const ModuleString word = derive(grammar, settings, turtle, &variables, step_done);
   if (stats) {
     stats->modules = word.size();
     stats->iterations = settings.iterations;

@@ -1,6 +1,7 @@
 #pragma once
 // Stage entry point: L-system options => derived module string => turtle => Skeleton.
 #include <cstddef>
+#include <functional>
 
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -39,8 +40,10 @@ std::string grammar_name(const LsystemOptions& options);
 // draws (ran, nran, bran, biran); else every seed grows the same tree.
 bool seed_shapes_growth(const LsystemOptions& options);
 
-// options (grammar file or inline rules, defines, seed, step) => skeleton (scene units).
-// Throws InputError with file:line:column for grammar errors, and at the module cap.
-Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats);
+// options (grammar file or inline rules, defines, seed, step) => skeleton (scene units);
+// `stepped` is told of each derivation step: its number, of how many, and its modules. Throws InputError
+// with file:line:column for grammar errors, and at the module cap.
+Skeleton grow_skeleton(const LsystemOptions& options, GrowthStats* stats,
+                       const std::function<void(int step, int steps, size_t modules)>& stepped = {});
 
 }  // namespace treeanim

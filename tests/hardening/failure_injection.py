@@ -430,6 +430,17 @@ def interrupted_while_growing(bake):
         raise Failed("the output folder was made: %s" % folders_under(bake.out))
 
 
+def growth_reports_progress(bake):
+    """A derivation that runs for seconds says how far it is ("growing: step S of N, M modules")
+    while no frame has begun; a bake was silent until its tree was grown."""
+    grow = "{\"axiom\": \"A(0)\", \"productions\": [\"A(n) : n < 20 --> A(n+1)A(n+1)\", " \
+           "\"A(n) : n >= 20 --> A(n)\"], \"iterations\": 120, \"max_modules\": 2000000}"
+    done = subprocess.run([bake.binary, "run", bake.scene, "-o", bake.out, "--set", "time.frames=2",
+                           "--set", "lsystem=" + grow], capture_output=True, text=True, errors="replace", timeout=600)
+    if not re.search(r"growing: step \d+ of 120, 1048576 modules", done.stderr):
+        raise Failed("no growth progress in: " + done.stderr[-2000:])
+
+
 def folders_under(folder):
     """folder => every folder below it, itself included (relative paths); [] when absent."""
     return sorted(os.path.relpath(root, folder) for root, _, _ in os.walk(folder))
@@ -748,6 +759,7 @@ SCENARIOS = {
     "sighup": interrupted(signal.SIGHUP, 129, "SIGHUP"),  # a terminal closed under the bake
     "interrupted-removes-made-folders": interrupted_removes_made_folders,
     "interrupted-while-growing": interrupted_while_growing,
+    "growth-reports-progress": growth_reports_progress,
     "wind-file-deleted": wind_file_deleted,
     "wind-file-truncated": wind_file_truncated,
     "wind-file-deleted-mid-bake": wind_file_deleted_mid_bake,
