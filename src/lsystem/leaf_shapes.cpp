@@ -57,7 +57,9 @@ uint32_t root(std::vector<uint32_t>& parent, uint32_t v) {
 }
 
 // Welds points within tolerance of each other (each to the first of its set), drops the
-// triangles that collapse and the points no triangle uses. Deterministic: a sweep in x order.
+// triangles that collapse and the points no triangle uses. Deterministic: equal points joined
+// first (patches stacked on each other give thousands at one place, which the sweep would
+// compare pair by pair), then a sweep in x order over one point of each place.
 void weld(std::vector<Eigen::Vector3d>& points, std::vector<uint32_t>& triangles) {
   const uint32_t n = static_cast<uint32_t>(points.size());
   Eigen::Vector3d lo = points[0], hi = points[0];
@@ -69,13 +71,21 @@ void weld(std::vector<Eigen::Vector3d>& points, std::vector<uint32_t>& triangles
   std::vector<uint32_t> order(n), parent(n);
   std::iota(order.begin(), order.end(), 0u);
   std::iota(parent.begin(), parent.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return points[a].x() < points[b].x(); });
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i + 1; j < n && points[order[j]].x() - points[order[i]].x() <= tolerance; ++j)
-      if ((points[order[j]] - points[order[i]]).cwiseAbs().maxCoeff() <= tolerance) {
-        const uint32_t a = root(parent, order[i]), b = root(parent, order[j]);
-        parent[std::max(a, b)] = std::min(a, b);
-      }
+  auto join = [&](uint32_t i, uint32_t j) {
+    const uint32_t a = root(parent, i), b = root(parent, j);
+    parent[std::max(a, b)] = std::min(a, b);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return std::lexicographical_compare(points[a].data(), points[a].data() + 3, points[b].data(), points[b].data() + 3);
+  });
+  std::vector<uint32_t> places;  // the first point of each place, in x order
+  for (size_t i = 0; i < n; ++i) {
+    if (i > 0 && points[order[i]] == points[order[i - 1]]) join(order[i - 1], order[i]);
+    else places.push_back(order[i]);
+  }
+  for (size_t i = 0; i < places.size(); ++i)
+    for (size_t j = i + 1; j < places.size() && points[places[j]].x() - points[places[i]].x() <= tolerance; ++j)
+      if ((points[places[j]] - points[places[i]]).cwiseAbs().maxCoeff() <= tolerance) join(places[i], places[j]);
   std::vector<uint32_t> kept;
   kept.reserve(triangles.size());
   for (size_t t = 0; t < triangles.size(); t += 3) {

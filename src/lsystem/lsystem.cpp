@@ -1,5 +1,6 @@
 #include "lsystem/lsystem.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 
 #include "common/direction.h"
@@ -38,7 +39,14 @@ LeafShape view_surface_shape(const ViewSurface& v, std::optional<int> scene_prec
   const std::array<int, 2> quads = scene_precision ? std::array<int, 2>{*scene_precision, *scene_precision}
                                                    : v.precision.value_or(v.surface.precision.value_or(std::array<int, 2>{kDefaultQuads, kDefaultQuads}));
   LeafShape shape = surface_shape(v.surface, v.id, v.scale, quads[0], quads[1]);
-  if (shape.triangles.empty())
+  // No area: no triangle left, or only slivers along a line (a leaf without drag or mass).
+  double area = 0, extent = 0;
+  for (size_t t = 0; t < shape.triangles.size(); t += 3) {
+    const Eigen::Vector3d& a = shape.points[shape.triangles[t]];
+    area += 0.5 * (shape.points[shape.triangles[t + 1]] - a).cross(shape.points[shape.triangles[t + 2]] - a).norm();
+  }
+  for (const Eigen::Vector3d& p : shape.points) extent = std::max(extent, (p - shape.points[0]).cwiseAbs().maxCoeff());
+  if (!(area > 1e-9 * extent * extent))
     throw InputError(v.where + ": the surface '" + std::string(1, v.id) + "' has no area (every patch collapses to a line or a point)");
   return shape;
 }

@@ -196,6 +196,14 @@ TEST(SurfaceShape, PatchesAreWeldedAtTheirSharedEdges) {
   const LeafShape triangle = surface_shape(fan, 'l', 3, 2, 2);
   EXPECT_EQ(triangle.points.size(), 9u - 2u);
   EXPECT_EQ(triangle.triangles.size(), (8u - 2u) * 3);
+
+  // 6,000 patches stacked on one another weld into one patch's points (pair by pair the weld
+  // compared 726,000 points at one place, for minutes), their triangles kept, each doubled.
+  BezierSurface stack = test_surface();
+  stack.patches.assign(6000, stack.patches[0]);
+  const LeafShape stacked = surface_shape(stack, 'l', 3, 10, 10);
+  EXPECT_EQ(stacked.points.size(), 121u);
+  EXPECT_EQ(stacked.triangles.size(), 6000u * 200 * 3);
 }
 
 TEST(SurfaceShape, SphereAndDiscAreClosedOutwardAndFlatUpward) {

@@ -1,0 +1,16 @@
+-1.50 1.50   0.00 3.00   0.00 0.00
+PRECISION S: 3 T: 2
+CONTACT POINT  X: -1.50 Y: 0.00 Z: 0.00
+END POINT  X: -1.50 Y: 3.00 Z: 0.00
+HEADING  X: 0.00 Y: 1.00 Z: 0.00
+UP  X: 0.00 Y: 0.00 Z: 1.00
+SIZE: 3.00
+blade
+TOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00
+AL: ~ A: ~ AR: ~
+L: ~ R: ~
+BL: ~ B: ~ BR: ~
+0 0 0  1 0 0  2 0 0  3 0 0
+4 0 0  5 0 0  6 0 0  7 0 0
+8 0 0  9 0 0  10 0 0  11 0 0
+12 0 0  13 0 0  14 0 0  15 0 0
