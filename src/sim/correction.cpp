@@ -75,6 +75,7 @@ void gather_block(const SolverModel<Real>& model, const Attachment<Real>& attach
     block.moving[k] = still ? 0 : 1;
     block.drag[k] = still ? Real(0) : model.vertex_drag[v];
     block.half_damping[k] = still ? Real(1) : attachment.vertex_half_damping[v];
+    block.kick_scale[k] = still ? Real(1) : attachment.vertex_kick_scale[v];
     block.global[k] = still ? Real(0) : attachment.vertex_global[v];
     block.flying[k] = still ? Real(0) : Real(attachment.vertex_flying[v]);
     Eigen::Matrix<Real, 3, 1> pull = Eigen::Matrix<Real, 3, 1>::Zero();
@@ -117,13 +118,13 @@ std::pair<uint32_t, uint32_t> for_vertex_blocks(const SolverModel<Real>& model, 
     if (direct) {
       in = {{corrections[0] + begin, corrections[1] + begin, corrections[2] + begin},
             model.vertex_drag.data() + begin, attachment.vertex_half_damping.data() + begin,
-            attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
+            attachment.vertex_kick_scale.data() + begin, attachment.vertex_global.data() + begin, block.flying, {}, nullptr};
       std::fill(block.moving, block.moving + n, uint8_t(1));
       std::copy_n(attachment.vertex_flying.data() + begin, n, block.flying);
     } else {
       gather_block(model, attachment, state, scratch, pass, begin, n, block);
       in = {{block.pull[0], block.pull[1], block.pull[2]}, block.drag, block.half_damping,
-            block.global, block.flying, {}, nullptr};
+            block.kick_scale, block.global, block.flying, {}, nullptr};
     }
     for (int i = 0; i < 3; ++i) in.goal[i] = prediction.goal.col(i).data() + begin;
     std::copy_n(model.vertex_shape_kick.data() + begin, n, block.kicked);

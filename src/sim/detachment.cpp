@@ -47,6 +47,7 @@ void detach_leaf(const SolverModel<Real>& model, Attachment<Real>& a, size_t lea
     a.vertex_flying[v] = 1;
     a.vertex_global[v] = 0;  // the rest pose no longer holds a flying leaf
     a.vertex_half_damping[v] = 1;  // nor does a limb's damping: gravity and drag alone act on its flight
+    a.vertex_kick_scale[v] = 1;
   }
   a.leaf_attached[leaf] = 0;
 }

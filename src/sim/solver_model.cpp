@@ -323,7 +323,12 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   for (size_t c = 0; c < C; ++c) chain.cluster_compliance[c] *= rates.cluster_compliance_share[c];
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
   a.vertex_half_damping.resize(V);
-  for (size_t v = 0; v < V; ++v) a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
+  a.vertex_kick_scale.resize(V);
+  for (size_t v = 0; v < V; ++v) {
+    a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
+    const double x = -0.5 * std::log(rates.vertex_damping[v]);  // zeta omega h
+    a.vertex_kick_scale[v] = static_cast<Real>(x < 1e-4 ? 1 + x * x / 6 : std::sinh(x) / x);
+  }
   precompute_drag(*this, w);
   precompute_beam(*this, w);
   precompute_islands(*this);

@@ -93,6 +93,11 @@ struct Attachment {
   // (V) velocity factor per half step of the limb's structural damping (the step's damping is
   // two); 1 on a flying leaf, whose rigid flight no limb damps
   std::vector<Real> vertex_half_damping;
+  // (V) what the kick between those halves is scaled by, sinh(x) / x with e^-x the half step's
+  // factor: the damped step then moves a vertex under a steady force as far as the force and
+  // the damping do together, (1 - e^-2x) / (2x) of the undamped kick (docs/solver.md,
+  // "Damping"); 1 where nothing damps
+  std::vector<Real> vertex_kick_scale;
   std::vector<Real> vertex_inv_count;      // (V) 1 / number of active memberships (0: none)
   std::vector<uint32_t> vertex_air_cluster;// (V) the cluster whose air velocity the vertex feels
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
