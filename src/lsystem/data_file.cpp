@@ -1,11 +1,17 @@
 // fscan's conversions (CPFG manual 5.4), with the semantics of C's fscanf for numbers.
 #include "lsystem/data_file.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <string>
 
 namespace treeanim {
+
+bool names_a_file_beside(const std::filesystem::path& name) {
+  return !name.empty() && !name.is_absolute() &&
+         std::none_of(name.begin(), name.end(), [](const std::filesystem::path& part) { return part == ".."; });
+}
 
 namespace {
 

@@ -4,10 +4,15 @@
 // as C's fscanf does.
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <string_view>
 
 namespace treeanim {
+
+// A file a grammar or view file names (fopen, surface:, curve:) => whether it stands beside it, a
+// relative path without '..': a scene from elsewhere reads nothing outside its folders.
+bool names_a_file_beside(const std::filesystem::path& name);
 
 // One fopen of a grammar: the file's text and the global variable holding its read offset.
 struct DataFile {

@@ -187,7 +187,7 @@ class Parser {
       const std::filesystem::path path(name);
       if (at.line == 0)
         throw GrammarError{at, "fopen reads a file beside the grammar file; an inline grammar has none"};
-      if (path.empty() || path.is_absolute() || std::any_of(path.begin(), path.end(), [](const auto& p) { return p == ".."; }))
+      if (!names_a_file_beside(path))
         throw GrammarError{at, "fopen(\"" + name + "\") names a file outside the grammar's folder: a grammar reads only "
                                "files beside it (a relative path without '..')"};
       const std::filesystem::path resolved = std::filesystem::path(g_.sources.at(static_cast<size_t>(at.source))).parent_path() / path;

@@ -13,6 +13,7 @@
 #include "common/direction.h"
 #include "common/errors.h"
 #include "common/read_text_file.h"
+#include "lsystem/data_file.h"
 
 namespace treeanim {
 
@@ -154,6 +155,13 @@ std::optional<Movement> read_movement(const std::string& name, size_t line, cons
   return m;
 }
 
+// A file named on line `line` of view file `name` => refused unless it stands beside it.
+void check_beside(const std::string& name, size_t line, const std::string& file) {
+  if (!names_a_file_beside(file))
+    fail(name, line, "'" + file + "' names a file outside the view file's folder: a view file reads only files beside "
+                     "it (a relative path without '..')");
+}
+
 // "id file.s scale [i j] [texture]" of the view file's line `line` => the surface with its
 // file read, or nothing when that file does not exist (cpfg then leaves the surface out).
 std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, size_t line, const std::string& rest) {
@@ -163,6 +171,7 @@ std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, 
   in >> id >> file;
   if (id.size() != 1) fail(name, line, "expected a one-letter surface id after 'surface:'");
   if (file.empty()) fail(name, line, "expected 'surface: id file.s scale' (the file name after the id)");
+  check_beside(name, line, file);
   ViewSurface out;
   out.id = id[0];
   out.where = name + ":" + std::to_string(line + 1) + ":1";
@@ -260,6 +269,7 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       in >> file;
       if (!(in >> samples)) samples = 100;  // cpfg's default
       if (samples < 2 || samples > 1'000'000) fail(name, i, "expected 2 ... 1000000 samples after the curve file");
+      check_beside(name, i, file);
       view.curves.push_back(read_view_curve(path.parent_path() / file, samples));
     } else if (key == "function" || key == "function set") {
       std::istringstream in(rest);

@@ -1,0 +1,2 @@
+angle increment: 20
+curve: ../curve.dat 10

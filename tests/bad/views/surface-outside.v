@@ -1,0 +1,2 @@
+angle increment: 20
+surface: l /etc/passwd 1
