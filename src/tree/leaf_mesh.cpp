@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <span>
@@ -62,6 +63,27 @@ void append_ai_mesh(const aiMesh& mesh, std::vector<Eigen::Vector3d>& points,
     if (face.mNumIndices != 3) continue;  // points and lines of the file carry no area
     for (unsigned k = 0; k < 3; ++k) triangles.push_back(first + face.mIndices[k]);
   }
+}
+
+// A scene's meshes, their node transforms applied => scaled about the origin so that their
+// largest extent is 1 (left as they are when it is 0 or not finite: refused later).
+void scale_to_unit_size(const aiScene& scene) {
+  ai_real lo[3], hi[3];
+  bool any = false;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+    for (unsigned v = 0; v < scene.mMeshes[m]->mNumVertices; ++v)
+      for (int i = 0; i < 3; ++i) {
+        const ai_real x = scene.mMeshes[m]->mVertices[v][i];
+        lo[i] = any ? std::min(lo[i], x) : x;
+        hi[i] = any ? std::max(hi[i], x) : x;
+        any = any || i == 2;
+      }
+  if (!any) return;
+  const double extent = std::max({double(hi[0]) - lo[0], double(hi[1]) - lo[1], double(hi[2]) - lo[2]});
+  if (!(extent > 0) || !std::isfinite(extent)) return;
+  const ai_real scale = ai_real(1 / extent);
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+    for (unsigned v = 0; v < scene.mMeshes[m]->mNumVertices; ++v) scene.mMeshes[m]->mVertices[v] *= scale;
 }
 
 // A PLY file (it starts "ply") whose header has no end_header line sends assimp's reader
@@ -134,6 +156,10 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   // of what is left once the parts a leaf does not use are dropped, then check_ai_meshes): a
   // damaged file whose faces point past its vertices or whose polygons are cut short is refused
   // here, where the triangulation asserted or crashed on it.
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot read leaf mesh: no such file");
+  if (!std::filesystem::is_regular_file(status)) throw InputError(file + ": cannot read leaf mesh: not a regular file");
   check_ply_header(file);
   const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);
   note_input_file(file);
@@ -141,8 +167,14 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   check_ai_meshes(*scene, file);
-  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                       aiProcess_JoinIdenticalVertices);
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  if (!scene || !scene->mRootNode)
+    throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
+  // The mesh is joined at unit size: assimp joins vertices closer than 1e-5 in the file's
+  // units, which took the corners of a leaf modelled 1e-5 across for one point; its size is
+  // the scene's (leaf.size) anyway.
+  scale_to_unit_size(*scene);
+  scene = importer.ApplyPostProcessing(aiProcess_JoinIdenticalVertices);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   std::vector<Eigen::Vector3d> points;

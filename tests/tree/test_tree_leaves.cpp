@@ -227,5 +227,28 @@ TEST(TreeLeaves, DamagedMeshIsAnInputErrorNamingTheFile) {
   std::filesystem::remove_all(dir);
 }
 
+// A leaf mesh is joined at unit size, whatever its file's units: a triangle modelled 1e-5 or
+// 1e-7 across keeps its three corners, as one 1 across does (assimp joined points closer than
+// 1e-5 in the file's units, so the small ones lost a corner, or were refused as of no extent).
+TEST(TreeLeaves, AMeshKeepsItsCornersAtAnySize) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("treeanim_small_leaf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  size_t vertices = 0;
+  for (const char* size : {"1", "1e-5", "1e-7"}) {
+    std::ofstream(dir / "t.obj") << "v 0 0 0\nv " << size << " 0 0\nv 0 " << size << " 0\nf 1 2 3\n";
+    TreeOptions o;
+    o.leaf.mesh = dir / "t.obj";
+    const TreeModel model = build_tree_model(test::small_tree(), o);
+    if (vertices == 0) vertices = model.vertex_count();
+    EXPECT_EQ(model.vertex_count(), vertices) << size;
+    for (size_t t = 0; t < model.triangle_count(); ++t) {
+      const uint32_t* corner = &model.triangles[3 * t];
+      EXPECT_TRUE(corner[0] != corner[1] && corner[1] != corner[2] && corner[0] != corner[2]) << size;
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace treeanim
