@@ -32,10 +32,11 @@ void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifes
     const BakePlan plan = plan_bake(one, tree_bake_config(config, id));
     targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, writes);
     targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, writes);
-    if (writes && plan.checkpoints.every > 0) {
+    // A complete tree's folder too: its spent checkpoints are removed from it.
+    if (plan.checkpoints.every > 0) {
       const std::string checkpoints = "the checkpoints of tree " + id;
       targets.add_folder(plan.checkpoints.dir, checkpoints);
-      targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), checkpoints);
+      if (writes) targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), checkpoints);
     }
   }
 }
@@ -108,9 +109,8 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     const BakeConfig own = tree_bake_config(config, tree.id);
     // Whole trees are the unit of a forest's restart: a finished tree's checkpoints are spent
     // (a bake killed between its part and their removal left them).
-    std::error_code ignored;
     if (complete[i]) {
-      if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
+      if (config.checkpoints.every > 0) remove_spent_checkpoints(own.checkpoints.dir);
       ++result.skipped;
       continue;
     }
@@ -124,7 +124,7 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     {
       const DeferredInterrupts deferred;  // the part is written whole, the spent checkpoints all removed
       write_tree_part(config, scene, trees[i], one, baked);
-      if (config.checkpoints.every > 0) fs::remove_all(own.checkpoints.dir, ignored);
+      if (config.checkpoints.every > 0) remove_spent_checkpoints(own.checkpoints.dir);
     }
     ++result.baked;
   }

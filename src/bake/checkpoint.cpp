@@ -182,6 +182,24 @@ fs::path checkpoint_path(const fs::path& dir, long long frame) {
   return dir / ("checkpoint-" + std::to_string(frame) + ".h5");
 }
 
+void remove_spent_checkpoints(const fs::path& dir) noexcept {
+  std::error_code error;
+  if (!fs::is_directory(fs::symlink_status(dir, error))) return;
+  auto spent = [](const std::string& name) {
+    auto between = [&](const std::string& prefix, const std::string& suffix) {
+      return name.size() > prefix.size() + suffix.size() && name.starts_with(prefix) && name.ends_with(suffix);
+    };
+    return between("checkpoint-", ".h5") || between("frames-from-", ".journal") ||
+           ((name.starts_with(".checkpoint-") || name.starts_with(".frames-from-")) &&
+            name.find(".tmp-") != std::string::npos);
+  };
+  std::vector<fs::path> removed;
+  for (fs::directory_iterator entry(dir, error), end; !error && entry != end; entry.increment(error))
+    if (spent(entry->path().filename().string()) && entry->is_regular_file(error)) removed.push_back(entry->path());
+  for (const fs::path& path : removed) fs::remove(path, error);
+  ::rmdir(dir.c_str());  // fails, harmlessly, on a folder that holds anything else
+}
+
 std::vector<std::pair<long long, fs::path>> list_checkpoints(const fs::path& dir) {
   std::vector<std::pair<long long, fs::path>> found;
   std::error_code error;

@@ -25,6 +25,11 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& dir, long lon
 // none when dir does not exist.
 std::vector<std::pair<long long, std::filesystem::path>> list_checkpoints(const std::filesystem::path& dir);
 
+// A finished bake's checkpoint folder => its checkpoints, frame journals and their temporaries
+// removed, then the folder when that empties it. Nothing else is touched: no other file in it,
+// nor what stands at `dir` when it is not a folder (a link, a file). Never throws.
+void remove_spent_checkpoints(const std::filesystem::path& dir) noexcept;
+
 // A model's sizes => an upper bound of one checkpoint's bytes: the state's vertex arrays (positions,
 // velocities and the step prediction's six) and cluster arrays in double, flags, and the HDF5 layout.
 double estimated_checkpoint_bytes(size_t vertices, size_t clusters, size_t leaves);

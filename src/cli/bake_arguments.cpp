@@ -27,8 +27,8 @@ FrameRange parse_frame_range(const std::string& text, long long first, long long
 
 Shard parse_shard(const std::string& text) {
   const std::string expected = "--shard '" + text +
-                               "': expected I/N with 0 <= I < N, the 0-based task of N (I may be 'auto', "
-                               "which reads $SLURM_ARRAY_TASK_ID)";
+                               "': expected I/N with 0 <= I < N <= 1000000 (farm --tasks' range), the 0-based task "
+                               "of N (I may be 'auto', which reads $SLURM_ARRAY_TASK_ID)";
   const size_t slash = text.find('/');
   if (slash == std::string::npos) throw InputError(expected);
   std::string index = text.substr(0, slash);
@@ -43,7 +43,8 @@ Shard parse_shard(const std::string& text) {
     return static_cast<size_t>(std::stoul(digits));
   };
   Shard shard{parse(index), parse(text.substr(slash + 1))};
-  if (shard.count == 0 || shard.index >= shard.count) throw InputError(expected);
+  // The plan of N tasks holds one list per task: a count past farm's is a slip, not a farm.
+  if (shard.count == 0 || shard.count > 1'000'000 || shard.index >= shard.count) throw InputError(expected);
   return shard;
 }
 

@@ -173,7 +173,11 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
     throw InputError(refused + "writes " + file.string() + ", the folder of " + owner->second);
   const auto [it, inserted] = writer_.emplace(absolute, writer);
   if (!inserted) throw InputError(refused + "writes " + file.string() + ", which " + it->second + " writes too");
+  if (const auto other = in_folder_.find(absolute); other != in_folder_.end())
+    throw InputError(refused + "writes " + file.string() + ", the folder " + other->second + " writes into");
   const std::string folder = absolute.substr(0, absolute.rfind('/'));
+  if (const auto other = writer_.find(folder); other != writer_.end())
+    throw InputError(refused + "writes into " + folder + ", which " + other->second + " writes as a file");
   if (const auto owner = owned_.find(folder); owner != owned_.end() && owner->second != writer)
     throw InputError(refused + "writes " + file.string() + ", in the folder of " + owner->second);
   in_folder_.emplace(folder, writer);

@@ -20,7 +20,7 @@ namespace {
 // True when `token` is a non-negative decimal integer (an array index in an override path).
 bool is_index(const std::string& token) {
   return !token.empty() && token.find_first_not_of("0123456789") == std::string::npos &&
-         token.size() < 10;
+         token.size() < 10 && (token.size() == 1 || token[0] != '0');  // "00" is no index, as in a JSON pointer
 }
 
 TimeOptions read_time_options(SceneObject section) {
@@ -138,7 +138,8 @@ void apply_override(Json& document, const std::string& assignment) {
     if (node->is_array()) {
       if (!is_index(token) || std::stoul(token) > node->size())
         throw InputError(shown + ": " + pointer + " is not an index of an array of " +
-                         std::to_string(node->size()) + " elements");
+                         std::to_string(node->size()) + " elements (0 ... " + std::to_string(node->size()) + ", " +
+                         std::to_string(node->size()) + " appending one)");
       const size_t index = std::stoul(token);
       if (index == node->size()) node->push_back(Json::object());
       node = &(*node)[index];

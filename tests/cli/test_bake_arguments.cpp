@@ -28,11 +28,12 @@ Scene line_scene(const std::string& extra = "") {
 TEST(BakeArguments, ParseShard) {
   EXPECT_EQ(parse_shard("3/8").index, 3u);
   EXPECT_EQ(parse_shard("3/8").count, 8u);
-  for (const char* bad : {"8/8", "1", "-1/4", "a/4", "0/0", "1/", "/4"})
+  EXPECT_EQ(parse_shard("999999/1000000").count, 1'000'000u);
+  for (const char* bad : {"8/8", "1", "-1/4", "a/4", "0/0", "1/", "/4", "15/1000001", "15/999999999"})
     EXPECT_EQ(error_of([&] { parse_shard(bad); }),
               std::string("--shard '") + bad +
-                  "': expected I/N with 0 <= I < N, the 0-based task of N (I may be 'auto', which reads "
-                  "$SLURM_ARRAY_TASK_ID)");
+                  "': expected I/N with 0 <= I < N <= 1000000 (farm --tasks' range), the 0-based task of N (I may be "
+                  "'auto', which reads $SLURM_ARRAY_TASK_ID)");
   setenv("SLURM_ARRAY_TASK_ID", "2", 1);
   EXPECT_EQ(parse_shard("auto/4").index, 2u);
   unsetenv("SLURM_ARRAY_TASK_ID");

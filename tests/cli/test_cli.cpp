@@ -115,7 +115,7 @@ TEST_F(Cli, InfoEstimatesEachOutput) {
   const double vertices = info["mesh"]["vertices"].get<double>(), triangles = info["mesh"]["triangles"].get<double>(),
                joints = info["model"]["clusters"].get<double>();
   EXPECT_EQ(outputs[0]["format"], "hdf5");
-  EXPECT_EQ(outputs[0]["bytes"].get<double>(), 5 * 12 * vertices + 36 * vertices + 12 * triangles);
+  EXPECT_EQ(outputs[0]["bytes"].get<double>(), 5 * 12 * vertices + 36 * vertices + 12 * triangles + 32768);
   EXPECT_EQ(outputs[1]["path"], "t.usda");
   const double usd_mesh = 40 * vertices + 36 * triangles;
   EXPECT_EQ(outputs[1]["bytes"].get<double>(), 5 * 36 * vertices + usd_mesh);

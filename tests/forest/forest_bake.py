@@ -344,8 +344,39 @@ def case_seeded(treeanim, tmp):
         raise Failed("the refused forest changed its output folder: %s" % sorted(folder_state(out)))
 
 
+def case_checkpoint_folders(treeanim, tmp):
+    """A complete tree's checkpoint folder, which --resume clears of spent checkpoints, where a
+    tree's output stands (checkpoints/{tree}); and a tree whose id makes its output the parts'
+    folder: refused (exit 2) before anything is written or removed. --resume removed the first
+    bake's outputs as spent checkpoints, then failed (exit 4); validate passed the second."""
+    scene = {"lsystem": {"axiom": "F", "iterations": 1}, "time": {"frames": 3},
+             "forest": {"trees": [{"id": "x"}, {"id": "b", "position": [5, 0, 0]}]},
+             "outputs": [{"format": "hdf5", "path": "checkpoints/{tree}"}]}
+    path = os.path.join(tmp, "collide.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    out = os.path.join(tmp, "out")
+    run(treeanim, "run", path, "-o", out, "-q")
+    before = folder_state(out)
+    done = run(treeanim, "run", path, "-o", out, "-q", "--checkpoint-every", "1", "--resume", check=False)
+    message = "writes %s, the folder of the checkpoints of tree x" % os.path.join(out, "checkpoints", "x")
+    if done.returncode != 2 or message not in done.stderr:
+        raise Failed("--resume: exit %d, expected 2 and %r: %s" % (done.returncode, message, done.stderr))
+    if folder_state(out) != before:
+        raise Failed("the refused --resume changed the output folder: %s" % sorted(folder_state(out)))
+    scene["forest"]["trees"][0]["id"] = "forest.parts"
+    scene["outputs"][0]["path"] = "{tree}"
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    for command in (["validate", path], ["run", path, "-o", os.path.join(tmp, "parts"), "-q"]):
+        done = run(treeanim, *command, check=False)
+        if done.returncode != 2 or "forest.parts" not in done.stderr:
+            raise Failed("%s of a tree named forest.parts: exit %d: %s" % (command[0], done.returncode, done.stderr))
+
+
 CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit,
-         "targets": case_targets, "locked": case_locked, "seeded": case_seeded}
+         "targets": case_targets, "locked": case_locked, "seeded": case_seeded,
+         "checkpoint-folders": case_checkpoint_folders}
 
 
 def main():

@@ -21,7 +21,7 @@ TEST(OutputEstimate, SizeEstimatesPerFormat) {
   auto with_normals = [](OutputOptions& o) { o.normals = true; };
   // What each writes once: the rest mesh (an HDF5's 36 bytes a vertex and 12 a triangle; a
   // GLB's 45 and 12; an OBJ file's lines), a skinned output's weights and joints.
-  const double hdf5_mesh = 36 * 100 + 12 * 50, glb_mesh = 45 * 100 + 12 * 50, usd_mesh = 40 * 100 + 36 * 50;
+  const double hdf5_mesh = 36 * 100 + 12 * 50 + 32768, glb_mesh = 45 * 100 + 12 * 50, usd_mesh = 40 * 100 + 36 * 50;
   const double obj_file = 54 * 100 + (2 + 3 * 2 * 4) * 50, obj_normals_file = 92 * 100 + (2 + 3 * 3 * 4) * 50;
   EXPECT_EQ(bytes("hdf5", plain), 4800 + hdf5_mesh);
   EXPECT_EQ(bytes("hdf5", [](OutputOptions& o) { o.quantize = 1e-3, o.velocities = o.normals = true; }),

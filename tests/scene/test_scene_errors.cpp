@@ -148,7 +148,7 @@ TEST(SceneOverrides, IndexesAndAppendsToArrays) {
     apply_override(document, "outputs.5.path=x");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "--set 'outputs.5.path=x': /outputs/5 is not an index of an array of 2 elements");
+    EXPECT_STREQ(e.what(), "--set 'outputs.5.path=x': /outputs/5 is not an index of an array of 2 elements (0 ... 2, 2 appending one)");
   }
 }
 
