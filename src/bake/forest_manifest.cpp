@@ -130,7 +130,7 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
                                        std::string& why) {
   const fs::path path = tree_part_path(out_dir, id);
   std::string text, reason;
-  if (!read_text_file(path, text, reason)) {
+  if (!read_text_file(path, text, reason, kMaxTextFileBytes, TextFileRole::kOwnOutput)) {
     why = "not baked (no " + path.string() + ")";
     return std::nullopt;
   }

@@ -8,7 +8,7 @@
 namespace treeanim {
 
 bool read_text_file(const std::filesystem::path& path, std::string& text, std::string& reason,
-                    std::uintmax_t max_bytes) {
+                    std::uintmax_t max_bytes, TextFileRole role) {
   text.clear();
   auto fail = [&](std::string why) {
     text.clear();
@@ -39,7 +39,7 @@ bool read_text_file(const std::filesystem::path& path, std::string& text, std::s
       if (!(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) text[kept++] = text[i];
     text.resize(kept);
   }
-  note_input_file(path);
+  if (role == TextFileRole::kInput) note_input_file(path);
   return true;
 }
 

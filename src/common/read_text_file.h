@@ -15,8 +15,11 @@ constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t(256) << 20;
 // pipe without end (/dev/zero) fails instead of filling memory; FIFOs and process
 // substitution still work. Text saved on Windows reads as on Linux: a UTF-8 byte-order mark at
 // the start is dropped and each CRLF line end becomes LF (lines are unchanged, and columns are
-// those an editor shows). A regular file read is noted as an input (common/input_files.h).
+// those an editor shows). A regular file read is noted as an input (common/input_files.h),
+// unless it is one of a bake's own outputs read back (kOwnOutput: a forest's parts and pages),
+// which the bake may write again.
+enum class TextFileRole { kInput, kOwnOutput };
 bool read_text_file(const std::filesystem::path& path, std::string& text, std::string& reason,
-                    std::uintmax_t max_bytes = kMaxTextFileBytes);
+                    std::uintmax_t max_bytes = kMaxTextFileBytes, TextFileRole role = TextFileRole::kInput);
 
 }  // namespace treeanim

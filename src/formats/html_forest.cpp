@@ -23,7 +23,7 @@ Eigen::Vector3d vector_of(const json& v) { return {v[0].get<double>(), v[1].get<
 // A tree's page => its bake, checked to plot the frames at `times` (the first tree's) when given.
 json tree_page_data(const ForestPageTree& tree, const json* times) {
   std::string text, reason;
-  if (!read_text_file(tree.page, text, reason))
+  if (!read_text_file(tree.page, text, reason, kMaxTextFileBytes, TextFileRole::kOwnOutput))
     throw OutputError(tree.page.string() + ": tree " + tree.id + "'s preview page cannot be read (" + reason + ")");
   json data = preview_page_data(text, tree.page.string());
   if (times && data.at("plot").at("time") != *times)

@@ -348,7 +348,8 @@ def case_checkpoint_folders(treeanim, tmp):
     """A complete tree's checkpoint folder, which --resume clears of spent checkpoints, where a
     tree's output stands (checkpoints/{tree}); and a tree whose id makes its output the parts'
     folder: refused (exit 2) before anything is written or removed. --resume removed the first
-    bake's outputs as spent checkpoints, then failed (exit 4); validate passed the second."""
+    bake's outputs as spent checkpoints, then failed (exit 4); validate passed the second. And a
+    resumed forest's parts, read back, are still its own to write."""
     scene = {"lsystem": {"axiom": "F", "iterations": 1}, "time": {"frames": 3},
              "forest": {"trees": [{"id": "x"}, {"id": "b", "position": [5, 0, 0]}]},
              "outputs": [{"format": "hdf5", "path": "checkpoints/{tree}"}]}
@@ -372,6 +373,15 @@ def case_checkpoint_folders(treeanim, tmp):
         done = run(treeanim, *command, check=False)
         if done.returncode != 2 or "forest.parts" not in done.stderr:
             raise Failed("%s of a tree named forest.parts: exit %d: %s" % (command[0], done.returncode, done.stderr))
+    # The parts --resume reads back are the bake's own files, not inputs it must leave alone: a
+    # changed scene rebakes every tree over them.
+    scene["forest"]["trees"][0]["id"] = "x"
+    scene["outputs"][0]["path"] = "t/{tree}.h5"
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    again = os.path.join(tmp, "again")
+    run(treeanim, "run", path, "-o", again, "-q")
+    run(treeanim, "run", path, "-o", again, "-q", "--set", "time.frames=4", "--checkpoint-every", "2", "--resume")
 
 
 CASES = {"shards": case_shards, "resume": case_resume, "plan": case_plan, "submit": case_submit,
