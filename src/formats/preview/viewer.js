@@ -26,9 +26,9 @@ style.textContent = `
   body { margin: 0; font: 13px system-ui, sans-serif; background: #f4f5f2; color: #222; }
   #view { position: relative; width: 100%; height: 62vh; min-height: 320px; }
   #view canvas { display: block; }
-  #bar { display: flex; gap: 10px; align-items: center; padding: 6px 10px; background: #e6e8e3; }
-  #bar input[type=range] { flex: 1; }
-  #clock { font-variant-numeric: tabular-nums; min-width: 15em; }
+  #bar { display: flex; flex-wrap: wrap; gap: 6px 10px; align-items: center; padding: 6px 10px; background: #e6e8e3; }
+  #bar input[type=range] { flex: 1 1 160px; min-width: 0; }
+  #clock { font-variant-numeric: tabular-nums; min-width: 13em; }
   #note { padding: 4px 10px; color: #8a4b00; }
   #plots { display: flex; flex-wrap: wrap; gap: 8px; padding: 8px 10px; }
   .plot { flex: 1 1 420px; min-width: 300px; margin: 0; background: #fff; border: 1px solid #ccd; }
