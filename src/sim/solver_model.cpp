@@ -326,7 +326,10 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   a.vertex_kick_scale.resize(V);
   for (size_t v = 0; v < V; ++v) {
     a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
-    const double x = -0.5 * std::log(rates.vertex_damping[v]);  // zeta omega h
+    // x = zeta omega h, at most 10 here: the scaled kick is taken before the second half step
+    // damps it by e^-x, so past that its product with the damping under- or overflows (float at
+    // one step a second: 0 x inf), where the creep it gives, 1 / (2x) of a kick, is slight anyway.
+    const double x = std::min(-0.5 * std::log(rates.vertex_damping[v]), 10.0);
     a.vertex_kick_scale[v] = static_cast<Real>(x < 1e-4 ? 1 + x * x / 6 : std::sinh(x) / x);
   }
   precompute_drag(*this, w);
