@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -119,6 +120,11 @@ FrameJournal FrameJournal::open(const fs::path& path, const JournalLayout& layou
   if (std::error_code error; fs::exists(path, error) && !fs::is_regular_file(path, error))
     throw InputError(path.string() + ": the frame journal is not a regular file");
   std::FILE* file = std::fopen(path.c_str(), "r+b");
+  // A journal the bake may not write cannot be continued; baking from the start instead would
+  // redo every frame it holds, where the user asked to resume.
+  if (!file && (errno == EACCES || errno == EPERM || errno == EROFS))
+    throw OutputError(io_failure(path, "cannot open the frame journal to continue it") +
+                      " (--resume appends to it: its folder must be writable)");
   if (!file) throw InputError(io_failure(path, "cannot open the frame journal"));
   FrameJournal journal(path, layout, file, 0);
   std::vector<unsigned char> header(kHeaderBytes);

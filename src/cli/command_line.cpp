@@ -238,6 +238,13 @@ int run_command_line(int argc, char** argv) {
   commands.info = add_info(app, args);
   commands.species = add_species(app, args);
   add_farm(app, args.farm, commands);
+  // CLI11 prints the version as it meets the flag, before it looks at the rest: `--version
+  // extra` printed it and exited 0, as if nothing else had been given.
+  for (int i = 1; i < argc && argc > 2; ++i)
+    if (std::string(argv[i]) == "--version") {
+      std::fprintf(stderr, "treeanim: --version takes no other arguments\n");
+      return kExitUsage;
+    }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

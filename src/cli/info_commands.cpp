@@ -53,6 +53,18 @@ void print_volume(const VolumeSummary& volume) {
               volume.last_frame, volume.layout.c_str(), bounds, volume.voxel_size, volume.largest_speed);
 }
 
+// A lone tree's scene => its tree, grown, after what run refuses before it simulates: two
+// outputs at one file, a folder or a device where one goes (the paths as run resolves them
+// without -o), then each output's own limits.
+PreparedTree prepare_checked_tree(const Scene& scene) {
+  const BakePlan plan = plan_bake(scene, BakeConfig{});
+  OutputTargets targets;
+  targets.add_outputs(scene.outputs, {}, plan.written.first, plan.written.count());
+  PreparedTree tree = prepare_tree(scene);
+  check_output_limits(scene.outputs, tree.model, bake_info(scene, plan, tree.model, nullptr));
+  return tree;
+}
+
 }  // namespace
 
 int validate_command(const std::filesystem::path& scene_file,
@@ -63,14 +75,7 @@ int validate_command(const std::filesystem::path& scene_file,
     shard_trees(scene, std::nullopt);  // grows one tree of each variant, and every tree a seed shapes
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
-    // What run refuses before it simulates: two outputs at one file, a folder or a device where
-    // one goes (the paths as run resolves them without -o), then each output's own limits.
-    const BakePlan plan = plan_bake(scene, BakeConfig{});
-    OutputTargets targets;
-    targets.add_outputs(scene.outputs, {}, plan.written.first, plan.written.count());
-    const PreparedTree tree = prepare_tree(scene);
-    check_output_limits(scene.outputs, tree.model, bake_info(scene, plan, tree.model, nullptr));
-    print_counts(tree_summary(scene, tree));
+    print_counts(tree_summary(scene, prepare_checked_tree(scene)));
   }
   if (scene.volume) print_volume(*scene.volume);
   std::printf("%s: OK\n", printable_text(scene_file.string()).c_str());
@@ -85,10 +90,12 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
     std::cout << scene.resolved.dump(2) << "\n";
     return 0;
   }
-  // A forest: the figures of its first tree.
+  // A forest: the figures of its first tree. Outputs that run would refuse are refused here
+  // too: figures of a bake that cannot run would say it can.
+  if (scene.forest) check_forest_writers(scene);
   const Scene first = scene.forest ? tree_scene(scene, 0) : Scene();
   const Scene& one = scene.forest ? first : scene;
-  const PreparedTree tree = prepare_tree(one);
+  const PreparedTree tree = scene.forest ? prepare_tree(one) : prepare_checked_tree(one);
   Json summary = tree_summary(one, tree);
   if (scene.forest) {
     summary["forest"] = {{"trees", scene.forest->trees.size()},

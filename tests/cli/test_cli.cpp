@@ -61,6 +61,8 @@ TEST_F(Cli, VersionAndHelp) {
 }
 
 TEST_F(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(run("--version extra").code, 2);
+  EXPECT_EQ(run("extra --version").code, 2);
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("frobnicate x").code, 2);
   EXPECT_EQ(run("run").code, 2);
@@ -202,6 +204,18 @@ TEST_F(Cli, ViewFileSurfaceIsTheLeafShapeAndBakes) {
   r = run("run " + scene.string() + " -o " + (dir_ / "out").string() + " --quiet");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "out/bake.h5"));
+}
+
+// info gives the figures of a bake: of one that run would refuse, it says why instead.
+TEST_F(Cli, InfoRefusesOutputsThatValidateRefuses) {
+  const fs::path scene = write("line.json", kLine);
+  const std::string twice = " --set 'outputs.1={\"format\": \"hdf5\", \"path\": \"bake.h5\"}'";
+  for (const char* command : {"validate ", "info ", "info --json "}) {
+    const Result r = run(command + scene.string() + twice);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.err.find("bake.h5"), std::string::npos) << command << r.err;
+  }
+  EXPECT_EQ(run("info " + scene.string()).code, 0);
 }
 
 TEST_F(Cli, SetOverridesASceneValue) {

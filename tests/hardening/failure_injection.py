@@ -356,6 +356,30 @@ def output_read_only_folder(bake):
     expect(bake.run(24), 4, "output failed: ", bake.out)
 
 
+def resume_from_a_read_only_folder(bake):
+    """--resume where the checkpoints' folder may not be written (a read-only bind mount as
+    root, its permissions otherwise): exit 4 naming the journal, before any output, rather than
+    bake every frame again from the start."""
+    checkpoints = os.path.join(bake.tmp, "checkpoints")
+    first = bake.run(60, ["--checkpoint-every", "10", "--checkpoint-dir", checkpoints, "--frames", "0:30"])
+    if first.returncode != 0:
+        raise Failed("the first part: exit %d: %s" % (first.returncode, first.stderr))
+    shutil.rmtree(bake.out)
+    if os.geteuid() == 0:
+        if subprocess.run(["mount", "--bind", checkpoints, checkpoints], capture_output=True).returncode:
+            print("skipped: bind mounts are not permitted here, and root ignores folder permissions")
+            return SKIP
+        bake.cleanups.append(lambda: subprocess.run(["umount", "-l", checkpoints]))
+        if subprocess.run(["mount", "-o", "remount,ro,bind", checkpoints], capture_output=True).returncode:
+            print("skipped: a bind mount cannot be made read-only here")
+            return SKIP
+    else:
+        os.chmod(checkpoints, 0o555)
+    for extra in ([], ["--checkpoint-every", "10"]):
+        expect(bake.run(60, extra + ["--checkpoint-dir", checkpoints, "--resume"]), 4,
+               "frames-from-0.journal: cannot open the frame journal to continue it", bake.out)
+
+
 def limit_file_size(ignore_sigxfsz, kib=100):
     """=> preexec function: a file-size limit (KiB), as a full disk or a quota gives."""
     def preexec():
@@ -743,6 +767,7 @@ SCENARIOS = {
     "output-through-folder-links": output_through_folder_links,
     "output-named-as-a-scratch": output_named_as_a_scratch,
     "output-read-only-folder": output_read_only_folder,
+    "resume-from-a-read-only-folder": resume_from_a_read_only_folder,
     "output-not-a-regular-file": output_not_a_regular_file,
     "output-symbolic-links-followed": output_symbolic_links_followed,
     "deep-scene-keeps-previous-bake": bad_scene_keeps_previous_bake(

@@ -296,6 +296,16 @@ function caption(figure, title, unit, series) {
     text.append(key);
   }
 }
+// The step of about `count` ticks over `span`: 1, 2 or 5 times a power of ten, so that the
+// ticks fall on round values.
+function tickStep(span, count) {
+  const rough = span / count, power = 10 ** Math.floor(Math.log10(rough));
+  return [1, 2, 5, 10].find((m) => m * power >= rough) * power;
+}
+// A tick's label: as many decimals as its step has, no more (0.25 reads 0.25, 10 reads 10).
+function tickLabel(value, step) {
+  return value.toFixed(Math.max(0, -Math.floor(Math.log10(step) + 1e-9)));
+}
 function drawPlot(canvas, series, cursorTime) {
   const dpr = window.devicePixelRatio || 1;
   const w = canvas.clientWidth, h = canvas.clientHeight;
@@ -306,21 +316,25 @@ function drawPlot(canvas, series, cursorTime) {
   const left = 48, right = 10, top = 10, bottom = 24;
   let ymax = 0;
   for (const s of series) for (const v of s.values) ymax = Math.max(ymax, v);
-  ymax = ymax > 0 ? ymax * 1.1 : 1;
+  // The axis ends on the first round tick 5 % or more above the largest value.
+  const top5 = ymax > 0 ? 1.05 * ymax : 1, ystep = tickStep(top5, 4);
+  ymax = Math.ceil(top5 / ystep - 1e-9) * ystep;
   const t0 = times[0], t1 = samples > 1 ? times[samples - 1] : t0 + 1;
   const x = (t) => left + ((t - t0) / (t1 - t0)) * (w - left - right);
   const y = (v) => h - bottom - (v / ymax) * (h - top - bottom);
   g.font = '11px system-ui, sans-serif';
   g.fillStyle = plotStyles.text;
   g.strokeStyle = plotStyles.grid;
-  for (let k = 0; k <= 4; ++k) {
-    const v = (ymax * k) / 4;
+  for (let k = 0; k * ystep <= ymax * (1 + 1e-9); ++k) {
+    const v = k * ystep;
     g.beginPath(); g.moveTo(left, y(v)); g.lineTo(w - right, y(v)); g.stroke();
-    g.fillText(v.toPrecision(2), 4, y(v) + 4);
+    g.fillText(tickLabel(v, ystep), 4, y(v) + 4);
   }
-  for (let k = 0; k <= 5; ++k) {
-    const t = t0 + ((t1 - t0) * k) / 5;
-    g.fillText(`${t.toFixed(1)} s`, Math.min(x(t) - 12, w - 36), h - 8);
+  // Time ticks on round times inside the bake's span (its last time is rarely one).
+  const tstep = tickStep(t1 - t0, 5);
+  for (let k = Math.ceil(t0 / tstep - 1e-9); k * tstep <= t1 + 1e-9 * tstep; ++k) {
+    const t = k * tstep;
+    g.fillText(`${tickLabel(t, tstep)} s`, Math.min(x(t) - 12, w - 36), h - 8);
   }
   for (const s of series) {
     g.strokeStyle = s.color;
