@@ -1,5 +1,10 @@
 #include "bake/bake_config.h"
 
+#include <cinttypes>
+#include <cstdio>
+#include <fstream>
+#include <vector>
+
 #include "bake/scene_hash.h"
 #include "treeanim_version.h"
 
@@ -7,8 +12,34 @@ namespace treeanim {
 
 std::string treeanim_generator() { return std::string("treeanim ") + TREEANIM_VERSION; }
 
+namespace {
+
+// A file => the FNV-1a of its bytes as 16 hex digits, or "absent" (no regular file: a volume's
+// frame pattern). Read each time: a forest's trees re-read kilobytes, and no cached digest can
+// miss an edit that kept the file's size and time.
+std::string file_digest(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return "absent";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "unreadable";
+  uint64_t hash = kFnv1aStart;
+  std::vector<char> chunk(1 << 16);
+  while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0)
+    hash = fnv1a64(hash, chunk.data(), size_t(in.gcount()));
+  char digest[24];
+  std::snprintf(digest, sizeof digest, "%016" PRIx64, hash);
+  return digest;
+}
+
+}  // namespace
+
 std::string bake_key(const Scene& scene, const std::string& generator) {
-  return scene_hash(scene.resolved.dump(2), generator);
+  // The resolved scene holds the paths of the files it names, not what they hold: each file's
+  // name and the hash of its bytes go after it, so that a grammar or a wind series edited
+  // between a kill and --resume is a new bake, not frames of the old one continued.
+  std::string text = scene.resolved.dump(2);
+  for (const std::filesystem::path& path : scene.input_paths) text += "\n" + path.string() + " " + file_digest(path);
+  return scene_hash(text, generator);
 }
 
 std::filesystem::path checkpoint_folder(const std::filesystem::path& out_dir, const std::filesystem::path& given) {

@@ -46,11 +46,15 @@ struct Subcommands {
   CLI::App* gather = nullptr;  // farm gather
 };
 
+// A path option given as '' names nothing: `-o ''` wrote into the working folder unasked.
+std::string non_empty_path(const std::string& path) { return path.empty() ? "expected a path, got ''" : ""; }
+
 CLI::App* add_run(CLI::App& app, Arguments& args) {
   CLI::App* run_app = app.add_subcommand("run", "Simulate a scene and write its outputs");
   run_app->add_option("scene", args.run.scene, "Scene file (JSON)")->required();
   run_app->add_option("-o,--out", args.run.out_dir,
-                      "Folder that relative output paths are resolved against (created if needed)");
+                      "Folder that relative output paths are resolved against (created if needed)")
+      ->check(non_empty_path);
   run_app->add_option("--frames", args.run.frames,
                       "Write only frames START:END (inclusive); the simulation still starts at "
                       "time.start");
@@ -64,7 +68,7 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
       ->check(CLI::Range(1LL, 1'000'000'000LL));
   run_app->add_option("--checkpoint-dir", args.run.checkpoint_dir,
                       "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)")
-      ->check([](const std::string& folder) { return folder.empty() ? std::string("expected a folder, got ''") : ""; });
+      ->check(non_empty_path);
   run_app->add_flag("--resume", args.run.resume,
                     "Continue from the newest usable checkpoint and complete every output; without "
                     "one, bake from the start");
@@ -131,7 +135,8 @@ void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
   submit->add_option("--engine", farm.engine, "slurm: write sbatch scripts and submit them; script: a plain shell script for any queue")
       ->required()->check(CLI::IsMember({"slurm", "script"}));
   submit->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(CLI::Range(1, 1'000'000));
-  submit->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)");
+  submit->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)")
+      ->check(non_empty_path);
   submit->add_flag("--no-space-check", farm.no_space_check,
                    "Submit even when the forest's estimated files exceed the output folder's free space (the "
                    "tasks then skip their own check too)");
@@ -157,13 +162,18 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
     sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE");
   }
   commands.plan->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(CLI::Range(1, 1'000'000));
-  commands.plan->add_option("--json", farm.json, "Also write the plan as JSON to this file");
+  commands.plan->add_option("--json", farm.json, "Also write the plan as JSON to this file")->check(non_empty_path);
   commands.plan->footer("Example:\n  treeanim farm plan configs/forest-demo.json --tasks 4 --json plan.json");
   add_farm_submit(commands.submit, farm);
-  commands.gather->add_option("-o,--out", farm.out_dir, "Output folder of the tasks (default: the working folder)");
-  commands.gather->add_option("--tasks", farm.tasks, "Tasks the forest was split into: name the task of each missing tree")
-      ->check(CLI::Range(1, 1'000'000));
-  commands.gather->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks");
+  commands.gather->add_option("-o,--out", farm.out_dir, "Output folder of the tasks (default: the working folder)")
+      ->check(non_empty_path);
+  CLI::Option* tasks =
+      commands.gather
+          ->add_option("--tasks", farm.tasks, "Tasks the forest was split into: name the task of each missing tree")
+          ->check(CLI::Range(1, 1'000'000));
+  commands.gather->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks")
+      ->check(non_empty_path)
+      ->needs(tasks);  // a log is named by its task, which --tasks decides
 }
 
 int dispatch(const Subcommands& commands, Arguments& args) {

@@ -3,6 +3,7 @@
 // `treeanim run SCENE --shard I/N -o OUT --checkpoint-every K --resume`, then one gather job.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <system_error>
 
@@ -190,6 +191,21 @@ double forest_bytes(const Scene& scene, const ForestEstimate& estimate, long lon
   return bytes;
 }
 
+// A path or --sbatch-arg the scripts write into comments and #SBATCH lines, where no quoting
+// holds: a line break there would end the line and run the rest as a command.
+void refuse_control_characters(const std::string& text, const std::string& what) {
+  const auto control = [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; };
+  if (std::none_of(text.begin(), text.end(), control)) return;
+  std::string shown;  // on one line, as printable_text would not put a line break
+  for (const char c : text) {
+    char escaped[5];
+    std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned char>(c));
+    shown += control(c) ? std::string(escaped) : std::string(1, c);
+  }
+  throw InputError(what + " " + printable_text(shown) + " holds a control character (a line break, a tab): the job "
+                   "scripts name it on comment and #SBATCH lines, which it would break; rename it");
+}
+
 }  // namespace
 
 int farm_submit_command(const FarmRequest& request) {
@@ -212,11 +228,16 @@ int farm_submit_command(const FarmRequest& request) {
   job.cpus = request.cpus_per_task;
   job.overrides = set_arguments(request.overrides);
   job.space_check = !request.no_space_check;
+  refuse_control_characters(job.scene.string(), "the scene");
+  refuse_control_characters(job.out.string(), "the output folder");
+  for (const std::string& arg : request.sbatch_args) refuse_control_characters(arg, "--sbatch-arg");
   if (job.space_check)
     check_free_space({{job.out / "forest.json", forest_bytes(scene, estimate, job.checkpoint_every)}});
 
   if (request.engine == "slurm") return submit_to_slurm(job, request);
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");
+  if (!request.sbatch_args.empty())
+    throw InputError("--sbatch-arg: only with --engine slurm (a plain script has no #SBATCH lines)");
   const fs::path script = job.farm / (job.name + ".sh");
   write_text_output(script, plain_script(job), true);
   // The commands as shell words, to copy as they are (a ' or $( in the path stays text).

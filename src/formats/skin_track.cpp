@@ -54,6 +54,7 @@ void add_skin_frame(const Skin& skin, const TreeModel& model, const float* posit
     frame_squared_error += error * error;
     track.largest_error = std::max(track.largest_error, error);
     track.squared_displacement += (baked - model.rest_positions.col(long(v))).squaredNorm();
+    track.squared_rounding += model.rest_positions.col(long(v)).squaredNorm() * 0x1p-48;
   }
   track.squared_error += frame_squared_error;
   track.frame_rms_error.push_back(model.vertex_count() ? std::sqrt(frame_squared_error / double(model.vertex_count()))
@@ -66,15 +67,21 @@ SkinError skin_error(const SkinTrack& track, size_t vertex_count) {
   const double samples = double(track.times.size()) * double(vertex_count);
   error.rms_displacement = samples > 0 ? std::sqrt(track.squared_displacement / samples) : 0.0;
   error.rms_error = samples > 0 ? std::sqrt(track.squared_error / samples) : 0.0;
-  error.relative_rms = error.rms_displacement > 0 ? error.rms_error / error.rms_displacement : 0.0;
-  error.relative_max = error.rms_displacement > 0 ? track.largest_error / error.rms_displacement : 0.0;
+  error.largest_error = track.largest_error;
+  error.still = track.squared_displacement <= 4 * track.squared_rounding;
+  error.relative_rms = error.still ? 0.0 : error.rms_error / error.rms_displacement;
+  error.relative_max = error.still ? 0.0 : track.largest_error / error.rms_displacement;
   return error;
 }
 
 std::string skin_error_report(const SkinError& error, size_t joints) {
   char text[200];
-  std::snprintf(text, sizeof text, "skinning error RMS %.2f %%, max %.2f %% of the RMS displacement, %zu joints",
-                100 * error.relative_rms, 100 * error.relative_max, joints);
+  if (error.still)
+    std::snprintf(text, sizeof text, "skinning error RMS %.3g m, max %.3g m, %zu joints (the tree rests in every frame)",
+                  error.rms_error, error.largest_error, joints);
+  else
+    std::snprintf(text, sizeof text, "skinning error RMS %.2f %%, max %.2f %% of the RMS displacement, %zu joints",
+                  100 * error.relative_rms, 100 * error.relative_max, joints);
   return text;
 }
 

@@ -20,6 +20,7 @@ struct SkinTrack {
   double squared_error = 0;               // m^2, summed over frames and vertices
   double largest_error = 0;               // m
   double squared_displacement = 0;        // m^2, baked - rest, summed over frames and vertices
+  double squared_rounding = 0;            // m^2, (|rest| 2^-24)^2, the same sums: float32's rounding of a still vertex
   std::vector<RigidMotion> motions;       // (J) scratch: the last frame's fitted motions
   std::vector<Eigen::Quaterniond> previous_rotation;  // (J) the last keys, for sign continuity
 };
@@ -35,12 +36,15 @@ void add_skin_frame(const Skin& skin, const TreeModel& model, const float* posit
 struct SkinError {
   double rms_displacement = 0;  // m, RMS of baked - rest
   double rms_error = 0;         // m, RMS of skinned - baked
-  double relative_rms = 0;      // rms_error / rms_displacement (0 without displacement)
+  double relative_rms = 0;      // rms_error / rms_displacement (0 when still)
   double relative_max = 0;      // largest error / rms_displacement
+  double largest_error = 0;     // m
+  bool still = false;           // no displacement past float32's rounding of the rest pose: no ratio means anything
 };
 SkinError skin_error(const SkinTrack& track, size_t vertex_count);
 
-// The run's summary line: "skinning error RMS 1.23 %, max 4.56 % of the RMS displacement, 12 joints".
+// The run's summary line: "skinning error RMS 1.23 %, max 4.56 % of the RMS displacement, 12 joints"
+// (of a tree that never moves, the errors in m).
 std::string skin_error_report(const SkinError& error, size_t joints);
 
 }  // namespace treeanim

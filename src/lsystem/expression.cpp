@@ -547,6 +547,11 @@ class Compiler {
     for (const Function& f : kFunctions)
       if (name == f.name) function = &f;
     if (!function) {
+      // cpfg's simulation and view functions (CPFG manual 5.6): a bake has neither to act on.
+      for (const char* cpfg : {"stop", "inblob", "vvXmin", "vvYmin", "vvZmin", "vvXmax", "vvYmax", "vvZmax"})
+        if (name == cpfg)
+          fail(start, "'" + name + "' (CPFG manual 5.6) is not supported: a bake derives lsystem.iterations steps "
+                      "and has no view volume (docs/grammar.md)");
       std::vector<std::string> names;
       for (const Function& f : kFunctions) names.emplace_back(f.name);
       const std::string near = suggestion(name, names);

@@ -9,6 +9,7 @@
 
 #include "lsystem/lsystem_options.h"
 #include "scene/scene_reader.h"
+#include "scene/species.h"
 #include "sim/sim_options.h"
 #include "tree/tree_options.h"
 
@@ -23,6 +24,10 @@ struct ForestVariant {
   HsmOptions hsm;          // the scene's /hsm, under the variant's species and its own /hsm
   std::string pointer;     // "/forest/variants/2" (messages)
   Json resolved;           // the variant's resolved object (what a tree's own scene records)
+  // A species variant: the species and the height it grows to at a tree's scale 1; a tree's
+  // scale keeps it within the species' range of heights, as /tree/scale does a lone tree.
+  const Species* species = nullptr;
+  double height = 0;       // m
 };
 
 // One tree of the forest.

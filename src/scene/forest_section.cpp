@@ -1,6 +1,7 @@
 // /forest => variants and placed trees (docs/scene.md "forest").
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -56,7 +57,11 @@ ForestVariant read_variant(SceneObject element, const ForestDefaults& defaults) 
   else
     element.fail("lsystem", "expected the variant's grammar (an object like /lsystem, or a species): the scene has "
                             "no top-level /lsystem for it to fall back to");
-  if (species) check_species_scale(*species, element.object("tree"));
+  if (species) {
+    check_species_scale(*species, element.object("tree"));
+    variant.species = species->species;
+    variant.height = species->height;
+  }
   variant.tree = element.has("tree") || species
                      ? read_tree_options(element.object("tree"), species ? species_tree(*species) : TreeOptions{})
                      : *defaults.tree;
@@ -97,6 +102,21 @@ std::vector<ForestVariant> read_variants(SceneObject& section, const ForestDefau
   return variants;
 }
 
+// A tree's scale (or a scatter's [lo, hi], `key` of `where`) and the variants it may take =>
+// nothing, or the refusal of a scale that grows a species past its range of heights.
+void check_species_scales(SceneObject& where, const char* key, double lo, double hi,
+                          const std::vector<const ForestVariant*>& variants) {
+  for (const ForestVariant* v : variants) {
+    if (!v->species) continue;
+    const double height = (v->height * lo < v->species->min_height ? lo : hi) * v->height;
+    if (height < v->species->min_height || height > v->species->max_height)
+      where.fail(key, range_text(*v->species) + number_text(height) + " m for variant \"" + v->name + "\" (" +
+                          number_text(v->height) + " m at scale 1): give a scale from " +
+                          number_text(inward(v->species->min_height / v->height, true)) + " to " +
+                          number_text(inward(v->species->max_height / v->height, false)));
+  }
+}
+
 // "0007": index i of a forest of `total` trees, zero-padded to at least 4 digits.
 std::string padded_id(size_t i, size_t total) {
   const size_t width = std::max<size_t>(4, std::to_string(total > 0 ? total - 1 : 0).size());
@@ -123,6 +143,7 @@ ForestTree read_listed_tree(SceneObject element, size_t index, size_t total, con
   tree.position = element.vector3("position", Eigen::Vector3d::Zero(), kGround);
   tree.rotation = element.number("rotation", 0, kTurn);
   tree.scale = element.number("scale", 1, kTreeScale);
+  check_species_scales(element, "scale", tree.scale, tree.scale, {&*found});
   RandomStream random{scene_seed ^ 0x7472656573656564ull ^ (uint64_t(index) << 20)};  // "treeseed", by index
   tree.seed = static_cast<uint64_t>(
       element.integer("seed", static_cast<long long>(random.next_u64() & kSeedMask), 0, 1LL << 53));
@@ -238,15 +259,26 @@ Forest read_forest(SceneObject section, const ForestDefaults& defaults) {
   }
   if (scatter) {
     const ScatterSettings settings = read_scatter(*scatter, defaults.seed);
+    std::vector<const ForestVariant*> drawn;  // the variants a scattered tree may be
+    for (const ForestVariant& v : forest.variants)
+      if (v.weight > 0) drawn.push_back(&v);
+    if (scatter_count > 0) check_species_scales(*scatter, "scale", settings.scale[0], settings.scale[1], drawn);
     if (scatter_count > 0) scatter_trees(*scatter, settings, scatter_count, forest);
   }
 
+  // Ids name files, and a farm's file system may not tell "a" from "A" (macOS, Windows).
   std::unordered_map<std::string, size_t> ids;
   for (size_t i = 0; i < forest.trees.size(); ++i) {
-    const auto [it, inserted] = ids.emplace(forest.trees[i].id, i);
-    if (!inserted)
-      section.fail("trees", "two trees have the id \"" + it->first + "\" (" + forest.trees[it->second].pointer +
-                                " and " + forest.trees[i].pointer + "): ids name the trees' files, give each its own");
+    std::string folded = forest.trees[i].id;
+    for (char& c : folded) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const auto [it, inserted] = ids.emplace(folded, i);
+    if (inserted) continue;
+    const std::string& other = forest.trees[it->second].id;
+    section.fail("trees", (other == forest.trees[i].id ? "two trees have the id \"" + other + "\""
+                                                       : "two trees have the ids \"" + other + "\" and \"" +
+                                                             forest.trees[i].id + "\", alike but for letter case") +
+                              " (" + forest.trees[it->second].pointer + " and " + forest.trees[i].pointer +
+                              "): ids name the trees' files, give each its own");
   }
   return forest;
 }

@@ -46,7 +46,7 @@ OutputOptions read_output_options(SceneObject element) {
   options.pointer = element.pointer();
   std::vector<std::string> formats;
   for (const OutputFormatRow& row : output_formats()) formats.emplace_back(row.name);
-  if (!element.has("format")) {
+  if (!element.raw("format")) {  // null is absent (docs/scene.md), as everywhere
     std::string listed;
     for (const std::string& format : formats) listed += (listed.empty() ? "" : ", ") + format;
     element.fail("format", "required (one of " + listed + ")");

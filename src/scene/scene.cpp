@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "common/errors.h"
@@ -192,6 +193,9 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   check_tree_placeholders(scene, reader);
   reader.check_unknown_keys();
   if (scene.wind.volume) scene.volume = check_volume(reader, scene);
+  scene.input_paths = reader.paths();
+  std::sort(scene.input_paths.begin(), scene.input_paths.end());
+  scene.input_paths.erase(std::unique(scene.input_paths.begin(), scene.input_paths.end()), scene.input_paths.end());
   return scene;
 }
 

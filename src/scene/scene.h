@@ -38,6 +38,9 @@ struct Scene {
   std::vector<OutputOptions> outputs;
   std::optional<Forest> forest;  // /forest: many trees; none = the one tree of /lsystem
   std::optional<VolumeSummary> volume;  // /wind/volume checked over the bake's times: what `info` prints
+  // The files the scene names (grammars, views, wind series, leaf meshes, volume patterns),
+  // sorted, each once: their contents key a bake (bake_key), as the resolved scene holds only paths.
+  std::vector<std::filesystem::path> input_paths;
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a

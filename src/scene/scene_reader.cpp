@@ -193,6 +193,7 @@ std::optional<std::filesystem::path> SceneObject::optional_path(const std::strin
   std::filesystem::path p(*text);
   if (!p.is_absolute()) p = (reader_->scene_dir() / p).lexically_normal();
   note_input_file(p);  // a scene's paths name its inputs, which no output may replace: a forest looks before it grows
+  reader_->note_path(p);
   return p;
 }
 

@@ -110,6 +110,9 @@ class SceneReader {
   // Called by SceneObject: marks key valid for the object at pointer.
   void register_key(const std::string& object_pointer, const std::string& key);
   void register_object(const std::string& object_pointer);
+  // Called by SceneObject::optional_path: the files the scene names, in the order read.
+  void note_path(const std::filesystem::path& path) { paths_.push_back(path); }
+  const std::vector<std::filesystem::path>& paths() const { return paths_; }
 
  private:
   void check_object(const Json& node, const std::string& pointer) const;
@@ -117,6 +120,7 @@ class SceneReader {
   std::filesystem::path scene_dir_;
   std::string source_name_;
   std::map<std::string, std::vector<std::string>> valid_keys_;  // object pointer => keys
+  std::vector<std::filesystem::path> paths_;
 };
 
 // Compact one-line rendering of a JSON value for messages (strings quoted, long values cut).

@@ -135,6 +135,10 @@ HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
   o.max_frequency = section.number("max_frequency", o.max_frequency, kSolverFrequency);
   o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, kSolverFrequency);
   o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::between(0, 1.5e7));
+  if (o.min_limb_frequency > o.max_limb_frequency)  // which bound would win is no one's guess to make
+    section.fail("min_limb_frequency", "the floor " + number_text(o.min_limb_frequency) +
+                                           " rad/s is above max_limb_frequency, " + number_text(o.max_limb_frequency) +
+                                           " rad/s: expected a floor at or below the cap");
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
   o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::between(0, 1e4));
   o.gravity = section.vector3("gravity", o.gravity, Range::between(-100, 100));

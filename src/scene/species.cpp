@@ -121,20 +121,20 @@ std::optional<double> given_scale(SceneObject& parent) {
 // A height => whether the species grows to it in the field (its range).
 bool outside_range(const Species& s, double height) { return height < s.min_height || height > s.max_height; }
 
-// A bound of a range at six significant digits, as messages write numbers, rounded into the
-// range (up for its lower end, down for its upper): the rounded upper bound of a scale was refused.
-double inward(double bound, bool lower) {
-  if (bound == 0 || !std::isfinite(bound)) return bound;
-  const double unit = std::pow(10.0, std::floor(std::log10(std::fabs(bound))) - 5);
-  return (lower ? std::ceil(bound / unit) : std::floor(bound / unit)) * unit;
-}
+}  // namespace
 
-// => "English oak (english_oak) grows from 10 to 40 m, got ", for a refusal outside it.
 std::string range_text(const Species& s) {
   return s.common + " (" + s.name + ") grows from " + number_text(s.min_height) + " to " + number_text(s.max_height) + " m, got ";
 }
 
-}  // namespace
+double inward(double bound, bool lower) {
+  if (bound == 0 || !std::isfinite(bound)) return bound;
+  const double unit = std::pow(10.0, std::floor(std::log10(std::fabs(bound))) - 5);
+  // A bound of six digits already (a scale of 1) stays as it is, whatever its quotient's round-off.
+  const double units = bound / unit, nearest = std::round(units);
+  if (std::abs(units - nearest) <= 1e-9 * std::abs(units)) return bound;
+  return (lower ? std::ceil(units) : std::floor(units)) * unit;
+}
 
 const std::vector<Species>& species_library() {
   static const std::vector<Species> library = parse_library();

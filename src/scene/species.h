@@ -26,6 +26,12 @@ struct Species {
   Json sources;         // where the wood, leaf and architecture values come from
 };
 
+// => "English oak (english_oak) grows from 10 to 28 m, got ", for a refusal outside its range.
+std::string range_text(const Species& s);
+// A bound of a range at six significant digits, as messages write numbers, rounded into the
+// range (up for its lower end, down for its upper): the rounded upper bound of a scale was refused.
+double inward(double bound, bool lower);
+
 // Every species, in the table's order (parsed once; a malformed table is a build defect).
 const std::vector<Species>& species_library();
 

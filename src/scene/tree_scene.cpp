@@ -30,6 +30,7 @@ Scene tree_scene(const Scene& forest_scene, size_t index) {
   scene.wind = forest_scene.wind;
   scene.time = forest_scene.time;
   scene.outputs = forest_scene.outputs;
+  scene.input_paths = forest_scene.input_paths;  // the whole forest's: a changed grammar of one variant rebakes all
   for (OutputOptions& output : scene.outputs) {
     std::string path = output.path.string();
     for (size_t at; (at = path.find(kTreePlaceholder)) != std::string::npos;)

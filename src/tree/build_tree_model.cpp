@@ -93,6 +93,10 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
       spread(model, c, leaves.area[l], is_leaf, model.vertex_drag_area);
     }
   }
+  // Below the floor everywhere: segments of no length (F(0), a step of 1e-300) and no leaf, a
+  // tree of floors alone whose motion would mean nothing.
+  if (std::none_of(model.vertex_mass.begin(), model.vertex_mass.end(), [](double m) { return m >= kMinVertexMass; }))
+    throw TreeModelError("the tree has no mass: its segments have no length and it has no leaf");
   for (double& m : model.vertex_mass) m = std::max(m, kMinVertexMass);
   anchor(rings, leaves, uint32_t(options.ring_sides), model);
 }

@@ -93,6 +93,26 @@ TEST_F(BakeStages, PlanOfAFrameRange) {
   EXPECT_FALSE(whole.use_checkpoints);
 }
 
+// The scene names its grammar and wind series by path: their bytes are part of the key, so a
+// checkpoint of the old files is not resumed with the new ones.
+TEST_F(BakeStages, TheKeyHoldsWhatTheNamedFilesHold) {
+  std::ofstream(dir_ / "g.lsys") << "Axiom: FF\n";
+  std::ofstream(dir_ / "wind.csv") << "time,speed,dx,dy,dz\n0,4,1,0,0\n";
+  const char* scene = R"({"lsystem": {"grammar": "g.lsys"}, "time": {"frames": 2},
+    "wind": {"file": "wind.csv"}, "outputs": []})";
+  auto key = [&] { return bake_key(load_scene_text(scene, "s.json", dir_, {}), treeanim_generator()); };
+  const std::string first = key();
+  EXPECT_EQ(key(), first);
+  std::ofstream(dir_ / "g.lsys") << "Axiom: FFF\n";
+  const std::string grammar = key();
+  EXPECT_NE(grammar, first);
+  std::ofstream(dir_ / "wind.csv") << "time,speed,dx,dy,dz\n0,5,1,0,0\n";
+  EXPECT_NE(key(), grammar);
+  std::ofstream(dir_ / "g.lsys") << "Axiom: FF\n";
+  std::ofstream(dir_ / "wind.csv") << "time,speed,dx,dy,dz\n0,4,1,0,0\n";
+  EXPECT_EQ(key(), first);  // the same bytes, the same bake
+}
+
 TEST_F(BakeStages, StartFreshThenFromACheckpoint) {
   const Scene line = scene();
   BakeConfig resume = config();

@@ -218,6 +218,17 @@ TEST_F(Cli, InfoRefusesOutputsThatValidateRefuses) {
   EXPECT_EQ(run("info " + scene.string()).code, 0);
 }
 
+// The job scripts name the scene on comment lines, where a line break would start a command.
+TEST_F(Cli, FarmScriptsRefuseALineBreakInAPath) {
+  const std::string forest = R"({"lsystem": {"axiom": "F", "iterations": 0}, "time": {"frames": 2},
+    "forest": {"trees": [{}]}, "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]})";
+  const fs::path scene = write("nl\ntouch injected\n.json", forest);
+  const Result r = run("farm submit '" + scene.string() + "' --engine script --tasks 1 -o " + (dir_ / "out").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("nl\\x0atouch injected\\x0a.json holds a control character"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
 TEST_F(Cli, SetOverridesASceneValue) {
   const fs::path scene = write("line.json", kLine);
   const Result r = run("info --json " + scene.string() + " --set lsystem.axiom=FFFFF");
