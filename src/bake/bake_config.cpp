@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <fstream>
+#include <string>
 #include <vector>
 
 #include "bake/scene_hash.h"
@@ -14,12 +15,20 @@ std::string treeanim_generator() { return std::string("treeanim ") + TREEANIM_VE
 
 namespace {
 
-// A file => the FNV-1a of its bytes as 16 hex digits, or "absent" (no regular file: a volume's
-// frame pattern). Read each time: a forest's trees re-read kilobytes, and no cached digest can
-// miss an edit that kept the file's size and time.
+// What a file past this many bytes is known by instead of its bytes: its size and time (a
+// volume of one file for all time may hold gigabytes, read again for each tree of a forest).
+constexpr uintmax_t kHashedBytes = uintmax_t(64) << 20;
+
+// A file => the FNV-1a of its bytes as 16 hex digits; past kHashedBytes, its size and time;
+// "absent" where no regular file stands (a volume's frame pattern). Read each time: a forest's
+// trees re-read kilobytes, and no cached digest can miss an edit that kept the file's size and time.
 std::string file_digest(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) return "absent";
+  if (const uintmax_t size = std::filesystem::file_size(path, error); !error && size > kHashedBytes) {
+    const auto time = std::filesystem::last_write_time(path, error).time_since_epoch().count();
+    return "bytes " + std::to_string(size) + " time " + std::to_string(time);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return "unreadable";
   uint64_t hash = kFnv1aStart;

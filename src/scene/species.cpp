@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <stdexcept>
 
@@ -129,11 +130,11 @@ std::string range_text(const Species& s) {
 
 double inward(double bound, bool lower) {
   if (bound == 0 || !std::isfinite(bound)) return bound;
+  // The bound as a message prints it, when that is inside the range (a scale of exactly 1).
+  const double shown = std::strtod(number_text(bound).c_str(), nullptr);
+  if (lower ? shown >= bound : shown <= bound) return shown;
   const double unit = std::pow(10.0, std::floor(std::log10(std::fabs(bound))) - 5);
-  // A bound of six digits already (a scale of 1) stays as it is, whatever its quotient's round-off.
-  const double units = bound / unit, nearest = std::round(units);
-  if (std::abs(units - nearest) <= 1e-9 * std::abs(units)) return bound;
-  return (lower ? std::ceil(units) : std::floor(units)) * unit;
+  return (lower ? std::ceil(bound / unit) : std::floor(bound / unit)) * unit;
 }
 
 const std::vector<Species>& species_library() {
