@@ -27,6 +27,9 @@ std::string obj_shared_lines(const TreeModel& model, const std::string& mtl_name
   std::string out;
   out.reserve(24 * model.vertex_count() + 40 * model.triangle_count());
   out += "mtllib " + mtl_name + "\n";
+  // Without normals of its own the mesh is one smoothing group, so that importers shade the
+  // bark smooth from the vertices' normals (Blender imported it faceted, a ring of eight flats).
+  if (!with_normals) out += "s 1\n";
   for (size_t v = 0; v < model.vertex_count(); ++v) {
     out += "vt ";
     append_number(out, model.uvs(0, long(v)));
@@ -74,7 +77,9 @@ void write_mtl_file(const std::filesystem::path& temporary, const std::filesyste
     append_number(text, shininess);
     text += "\nPr ";
     append_number(text, float(m.roughness));
-    text += "\nPm 0\nd 1\nillum 2\n";
+    // Ks 0.5: the specular Blender's importer sets from it, as its glTF importer does for the
+    // GLB's materials (without Ks, illum 2 made it 1, the OBJ glossier than the same GLB).
+    text += "\nKs 0.5 0.5 0.5\nPm 0\nd 1\nillum 2\n";
   }
   OutputFile file(temporary, target);
   file.write(text);

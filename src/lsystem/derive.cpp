@@ -355,12 +355,30 @@ class Deriver {
   // The strict predecessor after its first module: the modules right after it, one by one
   // (no module passed over; CPFG manual 3.1).
   bool match_tail(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
-    if (derived_ || !word_ || index + rule.length() > word_->size()) return false;
+    if (derived_) return match_tail_ahead(set, rule, slots);
+    if (!word_ || index + rule.length() > word_->size()) return false;
     for (uint32_t p = rule.tail_begin; p < rule.tail_end; ++p) {
       const PatternModule& pattern = set.patterns[p];
       const size_t j = index + 1 + (p - rule.tail_begin);
       if (word_->symbols[j] != pattern.symbol || word_->params_of(j).size() != pattern.arity) return false;
       bind(*word_, j, pattern, slots);
+    }
+    return true;
+  }
+
+  // The same for a module of a successor: the modules after it in that successor, with the
+  // parameters its rule's application evaluated (ahead_); none past the successor's end.
+  bool match_tail_ahead(const RuleSet& set, const Rule& rule, double* slots) const {
+    if (!ahead_.valid) return false;
+    const Frame& frame = frames_[ahead_.frame];
+    if (ahead_.position + (rule.length() - 1) > frame.rule->successor_end) return false;
+    size_t at = ahead_.cursor;
+    for (uint32_t p = rule.tail_begin; p < rule.tail_end; ++p) {
+      const PatternModule& pattern = set.patterns[p];
+      const SuccessorModule& module = set.successor[ahead_.position + (p - rule.tail_begin)];
+      if (module.symbol != pattern.symbol || module.arity != pattern.arity) return false;
+      for (uint32_t k = 0; k < module.arity; ++k) slots[pattern.first_slot + k] = frame_params_[at + k];
+      at += module.arity;
     }
     return true;
   }
@@ -476,12 +494,34 @@ class Deriver {
   }
 
   // A rule being expanded: its bound slots live in frame_slots_[slots, slots + slot_count).
+  // In a set with strict predecessors of several modules (RuleSet::any_strict_tail), its
+  // successor's parameters were evaluated when it was applied: frame_params_[params, ...), the
+  // next module's from `cursor`; else params is kNoParams and each module's are evaluated in turn.
+  static constexpr size_t kNoParams = static_cast<size_t>(-1);
   struct Frame {
     const Rule* rule;
     uint32_t next;   // next successor module
     int depth;
     size_t slots;
+    size_t params = kNoParams;
+    size_t cursor = 0;
   };
+  // The successor modules after the one being begun, for match_tail_ahead: those of
+  // frames_[frame] from `position`, their parameters at frame_params_[cursor].
+  struct Ahead {
+    bool valid = false;
+    size_t frame = 0;
+    uint32_t position = 0;
+    size_t cursor = 0;
+  };
+
+  // frames_.back() => popped, with its slots and parameters.
+  void pop_frame() {
+    const Frame& frame = frames_.back();
+    frame_slots_.resize(frame.slots);
+    if (frame.params != kNoParams) frame_params_.resize(frame.params);
+    frames_.pop_back();
+  }
 
   // Module `index` of word (with the modules after it, for a strict predecessor of several)
   // => its expansion appended to *out, depth first in successor order, with an explicit stack
@@ -493,6 +533,7 @@ class Deriver {
                 ModuleString* out) {
     frames_.clear();
     frame_slots_.clear();
+    frame_params_.clear();
     word_ = &word;
     const size_t used = begin_module(set, word.symbols[index], word.params_of(index), index, 0, random, out);
     derived_ = true;
@@ -500,20 +541,35 @@ class Deriver {
     while (!frames_.empty()) {
       Frame& frame = frames_.back();
       const Rule& rule = *frame.rule;
+      if (frame.next == rule.successor_end) {  // its last modules matched a strict predecessor before
+        pop_frame();
+        continue;
+      }
       rule_ = &rule;
       const SuccessorModule& module = set.successor[frame.next++];
       const int depth = frame.depth + 1;
-      double* slots = frame_slots_.data() + frame.slots;
       scratch_.clear();
-      for (uint32_t p = 0; p < module.arity; ++p)
-        scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
-                                    variables_.data()));
-      if (frame.next == rule.successor_end) {
-        frame_slots_.resize(frame.slots);
-        frames_.pop_back();
+      if (frame.params != kNoParams) {
+        scratch_.assign(frame_params_.begin() + std::ptrdiff_t(frame.cursor),
+                        frame_params_.begin() + std::ptrdiff_t(frame.cursor + module.arity));
+        frame.cursor += module.arity;
+      } else {
+        const double* slots = frame_slots_.data() + frame.slots;
+        for (uint32_t p = 0; p < module.arity; ++p)
+          scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
+                                      variables_.data()));
       }
+      const size_t at = frames_.size() - 1;
+      const bool last = frame.next == rule.successor_end;
+      ahead_ = {.valid = !last && frame.params != kNoParams, .frame = at, .position = frame.next, .cursor = frame.cursor};
+      if (last) pop_frame();
       params_.assign(scratch_.begin(), scratch_.end());
-      begin_module(set, module.symbol, params_, index, depth, random, out);
+      const size_t used = begin_module(set, module.symbol, params_, index, depth, random, out);
+      ahead_.valid = false;
+      for (size_t skipped = 1; skipped < used; ++skipped) {  // the rest of the strict predecessor it matched
+        Frame& from = frames_[at];
+        from.cursor += set.successor[from.next++].arity;
+      }
       if (past_cap(*out)) check_cap(*out);
     }
     word_ = nullptr;
@@ -536,6 +592,16 @@ class Deriver {
     if (rule->successor_begin != rule->successor_end) {  // else erased
       frames_.push_back({rule, rule->successor_begin, depth, frame_slots_.size()});
       frame_slots_.insert(frame_slots_.end(), slots, slots + rule->slot_count);
+      if (set.any_strict_tail) {
+        // Its successor's parameters now, with its slots, in module order.
+        Frame& frame = frames_.back();
+        frame.params = frame.cursor = frame_params_.size();
+        rule_ = rule;
+        for (uint32_t m = rule->successor_begin; m < rule->successor_end; ++m)
+          for (uint32_t p = 0; p < set.successor[m].arity; ++p)
+            frame_params_.push_back(evaluate(g_.program, set.successor_params[set.successor[m].first_param + p],
+                                             frame_slots_.data() + frame.slots, random, variables_.data()));
+      }
     }
     return rule->length();
   }
@@ -577,6 +643,8 @@ class Deriver {
   std::vector<double> params_;          // the same, while its own rule is selected
   std::vector<Frame> frames_;           // rules being expanded, innermost last
   std::vector<double> frame_slots_;     // their bound formals and locals
+  std::vector<double> frame_params_;    // their successors' parameters, where evaluated when applied (Frame::params)
+  Ahead ahead_;                         // the successor modules after the one being begun
   std::vector<double> chosen_slots_;    // (candidates x kMaxSlots) slots of stochastic candidates
   std::vector<double> variables_;       // global variables; [0] the last srand() argument
   std::vector<uint32_t> drawn_at_;      // where each module's homomorphism starts (query pass)

@@ -841,6 +841,7 @@ class Parser {
     for (uint32_t m = rule.successor_begin; m < rule.successor_end; ++m)
       if (set.successor[m].symbol == '%') set.any_cut = true;
     if (rule.has_context()) set.any_context = true;
+    if (rule.length() > 1) set.any_strict_tail = true;
     rule.cpfg_parts = rule.length() > 1 || rule.before.present() || rule.after.present();
     set.rules.push_back(rule);
   }

@@ -203,7 +203,9 @@ std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& 
     if (const std::string error = order_error(keys, keys.size() - 1); !error.empty())
       throw InputError(where + ": " + error);
   }
-  if (!header_seen) throw InputError(name + ":1: expected the header 'time,speed,dx,dy,dz[,gust]', the file is empty");
+  if (!header_seen)
+    throw InputError(name + ":1: expected the header 'time,speed,dx,dy,dz[,gust]', the file " +
+                     (line_number > 0 ? "holds comments and blank lines only" : "is empty"));
   if (keys.empty()) throw InputError(name + ":" + std::to_string(line_number) + ": expected at least one data line after the header");
   return keys;
 }

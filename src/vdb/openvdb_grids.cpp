@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -208,8 +209,16 @@ class LayoutWalk {
   void walk() {
     int64_t magic = 0;
     uint32_t version = 0;
-    // Not a VDB file, or one OpenVDB no longer reads: its own message says so.
-    if (size_ < 12) return;
+    // Not a VDB file, or one OpenVDB no longer reads: its own message says so. A file that
+    // begins as VDB's magic number and stops within the header (OpenVDB then finds no grids).
+    if (size_ < 12) {
+      const int64_t expected = openvdb::OPENVDB_MAGIC;
+      char start[12] = {};
+      in_.read(start, std::streamsize(size_));
+      if (size_ > 0 && std::memcmp(start, &expected, std::min<size_t>(size_, sizeof expected)) == 0)
+        throw std::runtime_error(cut("the header"));
+      return;
+    }
     read(magic, "the header"), read(version, "the header");
     if (magic != openvdb::OPENVDB_MAGIC || version < openvdb::OPENVDB_FILE_VERSION_FLOAT_FRUSTUM_BBOX) return;
     skip(8, "the header");  // the library's major and minor version

@@ -131,7 +131,8 @@ TEST(Cpfg, EqualsInARightContextSkipsTheRestOfTheBranch) {
 }
 
 // A strict predecessor of several modules (CPFG manual 3.1) replaces them all, with the right
-// context after its last module; in a homomorphism it applies to the derived word.
+// context after its last module; in a homomorphism it applies to the derived word and, as cpfg
+// rewrites its successor buffer, within the successors of a deeper recursion.
 TEST(Cpfg, PredecessorOfSeveralModules) {
   EXPECT_EQ(derive_text("axiom: A(1)B(2)C\nA(x)B(y) --> D(x+y)\n", 1), "D(3)C");
   EXPECT_EQ(derive_text("axiom: A B C A B\nA B > C --> X\nB --> Y\n", 1), "XCAY");
@@ -141,6 +142,17 @@ TEST(Cpfg, PredecessorOfSeveralModules) {
   ASSERT_EQ(drawn.size(), 2u);
   EXPECT_EQ(drawn.symbols[0], 'F');
   EXPECT_EQ(drawn.symbols[1], 'A');
+  // Within a successor (vlab's HilbertPanels: L --> Sl Tl, Sl --> ...), its parameters bound,
+  // not across the successor's end, and a tail the rule does not take left to the next module.
+  auto homomorphism = [](const std::string& text) {
+    const Grammar h = parse(text);
+    return text_of(apply_homomorphism(h, derive(h, {0, 1, 100}), {0, 1, 100}));
+  };
+  EXPECT_EQ(homomorphism("axiom: A\nhomomorphism\nmaximum depth: 2\nA --> F B(1)C(2)\nB(x)C(y) --> G(x+y)\n"), "FG(3)");
+  EXPECT_EQ(homomorphism("axiom: A C\nhomomorphism\nmaximum depth: 3\nA --> F B\nB C --> G\n"), "FBC");
+  EXPECT_EQ(homomorphism("axiom: A\nhomomorphism\nmaximum depth: 3\nA --> F B C D\nC D --> E\nB C --> G\n"), "FGD");
+  EXPECT_EQ(homomorphism("axiom: A\nhomomorphism\nmaximum depth: 1\nA --> F B(1)C(2)\nB(x)C(y) --> G(x+y)\n"),
+            "FB(1)C(2)");  // at the depth limit nothing more is rewritten
 }
 
 // Arrays (CPFG manual 2.2.2): row-major initialisers, "[i][j]" and "[i, j]", assignment in

@@ -226,11 +226,14 @@ grid.position.set(Math.round(center.x), box.min.y, Math.round(center.z));
 scene.add(grid);
 
 // Wind arrow: the air velocity at the probe point, from upwind, 1 m/s = 4 % of the trees' height
-// (not of a forest's width, which would draw it longer than the forest).
+// (not of a forest's width, which would draw it longer than the forest), and the fastest air
+// of the bake at most 60 % of it: a storm's arrow four heights long took the view from the tree.
 const probe = new THREE.Vector3().fromArray(bake.wind_probe);
 const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), probe, 1, 0x2060d0);
 scene.add(arrow);
-const arrowScale = 0.04 * size.y;
+let fastest = 0;
+for (let i = 0; i < samples; ++i) fastest = Math.max(fastest, Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
+const arrowScale = Math.min(0.04, fastest > 0 ? 0.6 / fastest : 0.04) * size.y;
 // The arrow at a sample: its tail, direction, length, and its head's length and width; none in still air.
 function arrowAt(sample) {
   const w = new THREE.Vector3().fromArray(bake.plot.wind, 3 * sample);
