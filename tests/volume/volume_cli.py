@@ -68,6 +68,7 @@ def check_bad(treeanim, tmp):
     # cut as garbage and allocated gigabytes before it failed.
     descriptor_cut = whole.index(b"\x03\x00\x00\x00vel") + 5
     truncated_descriptor = copy_with("truncated-descriptor", whole[:descriptor_cut])
+    truncated_header = copy_with("truncated-header", whole[:6])  # OpenVDB found no grids in it
     nan = os.path.join(tmp, "nan")
     write_volume("uniform", "houdini", nan, "--frames", "1", "10", "--voxel", "1", "--nan-at", "3")
     fast = os.path.join(tmp, "fast")
@@ -111,6 +112,8 @@ def check_bad(treeanim, tmp):
         ("truncated-descriptor", volume(truncated_descriptor), nine,
          f"vel.0003.vdb: not a readable VDB file (the file is cut short: it ends at byte {descriptor_cut}, inside "
          "grid 1's descriptor)"),
+        ("truncated-header", volume(truncated_header), nine,
+         "vel.0003.vdb: not a readable VDB file (the file is cut short: it ends at byte 6, inside the header)"),
         ("missing-grid", volume(vol, grid="velocity"), nine,
          "vel.0001.vdb: no grid 'velocity' (nor 'velocity.x', 'velocity.y', 'velocity.z'); its grids: 'vel' (vec3s)"),
         ("grid-of-another-type", volume(scalar), nine,
