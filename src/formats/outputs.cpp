@@ -123,6 +123,11 @@ struct OutputSet::Impl {
 
 namespace {
 
+// A file system's longest name (NAME_MAX of ext4, XFS, tmpfs, NFS), and what an output's own
+// name may take of it: its lock ".NAME.lock" and temporaries ".NAME.tmp-PID" (and a USD
+// layer's scratch beside them) add up to 32 bytes.
+constexpr size_t kMostFolderNameBytes = 255, kMostFileNameBytes = 255 - 32;
+
 std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
                                       long long frame_start, long long frame_count) {
   std::vector<OutputFiles> files;
@@ -158,6 +163,18 @@ std::string OutputTargets::identity(const fs::path& file) {
 // component cost ~20 us a target, a minute for a million-frame sequence.
 void OutputTargets::add(const fs::path& target, const std::string& writer, const std::string& refused,
                         const std::string& expected, bool written) {
+  // A name no file system takes (255 bytes), or one whose lock and temporaries would not fit:
+  // refused here, before the bake, rather than met when the file is made.
+  if (written) {
+    for (const fs::path& part : target.parent_path())
+      if (part.native().size() > kMostFolderNameBytes)
+        throw InputError(refused + "a folder name of " + std::to_string(part.native().size()) + " bytes: at most " +
+                         std::to_string(kMostFolderNameBytes) + ", a file system's limit");
+    if (const size_t bytes = target.filename().native().size(); bytes > kMostFileNameBytes)
+      throw InputError(refused + "a file name of " + std::to_string(bytes) + " bytes: at most " +
+                       std::to_string(kMostFileNameBytes) + ", a file system's 255 less the room of its lock and " +
+                       "temporary files");
+  }
   OutputTarget resolved;
   try {
     resolved = resolve_output_target(target);
