@@ -41,6 +41,7 @@ TreeOptions read_tree_options(SceneObject section, TreeOptions o) {
   o.wood_density = section.number("wood_density", o.wood_density, Range::between(50, 1500));
   o.pipe_exponent = section.number("pipe_exponent", o.pipe_exponent, Range::between(1.0, 4.0));
   o.tip_taper = section.number("tip_taper", o.tip_taper, Range::between(0.0, 1.0));
+  o.drag_share = section.number("drag_share", o.drag_share, {0, 1, true, false});
   o.bark_color = read_color(section, "bark_color", o.bark_color);
   o.leaf_color = read_color(section, "leaf_color", o.leaf_color);
   o.leaf_color_variation = section.number("leaf_color_variation", o.leaf_color_variation, Range::between(0.0, 1.0));

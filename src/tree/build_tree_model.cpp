@@ -86,11 +86,11 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
   for (size_t c = 0; c < C; ++c) {
     if (model.cluster_kind[c] == kClusterBranch) {
       spread(model, c, options.wood_density * volume[c], is_branch, model.vertex_mass);
-      spread(model, c, area[c], is_branch, model.vertex_drag_area);
+      spread(model, c, options.drag_share * area[c], is_branch, model.vertex_drag_area);
     } else {
       const size_t l = size_t(model.cluster_leaf[c]);
       spread(model, c, options.leaf.areal_density * leaves.area[l], is_leaf, model.vertex_mass);
-      spread(model, c, leaves.area[l], is_leaf, model.vertex_drag_area);
+      spread(model, c, options.drag_share * leaves.area[l], is_leaf, model.vertex_drag_area);
     }
   }
   // Below the floor everywhere: segments of no length (F(0), a step of 1e-300) and no leaf, a

@@ -30,6 +30,10 @@ struct TreeOptions {
   double wood_density = 700;   // kg/m^3
   double pipe_exponent = 2.0;  // k of the pipe model r_parent^k = sum r_child^k
   double tip_taper = 0.5;      // top / base radius of a segment that ends an axis
+  // The share of its segments' and leaf cards' own drag that the crown feels: 1 takes each as
+  // if alone in the air; a grown crown, whose parts shelter each other and streamline, feels
+  // 0.1 to 0.3 of it (the species, docs/species.md "Drag")
+  double drag_share = 1.0;
   // Base colours of the two surface materials, sRGB in [0, 1] as a colour picker gives them
   // (tree/surface_materials.h converts them for glTF, whose factors are linear).
   Eigen::Vector3d bark_color = Eigen::Vector3d(0.36, 0.27, 0.19);  // grey-brown bark

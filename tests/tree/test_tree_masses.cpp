@@ -104,5 +104,19 @@ TEST(TreeMasses, LeafMassAndDragAreaComeFromTheBladeArea) {
   EXPECT_NEAR(drag, expected, 1e-12);
 }
 
+// tree.drag_share scales every part's drag area, leaves' and branches', and no mass.
+TEST(TreeMasses, TheDragShareScalesEveryPartsDragAndNoMass) {
+  TreeOptions o;
+  const Skeleton sk = test::small_tree();
+  const TreeModel whole = build_tree_model(sk, o);
+  o.drag_share = 0.25;
+  const TreeModel shared = build_tree_model(sk, o);
+  ASSERT_GT(whole.leaf_count(), 0u);
+  for (size_t v = 0; v < whole.vertex_count(); ++v) {
+    EXPECT_NEAR(shared.vertex_drag_area[v], 0.25 * whole.vertex_drag_area[v], 1e-15 + 1e-15 * whole.vertex_drag_area[v]);
+    EXPECT_EQ(shared.vertex_mass[v], whole.vertex_mass[v]);
+  }
+}
+
 }  // namespace
 }  // namespace treeanim
