@@ -165,15 +165,19 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
                         const std::string& expected, bool written) {
   // A name no file system takes (255 bytes), or one whose lock and temporaries would not fit:
   // refused here, before the bake, rather than met when the file is made.
-  if (written) {
-    for (const fs::path& part : target.parent_path())
-      if (part.native().size() > kMostFolderNameBytes)
-        throw InputError(refused + "a folder name of " + std::to_string(part.native().size()) + " bytes: at most " +
-                         std::to_string(kMostFolderNameBytes) + ", a file system's limit");
-    if (const size_t bytes = target.filename().native().size(); bytes > kMostFileNameBytes)
-      throw InputError(refused + "a file name of " + std::to_string(bytes) + " bytes: at most " +
-                       std::to_string(kMostFileNameBytes) + ", a file system's 255 less the room of its lock and " +
-                       "temporary files");
+  // On the string, as the rest of these checks: a sequence has a target per frame.
+  const std::string& text = target.native();
+  for (size_t start = 0; written;) {
+    const size_t slash = text.find('/', start), end = slash == std::string::npos ? text.size() : slash;
+    const bool file = end == text.size();
+    if (end - start > (file ? kMostFileNameBytes : kMostFolderNameBytes))
+      throw InputError(refused + (file ? "a file name of " : "a folder name of ") + std::to_string(end - start) +
+                       " bytes: at most " +
+                       (file ? std::to_string(kMostFileNameBytes) +
+                                   ", a file system's 255 less the room of its lock and temporary files"
+                             : std::to_string(kMostFolderNameBytes) + ", a file system's limit"));
+    if (file) break;
+    start = slash + 1;
   }
   OutputTarget resolved;
   try {

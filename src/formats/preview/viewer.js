@@ -231,8 +231,8 @@ scene.add(grid);
 const probe = new THREE.Vector3().fromArray(bake.wind_probe);
 const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), probe, 1, 0x2060d0);
 scene.add(arrow);
-let fastest = 0;
-for (let i = 0; i < samples; ++i) fastest = Math.max(fastest, Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
+const windSpeed = times.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));  // m/s, also plotted
+const fastest = windSpeed.reduce((a, b) => Math.max(a, b), 0);
 const arrowScale = Math.min(0.04, fastest > 0 ? 0.6 / fastest : 0.04) * size.y;
 // The arrow at a sample: its tail, direction, length, and its head's length and width; none in still air.
 function arrowAt(sample) {
@@ -350,7 +350,6 @@ function drawPlot(canvas, series, cursorTime) {
   g.lineWidth = 1;
   g.beginPath(); g.moveTo(x(cursorTime), top); g.lineTo(x(cursorTime), h - bottom); g.stroke();
 }
-const windSpeed = times.map((_, i) => Math.hypot(...bake.plot.wind.slice(3 * i, 3 * i + 3)));
 const windTitle = trees.length > 1 ? 'wind speed at the first tree' : 'wind speed at the tree';
 const windSeries = [{ name: 'speed', values: windSpeed, color: '#2060d0' }];
 const dispSeries = [{ name: 'largest', values: bake.plot.max_displacement, color: '#c05a00' },
