@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <type_traits>
 
@@ -27,20 +28,50 @@ Eigen::Matrix3d rotation_of(const Eigen::Vector3d& theta) {
 }
 
 // The same by Rodrigues' formula, R = cos a I + (sin a / a) [theta]x + ((1 - cos a) / a^2) theta theta^T,
-// its factors from their series (to a^8: the next term is below 3e-21) for a turn of a2 =
-// |theta|^2 below 0.0025 (0.05 rad), as far as a joint of the chain turns in an ordinary wind;
-// R column-major. hsm.particles "samples" takes it: its clusters' fixed costs are its step's,
-// and the library's sine, cosine and matrix were some 4 % of them; "vertices" keeps the
-// paper's set-up byte for byte. T: a double, or four in lanes (turn_joints_quickly).
+// with a2 = |theta|^2 and the factors sin a / a and (1 - cos a) / a^2 given; R column-major.
+// T: a double, or four in lanes (turn_joints_quickly).
 template <typename T>
-inline void series_rotation(const T& tx, const T& ty, const T& tz, const T& a2, T (&R)[9]) {
-  const T sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
-  const T versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
+inline void rodrigues(const T& tx, const T& ty, const T& tz, const T& a2, const T& sine, const T& versine, T (&R)[9]) {
   const T vx = versine * tx, vy = versine * ty, vz = versine * tz, diagonal = 1 - versine * a2;
   const T sx = sine * tx, sy = sine * ty, sz = sine * tz;
   R[0] = vx * tx + diagonal, R[1] = vy * tx + sz, R[2] = vz * tx - sy;
   R[3] = vx * ty - sz, R[4] = vy * ty + diagonal, R[5] = vz * ty + sx;
   R[6] = vx * tz + sy, R[7] = vy * tz - sx, R[8] = vz * tz + diagonal;
+}
+
+// Rodrigues' factors from their series to a^8 (the next term is below 3e-21) for a turn
+// below 0.05 rad (a2 below 0.0025), as far as a joint of the chain turns in an ordinary wind.
+// hsm.particles "samples" takes them: its clusters' fixed costs are its step's, and the
+// library's sine, cosine and matrix were some 4 % of them; "vertices" keeps the paper's
+// set-up byte for byte.
+template <typename T>
+inline void small_turn_factors(const T& a2, T& sine, T& versine) {
+  sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
+  versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
+}
+
+// The same factors for any turn up to 1.6 rad (a2 below kWideTurn2), past the quarter turn
+// that caps every joint's (BarChain::cluster_max_turn): their series to a^22, the next terms
+// below 1e-18 there, in Horner's form on plain doubles. A leaf in a breeze turns tenths of a
+// radian, where the library's sine and cosine took a tenth of the samples' step.
+constexpr double kWideTurn2 = 2.56;
+constexpr int kWideTerms = 12;  // (-1)^k a2^k / (2k + 1)! and / (2k + 2)!, k < kWideTerms
+constexpr std::array<double, 2 * kWideTerms + 1> kInverseFactorials = [] {
+  std::array<double, 2 * kWideTerms + 1> f{};
+  f[0] = 1;
+  for (int n = 1; n <= 2 * kWideTerms; ++n) f[n] = f[n - 1] / n;
+  return f;
+}();
+template <typename T>
+inline void wide_turn_factors(const T& a2, T& sine, T& versine) {
+  constexpr double kLastSign = (kWideTerms - 1) % 2 ? -1 : 1;
+  sine = T{} + kLastSign * kInverseFactorials[2 * kWideTerms - 1];
+  versine = T{} + kLastSign * kInverseFactorials[2 * kWideTerms];
+  for (int k = kWideTerms - 1; k-- > 0;) {
+    const double sign = k % 2 ? -1 : 1;
+    sine = sine * a2 + sign * kInverseFactorials[2 * k + 1];
+    versine = versine * a2 + sign * kInverseFactorials[2 * k + 2];
+  }
 }
 
 // A joint's turn => the same turn, at most `largest` long (its yield turn).
@@ -298,10 +329,10 @@ constexpr uint8_t kQuickTurn = 0, kFullMean = 1, kFullRotation = 2;
 // farthest of them from the air, each joint that no point can turn to its yield takes the mean
 // of its uncapped turns, theta + reach x (mean |a| a - g), in one cross product: the same turn
 // as mean_yielded_turn's but for round-off, since ||a| a - |u| u| <= (|a| + |u|) |a - u|
-// bounds each point's. Its matrix comes from series_rotation below 0.05 rad. Four joints
+// bounds each point's. Its matrix comes from Rodrigues' factors by their series. Four joints
 // run at once, a lane each (lanes.h), every lane computing both cases of each choice; the
-// joints a point could yield (mean_yielded_turn) and those turned 0.05 rad or more
-// (rotation_of) are then taken one by one.
+// joints a point could yield (mean_yielded_turn) and any turned 1.6 rad or more (rotation_of)
+// are then taken one by one.
 template <typename Real>
 void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>& attachment, StepScratch<Real>& scratch,
                          const Eigen::Vector3d (*point)[6], double spread) {
@@ -367,17 +398,23 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         sqrt_lanes(reach);
         const Mask4 yields = mean & ~(angle + reach * (fastest + size) * spread <= largest);
         const Double4 a2 = (tx * tx + ty * ty) + tz * tz;
-        const Mask4 series = a2 < 0.0025;
+        const Mask4 small = a2 < 0.0025, wide = a2 < kWideTurn2;
         const Double4 share = j * give;
         const Double4 px = share * damping[0], py = share * damping[1], pz = share * damping[2];
-        Double4 R[9];
-        series_rotation(tx, ty, tz, a2, R);
+        Double4 sine, versine, R[9];
+        small_turn_factors(a2, sine, versine);
+        if (!(small[0] & small[1] & small[2] & small[3])) {  // a bare limb turns little in a breeze
+          Double4 wide_sine, wide_versine;
+          wide_turn_factors(a2, wide_sine, wide_versine);
+          sine = small ? sine : wide_sine, versine = small ? versine : wide_versine;
+        }
+        rodrigues(tx, ty, tz, a2, sine, versine, R);
         for (size_t i = 0; i < lanes; ++i) {
           const size_t c = first + k + i;
           path[3 * c] = px[i], path[3 * c + 1] = py[i], path[3 * c + 2] = pz[i];
           for (int m = 0; m < 9; ++m) rotation[9 * c + m] = R[m][i];
           turn[0][k + i] = tx[i], turn[1][k + i] = ty[i], turn[2][k + i] = tz[i];
-          full[k + i] = yields[i] ? kFullMean : series[i] ? kQuickTurn : kFullRotation;
+          full[k + i] = yields[i] ? kFullMean : wide[i] ? kQuickTurn : kFullRotation;
         }
       }
     });
@@ -389,9 +426,12 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
       if (full[k] == kFullMean) {
         theta = mean_yielded_turn(j * scratch.cluster_moment.col(c), scratch.cluster_load.col(c), area[c],
                                   j * attachment.cluster_drag_arm.col(c), *point, max_turn[c]);
-        double a2 = theta.squaredNorm(), R[9];
-        if (a2 < 0.0025) {
-          series_rotation(theta.x(), theta.y(), theta.z(), a2, R);
+        const double a2 = theta.squaredNorm();
+        if (a2 < kWideTurn2) {
+          double sine, versine, R[9];
+          if (a2 < 0.0025) small_turn_factors(a2, sine, versine);
+          else wide_turn_factors(a2, sine, versine);
+          rodrigues(theta.x(), theta.y(), theta.z(), a2, sine, versine, R);
           std::copy_n(R, 9, rotation + 9 * c);
           continue;
         }

@@ -182,10 +182,17 @@ uint32_t predict_vertices(const SolverModel<Real>& model, const Attachment<Real>
   return with_kernel_isa([&] {
     return for_vertex_blocks(model, attachment, state, scratch, first, last, pass, goals,
                              [&](size_t begin, int n, const VertexInputs<Real>& in, VertexBlock<Real>& block) {
-                               return mode.last ? predict_block<false>(model, attachment, scratch, prediction, begin,
-                                                                       n, in, kick, block)
-                                                : predict_block<true>(model, attachment, scratch, prediction, begin,
-                                                                      n, in, kick, block);
+                               const bool drags = !model.beam || std::any_of(in.flying, in.flying + n,
+                                                                              [](Real f) { return f != 0; });
+                               if (drags)
+                                 return mode.last ? predict_block<false, true>(model, attachment, scratch, prediction,
+                                                                               begin, n, in, kick, block)
+                                                  : predict_block<true, true>(model, attachment, scratch, prediction,
+                                                                              begin, n, in, kick, block);
+                               return mode.last ? predict_block<false, false>(model, attachment, scratch, prediction,
+                                                                              begin, n, in, kick, block)
+                                                : predict_block<true, false>(model, attachment, scratch, prediction,
+                                                                             begin, n, in, kick, block);
                              });
   }).first;
 }

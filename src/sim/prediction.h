@@ -225,8 +225,10 @@ inline bool correct_block(const SolverModel<Real>& model, const Attachment<Real>
 // uncorrected, corrected here first, as it would have) => their prediction for the next step,
 // in place, written for every lane (a still lane maps onto itself). `kick` is 1, or 1/2 when the
 // velocities are not staggered (a step from the state: leapfrog's first half kick). The
-// drag's square roots and divisions dominate the loop. Returns block_flagged.
-template <bool kCorrect, typename Real>
+// drag's square roots and divisions dominate the loop; kDrag false leaves them out where no
+// lane feels its drag directly (an attached vertex with the beam feels it through its goal):
+// the share is then +0 exactly as they would compute it. Returns block_flagged.
+template <bool kCorrect, bool kDrag, typename Real>
 inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>& attachment,
                           const StepScratch<Real>& scratch, StepPrediction<Real>& prediction, size_t begin, int n,
                           const VertexInputs<Real>& in, Real kick, VertexBlock<Real>& block) {
@@ -268,13 +270,13 @@ inline bool predict_block(const SolverModel<Real>& model, const Attachment<Real>
     const Real half = in.half_damping[k], falling = in.flying[k], scale = in.kick_scale[k];
     const Real pull_back = in.global[k] * inv_h * kicked * scale, drag = in.drag[k] * std::max(direct, falling);
     vx *= half, vy *= half, vz *= half;
-    Real share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    Real share = kDrag ? drag_share(drag, ax - vx, ay - vy, az - vz, half_step) : Real(0);
     vx += (ax - vx) * share, vy += (ay - vy) * share, vz += (az - vz) * share;
     const Real shape = in.kicked[k] * inv_h * scale;
     vx += falling * gravity_step[0] - pull_back * (ux - in.goal[0][k]) + shape * in.pull[0][k];
     vy += falling * gravity_step[1] - pull_back * (uy - in.goal[1][k]) + shape * in.pull[1][k];
     vz += falling * gravity_step[2] - pull_back * (uz - in.goal[2][k]) + shape * in.pull[2][k];
-    share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
+    if constexpr (kDrag) share = drag_share(drag, ax - vx, ay - vy, az - vz, half_step);
     vx = (vx + (ax - vx) * share) * half, vy = (vy + (ay - vy) * share) * half, vz = (vz + (az - vz) * share) * half;
     Real px = ux + step * vx, py = uy + step * vy, pz = uz + step * vz;
     // With per_step stiffness, Eq. 8 as the paper writes it: the global rate moves the
