@@ -19,16 +19,23 @@ namespace {
 // volume of one file for all time may hold gigabytes, read again for each tree of a forest).
 constexpr uintmax_t kHashedBytes = uintmax_t(64) << 20;
 
-// A file => the FNV-1a of its bytes as 16 hex digits; past kHashedBytes, its size and time;
+// A file's size and time, or "absent" where no regular file stands.
+std::string file_stamp(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return "absent";
+  const uintmax_t size = std::filesystem::file_size(path, error);
+  const auto time = std::filesystem::last_write_time(path, error).time_since_epoch().count();
+  return "bytes " + std::to_string(size) + " time " + std::to_string(time);
+}
+
+// A file => the FNV-1a of its bytes as 16 hex digits; past kHashedBytes, its file_stamp;
 // "absent" where no regular file stands (a volume's frame pattern). Read each time: a forest's
 // trees re-read kilobytes, and no cached digest can miss an edit that kept the file's size and time.
 std::string file_digest(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) return "absent";
-  if (const uintmax_t size = std::filesystem::file_size(path, error); !error && size > kHashedBytes) {
-    const auto time = std::filesystem::last_write_time(path, error).time_since_epoch().count();
-    return "bytes " + std::to_string(size) + " time " + std::to_string(time);
-  }
+  if (const uintmax_t size = std::filesystem::file_size(path, error); !error && size > kHashedBytes)
+    return file_stamp(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) return "unreadable";
   uint64_t hash = kFnv1aStart;
@@ -48,6 +55,7 @@ std::string bake_key(const Scene& scene, const std::string& generator) {
   // between a kill and --resume is a new bake, not frames of the old one continued.
   std::string text = scene.resolved.dump(2);
   for (const std::filesystem::path& path : scene.input_paths) text += "\n" + path.string() + " " + file_digest(path);
+  for (const std::filesystem::path& path : scene.volume_frames) text += "\n" + path.string() + " " + file_stamp(path);
   return scene_hash(text, generator);
 }
 

@@ -14,7 +14,8 @@ namespace treeanim {
 std::string treeanim_generator();
 
 // One-tree scene, generator => the key of its bake: the hash of its resolved scene, the bytes
-// of the files it names (Scene::input_paths) and the generator, that its checkpoints, frame
+// of the files it names or its grammars read (Scene::input_paths), the sizes and times of its
+// volume frames (Scene::volume_frames) and the generator, that its checkpoints, frame
 // journal and manifest part carry. The plan derives it from
 // the scene rather than take it from the config, so that the two cannot disagree.
 std::string bake_key(const Scene& scene, const std::string& generator);

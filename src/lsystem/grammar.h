@@ -90,6 +90,7 @@ struct Lsystem {
 
 struct Grammar {
   std::vector<std::string> sources;   // names of the texts (file path, or "scene.json: /lsystem/...")
+  std::vector<std::string> data_paths;  // the files fopen read, in the order it read them
   ExprProgram program;                // code of every expression
   std::vector<std::pair<std::string, double>> defines;  // resolved, scene overrides applied
   std::vector<SuccessorModule> axiom;       // evaluated when derivation starts (ran() uses the seed)

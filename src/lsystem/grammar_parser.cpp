@@ -182,7 +182,7 @@ class Parser {
 
   // fopen's reader (CPFG manual 5.4): a file beside the grammar file that names it, by a
   // relative path that stays in that folder.
-  std::function<std::string(const std::string&, SourcePos)> data_files() const {
+  std::function<std::string(const std::string&, SourcePos)> data_files() {
     return [this](const std::string& name, SourcePos at) {
       const std::filesystem::path path(name);
       if (at.line == 0)
@@ -194,6 +194,7 @@ class Parser {
       std::string text, reason;
       if (!read_text_file(resolved, text, reason))
         throw GrammarError{at, "fopen cannot read '" + resolved.string() + "' (" + reason + ")"};
+      g_.data_paths.push_back(resolved.string());
       return text;
     };
   }

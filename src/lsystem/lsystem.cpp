@@ -102,6 +102,18 @@ Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   return parse_grammar(texts, options.defines, GrammarText{options.inline_name() + "/axiom", options.axiom, true});
 }
 
+std::vector<std::filesystem::path> grammar_input_files(const LsystemOptions& options) {
+  if (!options.grammar && !options.view) return {};
+  ViewSettings view = load_view(options);
+  std::vector<std::filesystem::path> files = std::move(view.files);
+  if (options.grammar) {
+    const Grammar grammar = load_grammar(options, view);
+    files.insert(files.end(), grammar.sources.begin() + 1, grammar.sources.end());  // the first is the grammar file
+    files.insert(files.end(), grammar.data_paths.begin(), grammar.data_paths.end());
+  }
+  return files;
+}
+
 DerivationSettings derivation_settings(const LsystemOptions& options, const Grammar& grammar) {
   DerivationSettings settings;
   if (options.iterations) settings.iterations = *options.iterations;

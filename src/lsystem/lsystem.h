@@ -1,7 +1,9 @@
 #pragma once
 // Stage entry point: L-system options => derived module string => turtle => Skeleton.
 #include <cstddef>
+#include <filesystem>
 #include <functional>
+#include <vector>
 
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -23,6 +25,11 @@ Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view = {
 
 // options => the view file's settings (none without lsystem.view). Throws InputError.
 ViewSettings load_view(const LsystemOptions& options);
+
+// options => the files the grammar and view file read beyond those the scene names: the
+// grammar's #includes and fopen files, the view's surfaces, curves and functions (each
+// parsed, not grown). Empty for a grammar of the scene or the library. Throws InputError.
+std::vector<std::filesystem::path> grammar_input_files(const LsystemOptions& options);
 
 // options + grammar => derivation settings: the scene's iterations override "derivation
 // length:", the scene seed is mixed with the grammar's "seed:".

@@ -163,8 +163,10 @@ void check_beside(const std::string& name, size_t line, const std::string& file)
 }
 
 // "id file.s scale [i j] [texture]" of the view file's line `line` => the surface with its
-// file read, or nothing when that file does not exist (cpfg then leaves the surface out).
-std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, size_t line, const std::string& rest) {
+// file read, or nothing when that file does not exist (cpfg then leaves the surface out); the
+// file's path added to `named` either way.
+std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, size_t line, const std::string& rest,
+                                             std::vector<std::filesystem::path>& named) {
   const std::string name = view.string();
   std::istringstream in(rest);
   std::string id, file;
@@ -183,6 +185,7 @@ std::optional<ViewSurface> read_surface_line(const std::filesystem::path& view, 
   if (more.size() == 2 && more[0] >= 1 && more[1] >= 1)  // a single number is a texture; 0 0 leaves it to the file
     out.precision = std::array<int, 2>{static_cast<int>(std::min(more[0], 10.0)), static_cast<int>(std::min(more[1], 10.0))};
   const std::filesystem::path target = view.parent_path() / file;
+  named.push_back(target);
   std::error_code ec;
   if (!std::filesystem::exists(target, ec)) return std::nullopt;
   out.surface = read_surface_file(target);
@@ -257,7 +260,7 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       fail(name, i, "'tsurface:' (a surface of triangles in rayshade's format, CPFG manual 8.1.5, 8.4) is not supported; "
                     "give the surface as a bezieredit '.s' file on a 'surface:' line");
     } else if (key == "surface" || key == "line") {  // cpfg reads "line:" as a surface of that id (8.1.5)
-      std::optional<ViewSurface> surface = read_surface_line(path, i, rest);
+      std::optional<ViewSurface> surface = read_surface_line(path, i, rest, view.files);
       const auto same_id = [&](const ViewSurface& v) { return surface && v.id == surface->id; };
       // cpfg keeps the first surface of an id and leaves out one whose file does not exist.
       if (surface && std::none_of(view.surfaces.begin(), view.surfaces.end(), same_id))
@@ -270,12 +273,14 @@ ViewSettings read_view_file(const std::filesystem::path& path) {
       if (!(in >> samples)) samples = 100;  // cpfg's default
       if (samples < 2 || samples > 1'000'000) fail(name, i, "expected 2 ... 1000000 samples after the curve file");
       check_beside(name, i, file);
-      view.curves.push_back(read_view_curve(path.parent_path() / file, samples));
+      view.files.push_back(path.parent_path() / file);
+      view.curves.push_back(read_view_curve(view.files.back(), samples));
     } else if (key == "function" || key == "function set") {
       std::istringstream in(rest);
       std::string file;
       in >> file;
       const std::filesystem::path target = path.parent_path() / file;
+      view.files.push_back(target);
       const std::vector<std::string> flines = read_lines(target, "function file");
       size_t pos = 0;
       size_t items = 1;

@@ -35,6 +35,9 @@ struct ViewSettings {
   std::vector<ViewSurface> surfaces;          // "surface:" lines whose file exists, in order: drawn by ~id as leaves
   std::vector<SampledFunction> functions;     // "function: f.func n" / "function set: s.fset", in order
   std::vector<ViewCurve> curves;              // "curve: c.con [samples]", in order (curveX ... curveGAL)
+  // Every file its lines name (surfaces, curves, functions), read or, for a surface, absent
+  // (cpfg then leaves it out): what else a bake's key holds (grammar_input_files).
+  std::vector<std::filesystem::path> files;
 };
 
 // path => settings; files it names are found beside it. Throws InputError "file:line:col: message".

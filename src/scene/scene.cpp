@@ -7,6 +7,7 @@
 #include "common/json_text.h"
 #include "common/message_text.h"
 #include "common/read_text_file.h"
+#include "lsystem/lsystem.h"
 #include "scene/lsystem_section.h"
 #include "scene/output_section.h"
 #include "scene/sim_sections.h"
@@ -194,6 +195,16 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   reader.check_unknown_keys();
   if (scene.wind.volume) scene.volume = check_volume(reader, scene);
   scene.input_paths = reader.paths();
+  // The files the grammars and view files read in turn: an edited #include is a new bake too.
+  auto add_grammar_files = [&](const LsystemOptions& options) {
+    for (std::filesystem::path& path : grammar_input_files(options)) scene.input_paths.push_back(std::move(path));
+  };
+  if (top_lsystem) add_grammar_files(scene.lsystem);
+  if (scene.forest)
+    for (const ForestVariant& variant : scene.forest->variants) add_grammar_files(variant.lsystem);
+  if (scene.volume)
+    for (long long frame = scene.volume->first_frame; frame <= scene.volume->last_frame; ++frame)
+      scene.volume_frames.push_back(volume_frame_path(scene.wind.volume->path, frame));
   std::sort(scene.input_paths.begin(), scene.input_paths.end());
   scene.input_paths.erase(std::unique(scene.input_paths.begin(), scene.input_paths.end()), scene.input_paths.end());
   return scene;

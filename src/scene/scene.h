@@ -41,6 +41,9 @@ struct Scene {
   // The files the scene names (grammars, views, wind series, leaf meshes, volume patterns),
   // sorted, each once: their contents key a bake (bake_key), as the resolved scene holds only paths.
   std::vector<std::filesystem::path> input_paths;
+  // The frame files of /wind/volume over the bake's times, in order: their sizes and times key
+  // a bake (a sequence may hold gigabytes, which the key does not read again).
+  std::vector<std::filesystem::path> volume_frames;
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a

@@ -31,6 +31,7 @@ Scene tree_scene(const Scene& forest_scene, size_t index) {
   scene.time = forest_scene.time;
   scene.outputs = forest_scene.outputs;
   scene.input_paths = forest_scene.input_paths;  // the whole forest's: a changed grammar of one variant rebakes all
+  scene.volume_frames = forest_scene.volume_frames;
   for (OutputOptions& output : scene.outputs) {
     std::string path = output.path.string();
     for (size_t at; (at = path.find(kTreePlaceholder)) != std::string::npos;)

@@ -113,6 +113,28 @@ TEST_F(BakeStages, TheKeyHoldsWhatTheNamedFilesHold) {
   EXPECT_EQ(key(), first);  // the same bytes, the same bake
 }
 
+TEST_F(BakeStages, TheKeyHoldsWhatTheGrammarReadsInTurn) {
+  // An #include, a data file fopen reads, and a view file's surface, which cpfg leaves out
+  // while its file is missing: each edit is a new bake.
+  std::ofstream(dir_ / "g.l") << "#include \"more.l\"\nStart: {fp = fopen(\"data.txt\", \"r\");}\nAxiom: F\n";
+  std::ofstream(dir_ / "more.l") << "#define N 1\n";
+  std::ofstream(dir_ / "data.txt") << "1\n";
+  std::ofstream(dir_ / "v.v") << "surface: L leaf.s 1\n";
+  const char* scene = R"({"lsystem": {"grammar": "g.l", "view": "v.v"}, "time": {"frames": 2}, "outputs": []})";
+  auto key = [&] { return bake_key(load_scene_text(scene, "s.json", dir_, {}), treeanim_generator()); };
+  const std::string first = key();
+  std::ofstream(dir_ / "more.l") << "#define N 2\n";
+  const std::string included = key();
+  EXPECT_NE(included, first);
+  std::ofstream(dir_ / "data.txt") << "2\n";
+  const std::string data = key();
+  EXPECT_NE(data, included);
+  fs::copy_file(fs::path(TREEANIM_SOURCE_DIR) / "tests/data/cpfg/leaf.s", dir_ / "leaf.s");
+  EXPECT_NE(key(), data);
+  fs::remove(dir_ / "leaf.s");
+  EXPECT_EQ(key(), data);
+}
+
 TEST_F(BakeStages, StartFreshThenFromACheckpoint) {
   const Scene line = scene();
   BakeConfig resume = config();
