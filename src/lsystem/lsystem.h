@@ -28,7 +28,8 @@ ViewSettings load_view(const LsystemOptions& options);
 
 // options => the files the grammar and view file read beyond those the scene names: the
 // grammar's #includes and fopen files, the view's surfaces, curves and functions (each
-// parsed, not grown). Empty for a grammar of the scene or the library. Throws InputError.
+// parsed, not grown). Empty for a grammar of the scene or the library without a view file.
+// Throws InputError.
 std::vector<std::filesystem::path> grammar_input_files(const LsystemOptions& options);
 
 // options + grammar => derivation settings: the scene's iterations override "derivation
