@@ -8,13 +8,13 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
 #include <cstring>
 #include <type_traits>
 
 #include "sim/kernel_isa.h"
 #include "sim/lanes.h"
 #include "sim/solver_step.h"
+#include "sim/turn_series.h"
 
 namespace treeanim {
 
@@ -50,29 +50,11 @@ inline void small_turn_factors(const T& a2, T& sine, T& versine) {
   versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
 }
 
-// The same factors for any turn up to 1.6 rad (a2 below kWideTurn2), past the quarter turn
-// that caps every joint's (BarChain::cluster_max_turn): their series to a^22, the next terms
-// below 1e-18 there, in Horner's form on plain doubles. A leaf in a breeze turns tenths of a
-// radian, where the library's sine, cosine and matrix took 7 % of the samples' demo step in gusts.
+// Past 0.05 rad, Rodrigues' factors from their longer series (turn_series.h) up to 1.6 rad,
+// past the quarter turn that caps every joint's (BarChain::cluster_max_turn). A leaf in a
+// breeze turns tenths of a radian, where the library's sine, cosine and matrix took 7 % of
+// the samples' demo step in gusts.
 constexpr double kWideTurn2 = 2.56;
-constexpr int kWideTerms = 12;  // (-1)^k a2^k / (2k + 1)! and / (2k + 2)!, k < kWideTerms
-constexpr std::array<double, 2 * kWideTerms + 1> kInverseFactorials = [] {
-  std::array<double, 2 * kWideTerms + 1> f{};
-  f[0] = 1;
-  for (int n = 1; n <= 2 * kWideTerms; ++n) f[n] = f[n - 1] / n;
-  return f;
-}();
-template <typename T>
-inline void wide_turn_factors(const T& a2, T& sine, T& versine) {
-  constexpr double kLastSign = (kWideTerms - 1) % 2 ? -1 : 1;
-  sine = T{} + kLastSign * kInverseFactorials[2 * kWideTerms - 1];
-  versine = T{} + kLastSign * kInverseFactorials[2 * kWideTerms];
-  for (int k = kWideTerms - 1; k-- > 0;) {
-    const double sign = k % 2 ? -1 : 1;
-    sine = sine * a2 + sign * kInverseFactorials[2 * k + 1];
-    versine = versine * a2 + sign * kInverseFactorials[2 * k + 2];
-  }
-}
 
 // A joint's turn => the same turn, at most `largest` long (its yield turn).
 Eigen::Vector3d capped_turn(const Eigen::Vector3d& theta, double largest) {
@@ -405,7 +387,7 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         small_turn_factors(a2, sine, versine);
         if (!(small[0] & small[1] & small[2] & small[3])) {  // a bare limb turns little in a breeze
           Double4 wide_sine, wide_versine;
-          wide_turn_factors(a2, wide_sine, wide_versine);
+          rodrigues_factors(a2, wide_sine, wide_versine);
           sine = small ? sine : wide_sine, versine = small ? versine : wide_versine;
         }
         rodrigues(tx, ty, tz, a2, sine, versine, R);
@@ -430,7 +412,7 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         if (a2 < kWideTurn2) {
           double sine, versine, R[9];
           if (a2 < 0.0025) small_turn_factors(a2, sine, versine);
-          else wide_turn_factors(a2, sine, versine);
+          else rodrigues_factors(a2, sine, versine);
           rodrigues(theta.x(), theta.y(), theta.z(), a2, sine, versine, R);
           std::copy_n(R, 9, rotation + 9 * c);
           continue;

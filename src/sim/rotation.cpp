@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sim/kernel_isa.h"
+#include "sim/turn_series.h"
 
 namespace treeanim {
 
@@ -10,18 +11,25 @@ namespace {
 
 // Rotation vector omega with |omega| = angle => its unit quaternion. A warm-started step is
 // tiny, where the series (sin(a/2)/a to a^4, cos(a/2) to a^4, both below 1e-13 relative
-// error for a < 1e-2) replaces the library's sine and cosine, the most costly part of a step.
-Eigen::Quaterniond increment(const Eigen::Vector3d& omega, double angle) {
-  if (angle >= 1e-2) return Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle));
+// error for a < 1e-2) replaces the library's sine and cosine, the most costly part of a step;
+// with `series_turns` the longer series do for every step (extract_rotation).
+Eigen::Quaterniond increment(const Eigen::Vector3d& omega, double angle, bool series_turns) {
   const double a2 = angle * angle;
-  const double half_sinc = 0.5 - a2 * (1.0 / 48) + a2 * a2 * (1.0 / 3840);
-  const double cosine = 1 - a2 * (1.0 / 8) + a2 * a2 * (1.0 / 384);
+  double half_sinc, cosine;
+  if (series_turns) {
+    half_turn_factors(a2, half_sinc, cosine);
+  } else {
+    if (angle >= 1e-2) return Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle));
+    half_sinc = 0.5 - a2 * (1.0 / 48) + a2 * a2 * (1.0 / 3840);
+    cosine = 1 - a2 * (1.0 / 8) + a2 * a2 * (1.0 / 384);
+  }
   return Eigen::Quaterniond(cosine, half_sinc * omega.x(), half_sinc * omega.y(), half_sinc * omega.z());
 }
 
 }  // namespace
 
-int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations, double newton_stop) {
+int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_iterations, double newton_stop,
+                     bool series_turns) {
   // Müller et al. step: the torque sum_i r_i x a_i of the columns (the gradient of
   // tr(R^T A) over a rotation increment), divided by |tr(R^T A)| + 1e-9. That step is slow
   // about the long axis of an elongated cluster (a branch segment: 1% per iteration at a
@@ -71,7 +79,7 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
       omega *= kMaxStep / angle;
       angle = kMaxStep;
     }
-    q = increment(omega, angle) * q;
+    q = increment(omega, angle, series_turns) * q;
     q.normalize();
     // Newton converges quadratically: after a step below newton_stop the error left is of the
     // order of its square (1e-12 rad after 1e-6, what the test above would find), so that test
@@ -84,7 +92,8 @@ int extract_rotation(const Eigen::Matrix3d& A, Eigen::Quaterniond& q, int max_it
   return iteration;
 }
 
-void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iterations, double newton_stop) {
+void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iterations, double newton_stop,
+                       bool series_turns) {
   // extract_rotation's arithmetic, written out as the library computes it (the quaternion's
   // matrix, product and norm), in every lane at once; a lane that extract_rotation would have
   // left stays as it is.
@@ -129,14 +138,20 @@ void extract_rotations(const Double4 (&A)[9], Double4 (&q)[4], int max_iteration
       const Double4 cap = kMaxStep / angle;
       for (int k = 0; k < 3; ++k) omega[k] = capped ? omega[k] * cap : omega[k];
       angle = capped ? zero + kMaxStep : angle;
-      // increment(omega, angle) * q
+      // increment(omega, angle, series_turns) * q
       const Double4 a2 = angle * angle;
-      const Double4 half_sinc = 0.5 - a2 * (1.0 / 48) + a2 * a2 * (1.0 / 3840);
+      Double4 half_sinc, iw;
+      if (series_turns) {
+        half_turn_factors(a2, half_sinc, iw);
+      } else {
+        half_sinc = 0.5 - a2 * (1.0 / 48) + a2 * a2 * (1.0 / 3840);
+        iw = 1 - a2 * (1.0 / 8) + a2 * a2 * (1.0 / 384);
+      }
       Double4 ix = half_sinc * omega[0], iy = half_sinc * omega[1], iz = half_sinc * omega[2];
-      Double4 iw = 1 - a2 * (1.0 / 8) + a2 * a2 * (1.0 / 384);
-      for (int l = 0; l < 4; ++l) {
+      for (int l = 0; !series_turns && l < 4; ++l) {
         if (!(active[l] && angle[l] >= 1e-2)) continue;
-        const Eigen::Quaterniond big = increment(Eigen::Vector3d(omega[0][l], omega[1][l], omega[2][l]), angle[l]);
+        const Eigen::Quaterniond big =
+            increment(Eigen::Vector3d(omega[0][l], omega[1][l], omega[2][l]), angle[l], false);
         ix[l] = big.x(), iy[l] = big.y(), iz[l] = big.z(), iw[l] = big.w();
       }
       const Double4 &x = q[0], &y = q[1], &z = q[2], &w = q[3];

@@ -170,7 +170,7 @@ uint32_t match_in_lanes(const SolverModel<Real>& model, const Attachment<Real>& 
   std::memcpy(q, q_lanes, sizeof q);
   std::memcpy(point, point_lanes, sizeof point);
   std::memcpy(moved, moved_lanes, sizeof moved);
-  extract_rotations(A, q, model.options.rotation_iterations, model.rotation_newton_stop);
+  extract_rotations(A, q, model.options.rotation_iterations, model.rotation_newton_stop, model.rotation_series_turns);
   Double4 R[9];
   rotation_matrix(q, R);
   // The goal of the match point is o + w: t - t0 = w - (R - I) o (w itself about the centre).

@@ -302,6 +302,7 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
       store_drag_force(detach_enabled || beam),
       parallel(t.membership_count() >= kParallelMemberships),
       rotation_newton_stop(o.particles == ParticleMode::kSamples ? kNewtonStopSamples : kNewtonStopRoundOff),
+      rotation_series_turns(o.particles == ParticleMode::kSamples),
       quick_chain(o.particles == ParticleMode::kSamples),
       lane_frames(o.particles == ParticleMode::kSamples) {
   if (!(dt > 0) || n < 1) throw InputError("simulator: frame_dt must be > 0 and substeps >= 1");

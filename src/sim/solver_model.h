@@ -130,6 +130,7 @@ struct SolverModel {
   // hsm.particles "samples", whose clusters' fixed costs are its step's, takes cheaper choices
   // of the same accuracy (docs/solver.md, "Particles"); "vertices" keeps the paper's set-up byte for byte.
   double rotation_newton_stop;             // rad, the Newton step that ends a rotation's iterations (rotation.h)
+  bool rotation_series_turns;              // each of those steps turns by the series of its sine and cosine (rotation.h)
   // The chain's turns by their series (beam_statics.cpp, series_rotation), and their unscented
   // mean in one cross product where no point reaches the yield turn (turn_joints_quickly)
   bool quick_chain;

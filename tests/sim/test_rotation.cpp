@@ -142,10 +142,11 @@ TEST(Rotation, TinyScaleWorks) {
 // Newton step and leaves of the order of its square; the vertices' takes a second, to round-off.
 TEST(Rotation, AWarmStartASubstepAwayTakesOneStepWithTheSamplesTolerance) {
   // About the optimum of tr(R^T A) for a symmetric stretch the objective is even, so one Newton
-  // step from a turn a away leaves some a^3 / 2: the samples' stop (a step below 1e-2 rad)
-  // leaves at most some 5e-7 rad, the vertices' (1e-6) takes a second step to round-off.
+  // step from a turn a away leaves some a^3 / 2: the samples' stop (a step below 5e-2 rad,
+  // turned by the series of its sine and cosine) leaves at most some 6e-5 rad, the vertices'
+  // (1e-6) takes a second step to round-off.
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> turn(1e-5, 9e-3);
+  std::uniform_real_distribution<double> turn(1e-5, 4e-2);
   double worst_one = 0, worst_cubed = 0, worst_two = 0;
   for (int trial = 0; trial < 500; ++trial) {
     const Eigen::Quaterniond truth = random_rotation(rng);
@@ -153,14 +154,17 @@ TEST(Rotation, AWarmStartASubstepAwayTakesOneStepWithTheSamplesTolerance) {
     const double a = turn(rng);
     const Eigen::Quaterniond off(Eigen::AngleAxisd(a, random_rotation(rng) * Eigen::Vector3d::UnitX()));
     Eigen::Quaterniond samples = off * truth, vertices = samples;
-    EXPECT_EQ(extract_rotation(A, samples, 12, kNewtonStopSamples), 1) << "trial " << trial;
-    EXPECT_EQ(extract_rotation(A, vertices, 12, kNewtonStopRoundOff), a < 1e-6 ? 1 : 2) << "trial " << trial;
+    EXPECT_EQ(extract_rotation(A, samples, 12, kNewtonStopSamples, true), 1) << "trial " << trial;
+    // the vertices stop after a step below 1e-6 rad: their second where one leaves less (a^3 / 2), else their third
+    const int steps = extract_rotation(A, vertices, 12, kNewtonStopRoundOff);
+    if (a < 9e-3) EXPECT_EQ(steps, a < 1e-6 ? 1 : 2) << "trial " << trial;
+    else EXPECT_LE(steps, 3) << "trial " << trial;
     worst_one = std::max(worst_one, angle_between(samples, truth));
     // above the round-off of the angle (some 1e-14 rad), a^3 bounds what one step leaves
     worst_cubed = std::max(worst_cubed, (angle_between(samples, truth) - 1e-13) / (a * a * a));
     worst_two = std::max(worst_two, angle_between(vertices, truth));
   }
-  EXPECT_LT(worst_one, 1e-6);
+  EXPECT_LT(worst_one, 1e-4);
   EXPECT_LT(worst_cubed, 1.0);
   EXPECT_LT(worst_two, 1e-12);
   std::printf("one step: %.3g rad at most (above 1e-13 rad, %.3g a^3); two: %.3g rad\n", worst_one, worst_cubed, worst_two);
@@ -184,7 +188,8 @@ TEST(Rotation, FourLanesGiveTheScalarBitsWhateverTheirNeighbours) {
   int differing = 0, lanes = 0;
   for (int trial = 0; trial < 20000; ++trial) {
     const int iterations = 1 + int(u(rng) * 12);
-    const double stop = u(rng) < 0.5 ? kNewtonStopSamples : kNewtonStopRoundOff;
+    const bool samples = u(rng) < 0.5;
+    const double stop = samples ? kNewtonStopSamples : kNewtonStopRoundOff;
     Double4 A[9], q[4];
     Eigen::Matrix3d scalar_A[4];
     Eigen::Quaterniond scalar_q[4];
@@ -207,9 +212,9 @@ TEST(Rotation, FourLanesGiveTheScalarBitsWhateverTheirNeighbours) {
       for (int i = 0; i < 9; ++i) A[i][l] = M(i);
       for (int k = 0; k < 4; ++k) q[k][l] = warm.coeffs()[k];
     }
-    extract_rotations(A, q, iterations, stop);
+    extract_rotations(A, q, iterations, stop, samples);
     for (int l = 0; l < 4; ++l, ++lanes) {
-      extract_rotation(scalar_A[l], scalar_q[l], iterations, stop);
+      extract_rotation(scalar_A[l], scalar_q[l], iterations, stop, samples);
       for (int k = 0; k < 4; ++k) {
         const double lane = q[k][l], scalar = scalar_q[l].coeffs()[k];
         if (std::memcmp(&lane, &scalar, sizeof lane) != 0) {
