@@ -19,7 +19,7 @@ namespace {
 class GltfSink final : public FrameSink {
  public:
   GltfSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
-      : pattern_(sequence_pattern(path, ".glb", options.pointer)), model_(model), info_(info),
+      : pattern_(sequence_pattern(path, ".glb", options.where())), model_(model), info_(info),
         normals_(options.normals), selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
   std::vector<fs::path> summary_paths() const override {
@@ -69,7 +69,7 @@ class GltfSink final : public FrameSink {
 
 void gltf_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
                   const TargetVisitor& visit) {
-  const SequencePattern pattern = sequence_pattern(path, ".glb", options.pointer);
+  const SequencePattern pattern = sequence_pattern(path, ".glb", options.where());
   for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));
 }
 

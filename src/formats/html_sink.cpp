@@ -132,7 +132,7 @@ class HtmlSink final : public FrameSink {
     probe_ = 0.5 * (model.rest_positions.rowwise().minCoeff() + model.rest_positions.rowwise().maxCoeff());
     plan_ = plan_preview_page(html_page_shape(options, model, info), max_page_bytes_);
     if (!plan_.fits)
-      throw InputError(options.pointer + "/max_mib: the page needs " + std::to_string(mebibytes(plan_.bytes)) +
+      throw InputError(options.where() + "/max_mib: the page needs " + std::to_string(mebibytes(plan_.bytes)) +
                        " MiB at least for this tree (viewer, mesh and two frames)");
   }
 

@@ -25,7 +25,7 @@ fs::path mtl_path(const SequencePattern& pattern) { return fs::path(pattern.rest
 class ObjSink final : public FrameSink {
  public:
   ObjSink(const OutputOptions& options, const fs::path& path, const TreeModel& model, const BakeInfo& info)
-      : pattern_(sequence_pattern(path, ".obj", options.pointer)), model_(model), info_(info),
+      : pattern_(sequence_pattern(path, ".obj", options.where())), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals),
         mtl_(mtl_path(pattern_)) {}
 
@@ -64,7 +64,7 @@ class ObjSink final : public FrameSink {
 
 void obj_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
                  const TargetVisitor& visit) {
-  const SequencePattern pattern = sequence_pattern(path, ".obj", options.pointer);
+  const SequencePattern pattern = sequence_pattern(path, ".obj", options.where());
   visit(pattern.rest());
   visit(mtl_path(pattern));
   for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));

@@ -217,7 +217,7 @@ void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const
   for (const OutputFiles& output : output_files(outputs, out_dir, frame_start, frame_count)) {
     const std::string& pointer = output.options.pointer;
     const std::string writer = owner.empty() ? pointer : pointer + " of " + owner;
-    const std::string refused = (owner.empty() ? "" : owner + ": ") + pointer + "/path: ";
+    const std::string refused = output.options.where() + "/path" + (owner.empty() ? "" : " of " + owner) + ": ";
     fs::path first;
     output.for_each([&](const fs::path& target) {
       if (first.empty()) first = target;

@@ -121,7 +121,7 @@ std::unique_ptr<FrameSink> make_pc2_sink(const OutputOptions& options, const fs:
                                          const TreeModel& model, const BakeInfo& info) {
   // Its header's start frame is a float32, which holds every whole frame only up to 2^24.
   if (double(float(info.frame_start)) != double(info.frame_start))
-    throw InputError(options.pointer + ": PC2 keeps its start frame in float32, which cannot hold frame " +
+    throw InputError(options.where() + ": PC2 keeps its start frame in float32, which cannot hold frame " +
                      std::to_string(info.frame_start) + " (past 16777216 it holds only some whole frames): bake "
                      "nearer frame 0 (time.start)");
   return std::make_unique<PointCacheSink>(CacheFormat::kPc2, options, path, model, info);

@@ -79,7 +79,7 @@ void check_float32_key_times(const OutputOptions& options, const BakeInfo& info,
                              bool from_zero) {
   const FrameSelection selection{info.frame_start, info.frame_count, options.frame_step};
   if (from_zero && selection.start < 0)
-    throw InputError(options.pointer + ": " + keys + " start at time 0, and this bake's first frame is at " +
+    throw InputError(options.where() + ": " + keys + " start at time 0, and this bake's first frame is at " +
                      number_text(double(selection.start) / info.fps) + " s (time.start " +
                      std::to_string(selection.start) + "): bake from time.start 0 or later");
   const double last = double(selection.start + (selection.written() - 1) * selection.step);
@@ -87,7 +87,7 @@ void check_float32_key_times(const OutputOptions& options, const BakeInfo& info,
   const double float_step = farthest > 0 ? std::ldexp(1.0, std::ilogb(farthest) - 23) : 0;  // float32's, there
   const double frame_step = double(selection.step) / info.fps;
   if (float_step <= frame_step / 2) return;
-  throw InputError(options.pointer + ": " + keys + " keep their times in float32, whose step at " +
+  throw InputError(options.where() + ": " + keys + " keep their times in float32, whose step at " +
                    number_text(farthest) + " s is " + number_text(float_step) + " s, more than half the " +
                    number_text(frame_step) + " s between written frames: bake nearer time 0 (time.start)");
 }

@@ -125,12 +125,12 @@ class VatSink final : public FrameSink {
         selection_{info.frame_start, info.frame_count, options.frame_step}, half_(options.vat_half),
         layout_(vat_layout(model.vertex_count(), size_t(selection_.written()), options.texture_width)) {
     if (layout_.rows_per_frame > kVatMaxSize)  // no frame fits, whatever the frame_step
-      throw InputError(options.pointer + "/texture_width: " + std::to_string(layout_.width) + " texels a row put a frame's " +
+      throw InputError(options.where() + "/texture_width: " + std::to_string(layout_.width) + " texels a row put a frame's " +
                        std::to_string(model.vertex_count()) + " vertices on " + std::to_string(layout_.rows_per_frame) +
                        " rows, over " + std::to_string(kVatMaxSize) + "; expected at least " +
                        std::to_string((model.vertex_count() + kVatMaxSize - 1) / kVatMaxSize) + " (or 0: as wide as the vertices)");
     if (layout_.height > kVatMaxSize)
-      throw InputError(options.pointer + ": the vertex animation textures would be " + std::to_string(layout_.width) +
+      throw InputError(options.where() + ": the vertex animation textures would be " + std::to_string(layout_.width) +
                        " x " + std::to_string(layout_.height) + " texels (" + std::to_string(layout_.rows_per_frame) +
                        " rows a frame x " + std::to_string(selection_.written()) + " frames), over " +
                        std::to_string(kVatMaxSize) + " x " + std::to_string(kVatMaxSize) + "; at most " +

@@ -347,12 +347,12 @@ TEST_F(OutputSetTest, EachFileOfSeveralWritersHasOne) {
               t.add_outputs(a, dir_, info.frame_start, info.frame_count, "tree a", false);
               t.add_outputs({output("hdf5", "shared.pc2")}, dir_, info.frame_start, info.frame_count, "tree b");
             }),
-            "tree b: /outputs/0/path: writes " + (dir_ / "shared.pc2").string() +
+            "/outputs/0/path of tree b: writes " + (dir_ / "shared.pc2").string() +
                 ", which /outputs/0 of tree a writes too");
   EXPECT_EQ(refusal([&](OutputTargets& t) {
               t.add_outputs({output("hdf5", "forest.json")}, dir_, info.frame_start, info.frame_count, "tree forest");
             }),
-            "tree forest: /outputs/0/path: writes " + (dir_ / "forest.json").string() +
+            "/outputs/0/path of tree forest: writes " + (dir_ / "forest.json").string() +
                 ", which the forest's manifest writes too");
   std::filesystem::create_directories(dir_ / "b.h5");
   EXPECT_EQ(refusal([&](OutputTargets& t) {
