@@ -296,8 +296,8 @@ def case_targets(treeanim, tmp):
         os.makedirs(os.path.dirname(os.path.join(out, name)), exist_ok=True)
         with open(os.path.join(out, name), "wb") as f:
             f.write(b"earlier bake of " + name.encode())
-    in_the_way = [("trees/hero-bush.h5", "/outputs/0/path: "), ("forest.parts/hero-bush.json", ""),
-                  ("forest.json", ""), ("forest.html", "")]
+    in_the_way = [("trees/hero-bush.h5", "forest-demo.json: /outputs/0/path of tree hero-bush: "),
+                  ("forest.parts/hero-bush.json", ""), ("forest.json", ""), ("forest.html", "")]
     for name, pointer in in_the_way:
         folder = os.path.join(out, name)
         os.makedirs(folder)
