@@ -1,5 +1,7 @@
 // The air velocity each cluster feels (docs/solver.md, "Wind and forces"): sampled once per
 // cluster and step, at the rest centre (a flying leaf: at its centre).
+#include <algorithm>
+
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -66,11 +68,46 @@ void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& 
   scratch.cluster_air.row(c) = velocity.transpose().template cast<Real>();
 }
 
+template <typename Real>
+void sample_clusters_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                         StepScratch<Real>& scratch, std::span<const uint32_t> clusters) {
+  // Clusters at rest centres in air without a volume, four at a time; the others one by one.
+  const size_t P = size_t(model.wind.phase_count());
+  uint32_t lane[4];
+  size_t n = 0;
+  auto flush = [&] {
+    const double* sin_a[4];
+    const double* cos_a[4];
+    for (size_t l = 0; l < 4; ++l) {
+      const uint32_t c = lane[std::min(l, n - 1)];  // lanes past the last repeat it
+      sin_a[l] = &model.cluster_phase_sin[c * P], cos_a[l] = &model.cluster_phase_cos[c * P];
+    }
+    double v[3][4];
+    model.wind.velocities(sin_a, cos_a, scratch.air, v);
+    for (size_t l = 0; l < n; ++l)
+      for (int i = 0; i < 3; ++i) scratch.cluster_air(lane[l], i) = static_cast<Real>(v[i][l]);
+    n = 0;
+  };
+  for (const uint32_t c : clusters) {
+    if (model.wind.volume() || attachment.cluster_flying[c]) {
+      sample_cluster_air(model, attachment, state, scratch, c);
+      continue;
+    }
+    lane[n++] = c;
+    if (n == 4) flush();
+  }
+  if (n > 0) flush();
+}
+
 template void set_air_time(const SolverModel<float>&, double, StepScratch<float>&);
 template void set_air_time(const SolverModel<double>&, double, StepScratch<double>&);
 template void sample_cluster_air(const SolverModel<float>&, const Attachment<float>&, const SimState&,
                                  StepScratch<float>&, size_t);
 template void sample_cluster_air(const SolverModel<double>&, const Attachment<double>&, const SimState&,
                                  StepScratch<double>&, size_t);
+template void sample_clusters_air(const SolverModel<float>&, const Attachment<float>&, const SimState&,
+                                  StepScratch<float>&, std::span<const uint32_t>);
+template void sample_clusters_air(const SolverModel<double>&, const Attachment<double>&, const SimState&,
+                                  StepScratch<double>&, std::span<const uint32_t>);
 
 }  // namespace treeanim

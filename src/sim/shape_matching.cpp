@@ -233,15 +233,20 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
         balanced_range(model.match_work_offsets, omp_get_thread_num(), omp_get_num_threads());
     const size_t first = range.first, last = range.second;
     MatchLanes<Real> branches(model, attachment, state, scratch, false, true);
+    uint32_t leaves[kMatchLanes];  // the leaves are matched after their branches; their air now
+    size_t n = 0;
     with_kernel_isa([&] {
       for (size_t c = first; c < last; ++c) {
         if (!cluster_awake(model, attachment, state, c)) continue;
-        if (attachment.cluster_pin_slot[c] == kNone)
+        if (attachment.cluster_pin_slot[c] == kNone) {
           branches.add(static_cast<uint32_t>(c));
-        else
-          sample_cluster_air(model, attachment, state, scratch, c);  // the leaf is matched after its branch
+        } else {
+          leaves[n++] = static_cast<uint32_t>(c);
+          if (n == kMatchLanes) sample_clusters_air(model, attachment, state, scratch, {leaves, n}), n = 0;
+        }
       }
       branches.flush();
+      sample_clusters_air(model, attachment, state, scratch, {leaves, n});
     });
     bad = std::min(bad, branches.bad());
     if (!model.pinned_leaf_clusters.empty()) {

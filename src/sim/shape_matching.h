@@ -54,8 +54,7 @@ class MatchLanes {
     if (count_ == 0) return;
     const std::span<const uint32_t> clusters(clusters_, count_);
     bad_ = std::min(bad_, match_in_lanes(model_, attachment_, state_, scratch_, clusters, pinned_));
-    if (air_)
-      for (const uint32_t c : clusters) sample_cluster_air(model_, attachment_, state_, scratch_, c);
+    if (air_) sample_clusters_air(model_, attachment_, state_, scratch_, clusters);
     count_ = 0;
   }
   // The lowest cluster whose fit was not finite, kNone for none.

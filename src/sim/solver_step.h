@@ -21,6 +21,11 @@ void set_air_time(const SolverModel<Real>& model, double t, StepScratch<Real>& s
 template <typename Real>
 void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                         StepScratch<Real>& scratch, size_t c);
+// The same for each of the listed clusters, those at their rest centres in air without a
+// volume four at a time (WindField::velocities), to the same bits.
+template <typename Real>
+void sample_clusters_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+                         StepScratch<Real>& scratch, std::span<const uint32_t> clusters);
 
 // --- correction.cpp: the per-vertex pass ---
 enum class VertexPass {

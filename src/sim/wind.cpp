@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-
+#include <cstring>
 #include <numbers>
 
 #include "common/random.h"
+#include "sim/kernel_isa.h"
+#include "sim/lanes.h"
 
 namespace treeanim {
 
@@ -201,6 +203,39 @@ Eigen::Vector3d WindField::velocity(const double* sin_a, const double* cos_a, co
     v += u * air.turbulence;
   }
   return v;
+}
+
+void WindField::velocities(const double* const (&sin_a)[4], const double* const (&cos_a)[4], const AirSample& air,
+                           double (&v)[3][4]) const {
+  with_kernel_isa([&] {
+    // Phase j of the four points as one vector (written lane by lane, then loaded; by
+    // reference: lanes.h).
+    auto lanes = [](const double* const (&a)[4], int j, Double4& x) {
+      const double lane[4] = {a[0][j], a[1][j], a[2][j], a[3][j]};
+      std::memcpy(&x, lane, sizeof x);
+    };
+    Double4 sin_j, cos_j;
+    Double4 sum[3];
+    for (int i = 0; i < 3; ++i) sum[i] = Double4{} + air.mean[i];
+    if ((air.gust.array() != 0).any()) {
+      Double4 gust = {};
+      for (int j = mode_count(); j < phase_count(); ++j) {
+        lanes(sin_a, j, sin_j), lanes(cos_a, j, cos_j);
+        gust += sin_j * air.cos_b[j] + cos_j * air.sin_b[j];
+      }
+      for (int i = 0; i < 3; ++i) sum[i] += air.gust[i] * (gust / kGustWaves);
+    }
+    if (air.turbulence != 0) {
+      Double4 u[3] = {};
+      for (int m = 0; m < mode_count(); ++m) {
+        lanes(sin_a, m, sin_j), lanes(cos_a, m, cos_j);
+        const Double4 wave = sin_j * air.cos_b[m] + cos_j * air.sin_b[m];
+        for (int i = 0; i < 3; ++i) u[i] += mode_amplitude(i, m) * wave;
+      }
+      for (int i = 0; i < 3; ++i) sum[i] += u[i] * air.turbulence;
+    }
+    std::memcpy(v, sum, sizeof v);
+  });
 }
 
 Eigen::Vector3d WindField::velocity(const Eigen::Vector3d& x, double t) const {

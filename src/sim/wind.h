@@ -62,6 +62,10 @@ class WindField {
   // The same about the mean wind `mean` (a volume's at x) in place of air.mean.
   Eigen::Vector3d velocity(const double* sin_a, const double* cos_a, const AirSample& air,
                            const Eigen::Vector3d& mean) const;
+  // Four points' spatial phases (a lane each) + the terms at t => their air velocities about
+  // air.mean, each lane the arithmetic of velocity() (lanes.h): v[i][l] is component i of lane l's.
+  void velocities(const double* const (&sin_a)[4], const double* const (&cos_a)[4], const AirSample& air,
+                  double (&v)[3][4]) const;
   // x (m), t => the air velocity (m/s); the two calls above for a single point.
   Eigen::Vector3d velocity(const Eigen::Vector3d& x, double t) const;
 
