@@ -43,11 +43,12 @@ inline void rodrigues(const T& tx, const T& ty, const T& tz, const T& a2, const 
 // below 0.05 rad (a2 below 0.0025), as far as a joint of the chain turns in an ordinary wind.
 // hsm.particles "samples" takes them: its clusters' fixed costs are its step's, and the
 // library's sine, cosine and matrix were some 4 % of them; "vertices" keeps the paper's
-// set-up byte for byte.
+// set-up byte for byte. Each factor is a product by a constant's reciprocal, not a division:
+// a vector division costs several products.
 template <typename T>
 inline void small_turn_factors(const T& a2, T& sine, T& versine) {
-  sine = 1 - a2 / 6 * (1 - a2 / 20 * (1 - a2 / 42 * (1 - a2 / 72)));
-  versine = 0.5 * (1 - a2 / 12 * (1 - a2 / 30 * (1 - a2 / 56 * (1 - a2 / 90))));
+  sine = 1 - a2 * (1.0 / 6) * (1 - a2 * (1.0 / 20) * (1 - a2 * (1.0 / 42) * (1 - a2 * (1.0 / 72))));
+  versine = 0.5 * (1 - a2 * (1.0 / 12) * (1 - a2 * (1.0 / 30) * (1 - a2 * (1.0 / 56) * (1 - a2 * (1.0 / 90)))));
 }
 
 // Past 0.05 rad, Rodrigues' factors from their longer series (turn_series.h) up to 1.6 rad,
@@ -357,12 +358,13 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         const Double4 give = angle > largest ? largest / angle : one;
         // Without a drag area or unresolved air, the capped turn (capped_turn).
         const Mask4 mean = averaged & (drag_area > zero);
-        const Double4 gx = g[0] / drag_area, gy = g[1] / drag_area, gz = g[2] / drag_area;
+        const Double4 per_area = 1 / drag_area;
+        const Double4 gx = g[0] * per_area, gy = g[1] * per_area, gz = g[2] * per_area;
         Double4 size = (gx * gx + gy * gy) + gz * gz;
         sqrt_lanes(size);
         sqrt_lanes(size);
-        const Double4 ux = size > zero ? gx / size : zero, uy = size > zero ? gy / size : zero,
-                      uz = size > zero ? gz / size : zero;
+        const Double4 per_size = size > zero ? 1 / size : zero;
+        const Double4 ux = gx * per_size, uy = gy * per_size, uz = gz * per_size;
         Double4 fx = zero, fy = zero, fz = zero, fastest = zero;
         for (int p = 0; p < 6; ++p) {
           const Double4 ax = ux + d[p][0], ay = uy + d[p][1], az = uz + d[p][2];
@@ -372,7 +374,7 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
           fastest = fastest < speed ? speed : fastest;  // std::max
         }
         const Double4 rx = j * r[0], ry = j * r[1], rz = j * r[2];
-        const Double4 wx = fx / 6 - gx, wy = fy / 6 - gy, wz = fz / 6 - gz;
+        const Double4 wx = fx * (1.0 / 6) - gx, wy = fy * (1.0 / 6) - gy, wz = fz * (1.0 / 6) - gz;
         const Double4 tx = mean ? lx + (ry * wz - rz * wy) : lx * give;
         const Double4 ty = mean ? ly + (rz * wx - rx * wz) : ly * give;
         const Double4 tz = mean ? lz + (rx * wy - ry * wx) : lz * give;
