@@ -3,14 +3,25 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
+#include <tbb/global_control.h>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <string_view>
+#include <utility>
 
 #include "sim/volume_grids.h"
 
@@ -216,7 +227,7 @@ class LayoutWalk {
       char start[12] = {};
       in_.read(start, std::streamsize(size_));
       if (size_ > 0 && std::memcmp(start, &expected, std::min<size_t>(size_, sizeof expected)) == 0)
-        throw std::runtime_error(cut("the header"));
+        throw std::runtime_error(past_limit("the header"));
       return;
     }
     read(magic, "the header"), read(version, "the header");
@@ -238,6 +249,14 @@ class LayoutWalk {
       read(grid, what + "'s descriptor"), read(block, what + "'s descriptor"), read(end, what + "'s descriptor");
       if (grid < int64_t(at_) || block < grid || end < block)
         throw std::runtime_error(what + "'s descriptor places it outside its own bounds");
+      // The grid's own metadata, read before its transform and tree, lies before its data
+      // block: a flipped length there made OpenVDB read on past the file's end and take 16 GB.
+      skip(uint64_t(grid) - at_, what + ", which begins at byte " + std::to_string(grid));
+      within(uint64_t(block), "the grid's data, which begins at byte " + std::to_string(block), [&] {
+        if (version >= openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) skip(4, what + "'s compression flags");
+        const uint64_t tree_bytes = limit_ - at_;
+        metadata(what + "'s metadata", &tree_bytes);
+      });
       skip(uint64_t(end) - at_, what + ", which ends at byte " + std::to_string(end));
     }
   }
@@ -245,18 +264,30 @@ class LayoutWalk {
  private:
   std::ifstream in_;
   uint64_t size_, at_ = 0;
+  uint64_t limit_ = size_;  // where what is walked must end: the file's end, a grid's data block, a value's end
+  std::string limit_name_;  // that end before the file's, as messages name it
 
-  std::string cut(const std::string& what) const {
+  // `what` runs past the limit => why the file cannot be read.
+  std::string past_limit(const std::string& what) const {
+    if (limit_ < size_) return what + " runs past " + limit_name_;
     return "the file is cut short: it ends at byte " + std::to_string(size_) + ", inside " + what;
   }
+  // Walks what `walk` reads with its end at byte `end`, named `name`.
+  template <typename Walk>
+  void within(uint64_t end, const std::string& name, Walk walk) {
+    const uint64_t outer = std::exchange(limit_, std::min(end, limit_));
+    std::string outer_name = std::exchange(limit_name_, name);
+    walk();
+    limit_ = outer, limit_name_ = std::move(outer_name);
+  }
   void skip(uint64_t bytes, const std::string& what) {
-    if (bytes > size_ - at_) throw std::runtime_error(cut(what));
+    if (bytes > limit_ - at_) throw std::runtime_error(past_limit(what));
     at_ += bytes;
     in_.seekg(std::streamoff(at_));
   }
   template <typename T>
   void read(T& value, const std::string& what) {
-    if (sizeof value > size_ - at_) throw std::runtime_error(cut(what));
+    if (sizeof value > limit_ - at_) throw std::runtime_error(past_limit(what));
     in_.read(reinterpret_cast<char*>(&value), sizeof value);
     at_ += sizeof value;
   }
@@ -265,17 +296,73 @@ class LayoutWalk {
     read(length, what);
     skip(length, what);
   }
-  void metadata(const std::string& what) {  // a count, then name, type and value of each item
+  // A count, then name, type and value of each item. In a grid's own metadata (`tree_bytes`:
+  // the bytes before its data block, which hold its tree), a delayed-load table is checked inside.
+  void metadata(const std::string& what, const uint64_t* tree_bytes = nullptr) {
     uint32_t count = 0;
     read(count, what);
-    for (uint32_t k = 0; k < count; ++k)
-      for (int part = 0; part < 3; ++part) text(what);
+    for (uint32_t k = 0; k < count; ++k) {
+      text(what);
+      uint32_t length = 0;
+      read(length, what);
+      std::string type;
+      if (tree_bytes && length == kDelayedLoad.size()) {
+        type.resize(length);
+        if (length > limit_ - at_) throw std::runtime_error(past_limit(what));
+        in_.read(type.data(), length);
+        at_ += length;
+      } else {
+        skip(length, what);
+      }
+      if (type == kDelayedLoad)
+        delayed_load(what, *tree_bytes);
+      else
+        text(what);
+    }
+  }
+
+  // OpenVDB's table of which leaf nodes a grid may load later (io::DelayedLoadMetadata): a
+  // count of leaves, their masks and their compressed sizes, each raw or as a Blosc buffer.
+  // OpenVDB sizes its arrays by that count and by the sizes the Blosc headers give, and reads
+  // on whatever they say: a flipped bit in them took it to 6.7 GB.
+  static constexpr std::string_view kDelayedLoad = "__delayedload";
+  void delayed_load(const std::string& what, uint64_t tree_bytes) {
+    uint32_t length = 0;
+    read(length, what);
+    if (length == 0) return;
+    const std::string table = what + "'s delayed-load table";
+    const uint64_t end = at_ + length;
+    if (end > limit_) throw std::runtime_error(past_limit(table));
+    within(end, "the table's " + std::to_string(length) + " bytes", [&] { delayed_load_table(table, tree_bytes); });
+    skip(end - at_, table);
+  }
+  void delayed_load_table(const std::string& table, uint64_t tree_bytes) {
+    uint32_t count = 0, bytes = 0;
+    read(count, table), read(bytes, table);
+    // Each leaf node's value mask takes 64 bytes of the tree (its origin follows from its place).
+    if (count > tree_bytes / 64)
+      throw std::runtime_error(table + " counts " + std::to_string(count) + " leaf nodes, more than the grid's " +
+                               std::to_string(tree_bytes) + " bytes of tree can hold");
+    auto array = [&](uint32_t compressed, uint64_t element, const std::string& part) {
+      if (compressed == 0) return skip(count * element, part);
+      // Blosc's header: its uncompressed size at byte 4, its compressed size at byte 12.
+      uint32_t header[4] = {};
+      if (compressed < sizeof header) throw std::runtime_error(part + " is shorter than a Blosc header");
+      read(header, part);
+      // OpenVDB pads an array of 48 to 127 bytes by 128 before it compresses it.
+      if (header[1] < count * element || header[1] > count * element + 128 || header[3] > compressed)
+        throw std::runtime_error(part + " does not hold the " + std::to_string(count) + " values its count says");
+      skip(compressed - sizeof header, part);
+    };
+    array(bytes, sizeof(int8_t), table + " (its masks)");
+    read(bytes, table);
+    if (bytes != std::numeric_limits<uint32_t>::max()) array(bytes, sizeof(int64_t), table + " (its sizes)");
   }
 };
 
-// Frame file, grid name => its grids read whole; throws std::runtime_error with what is wrong.
+// Frame file, grid name => its grids read whole (OpenVDB initialised); throws
+// std::runtime_error with what is wrong.
 std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::string& name) {
-  std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
   auto frame = std::make_unique<OpenVdbGrids>();
   frame->name = name;
   LayoutWalk(path).walk();
@@ -313,6 +400,81 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
   return frame;
 }
 
+// Frame file, grid name => its grids, or null with what is wrong with the file or the grid.
+std::unique_ptr<OpenVdbGrids> try_read(const std::string& path, const std::string& name, std::string& error) {
+  try {
+    return read_grids(path, name);
+  } catch (const std::invalid_argument& e) {
+    error = e.what();
+  } catch (const std::exception& e) {  // openvdb::Exception, and the streams' failures on a truncated file
+    error = std::string("not a readable VDB file (") + e.what() + ")";
+  }
+  return nullptr;
+}
+
+// The memory a trial read may take beyond what the process holds: a grid expands its
+// compressed file many times over.
+constexpr uint64_t kTrialBytes = uint64_t(2) << 30, kTrialFileTimes = 64;
+
+// OpenVDB's reader trusts the lengths inside a grid's tree and data: a raw chunk longer than
+// its node is read over the heap past the node's buffer (a flipped bit in a leaf's length did
+// that, and malloc aborted), and counts size what it allocates. So each file is first read in
+// a child process with its memory capped, and read in this one only when that read came
+// through. => nothing, or what is wrong with the file.
+std::string trial_read(const std::string& path, const std::string& name) {
+  int channel[2];
+  if (pipe(channel) != 0) return "";  // no trial without a pipe: the read in this process is the only one
+  const pid_t child = fork();
+  if (child < 0) {
+    close(channel[0]), close(channel[1]);
+    return "";
+  }
+  if (child == 0) {
+    close(channel[0]);
+    // The cap is on address space, above what the child starts with: the parent's (terabytes
+    // with AddressSanitizer's shadow).
+    unsigned long long pages = 0;
+    if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+      if (std::fscanf(statm, "%llu", &pages) != 1) pages = 0;
+      std::fclose(statm);
+    }
+    const rlim_t cap = pages * uint64_t(sysconf(_SC_PAGESIZE)) + kTrialBytes +
+                       kTrialFileTimes * std::filesystem::file_size(path);
+    const rlimit limit = {cap, cap};
+    setrlimit(RLIMIT_AS, &limit);
+    std::string error;
+    try_read(path, name, error);
+    for (size_t done = 0; done < error.size();) {
+      const ssize_t n = write(channel[1], error.data() + done, error.size() - done);
+      if (n <= 0) break;
+      done += size_t(n);
+    }
+    _exit(error.empty() ? 0 : 1);  // no exit handlers, no leak checks: the parent carries on
+  }
+  close(channel[1]);
+  std::string error;
+  char buffer[4096];
+  for (ssize_t n; (n = read(channel[0], buffer, sizeof buffer)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    error.append(buffer, size_t(n));
+  }
+  close(channel[0]);
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    return "not a readable VDB file (OpenVDB's reader failed on it with signal " + std::to_string(WTERMSIG(status)) +
+           " (" + strsignal(WTERMSIG(status)) + "): the file is damaged)";
+  if (WIFEXITED(status) && WEXITSTATUS(status) != 0 && error.empty())
+    return "not a readable VDB file (reading it failed without a message)";
+  return error;
+}
+
+// Files that came through a trial read, with their size and time then: each is tried once.
+std::mutex tried_mutex;
+std::map<std::string, std::pair<uintmax_t, std::filesystem::file_time_type>> tried;
+
 }  // namespace
 
 }  // namespace treeanim
@@ -320,12 +482,22 @@ std::unique_ptr<OpenVdbGrids> read_grids(const std::string& path, const std::str
 // The entry point (sim/volume_grids.h): no exception leaves the module.
 extern "C" __attribute__((visibility("default"))) treeanim::VolumeGrids* treeanim_read_volume_grids(
     const std::string& path, const std::string& grid, std::string& error) {
+  using namespace treeanim;
+  // OpenVDB's parallel loops (a tree's clear, its bounding box) run on the calling thread: a
+  // child forked while TBB's workers exist waits for them for ever.
+  static const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
   try {
-    return treeanim::read_grids(path, grid).release();
-  } catch (const std::invalid_argument& e) {
-    error = e.what();
-  } catch (const std::exception& e) {  // openvdb::Exception, and the streams' failures on a truncated file
+    std::call_once(openvdb_initialised, [] { openvdb::initialize(); });  // before the fork: the child only reads
+    const auto stamp = std::make_pair(std::filesystem::file_size(path), std::filesystem::last_write_time(path));
+    std::lock_guard lock(tried_mutex);
+    if (auto it = tried.find(path); it == tried.end() || it->second != stamp) {
+      error = trial_read(path, grid);
+      if (!error.empty()) return nullptr;
+      tried[path] = stamp;
+    }
+  } catch (const std::exception& e) {  // the file's size or time could not be read
     error = std::string("not a readable VDB file (") + e.what() + ")";
+    return nullptr;
   }
-  return nullptr;
+  return try_read(path, grid, error).release();
 }

@@ -14,6 +14,7 @@ import json
 import os
 import re
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
@@ -69,6 +70,25 @@ def check_bad(treeanim, tmp):
     descriptor_cut = whole.index(b"\x03\x00\x00\x00vel") + 5
     truncated_descriptor = copy_with("truncated-descriptor", whole[:descriptor_cut])
     truncated_header = copy_with("truncated-header", whole[:6])  # OpenVDB found no grids in it
+
+    def flipped(name, position, bit):
+        damaged = bytearray(whole)
+        damaged[position] ^= 1 << bit
+        return copy_with(name, bytes(damaged))
+    # A length inside the grid's own metadata 32 KB too long: OpenVDB read on past the file's end
+    # and took 16 GB. The value of its string item "file_compression" follows its name and type.
+    compression_value = whole.index(b"file_compression\x06\x00\x00\x00string") + 16 + 4 + 6
+    metadata_length = flipped("metadata-length", compression_value + 1, 7)
+    # The count of leaves in its delayed-load table 4,096 too large: OpenVDB sized its arrays by it.
+    delayed_count = flipped("delayed-load-count", whole.index(b"__delayedload") + 13 + 4 + 1, 4)
+    # The first leaf's values as a raw chunk of 64 KB, with that much more file after it: OpenVDB
+    # reads it into the leaf's 6 KB buffer before it checks the length, over the heap beyond.
+    grid, block, end = struct.unpack_from("<3q", whole, whole.index(b"Tree_vec3s_5_4_3") + 16 + 4)
+    leaf_values = block + 64 + 1  # the leaf's value mask, its byte of what is stored, then its values
+    assert whole[block + 64] in (0, 1, 6), "the first leaf stores no inactive values: its chunk's length follows"
+    raw_chunk = bytearray(whole)
+    struct.pack_into("<q", raw_chunk, leaf_values, -65536)
+    raw_chunk = copy_with("raw-chunk", bytes(raw_chunk) + bytes(65536))
     nan = os.path.join(tmp, "nan")
     write_volume("uniform", "houdini", nan, "--frames", "1", "10", "--voxel", "1", "--nan-at", "3")
     fast = os.path.join(tmp, "fast")
@@ -114,6 +134,13 @@ def check_bad(treeanim, tmp):
          "grid 1's descriptor)"),
         ("truncated-header", volume(truncated_header), nine,
          "vel.0003.vdb: not a readable VDB file (the file is cut short: it ends at byte 6, inside the header)"),
+        ("metadata-length", volume(metadata_length), nine,
+         f"metadata-length/vel.0003.vdb: not a readable VDB file (grid 1's metadata runs past the grid's data, "
+         f"which begins at byte {block})"),
+        ("delayed-load-count", volume(delayed_count), nine,
+         "delayed-load-count/vel.0003.vdb: not a readable VDB file (grid 1's metadata's delayed-load table counts "
+         "4"),
+        ("raw-chunk", volume(raw_chunk), nine, "raw-chunk/vel.0003.vdb: not a readable VDB file ("),
         ("missing-grid", volume(vol, grid="velocity"), nine,
          "vel.0001.vdb: no grid 'velocity' (nor 'velocity.x', 'velocity.y', 'velocity.z'); its grids: 'vel' (vec3s)"),
         ("grid-of-another-type", volume(scalar), nine,
