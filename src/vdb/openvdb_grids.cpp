@@ -5,12 +5,15 @@
 #include <openvdb/tools/Interpolation.h>
 #include <tbb/global_control.h>
 
+#include <poll.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -422,6 +425,7 @@ constexpr uint64_t kTrialBytes = uint64_t(2) << 30, kTrialFileTimes = 64;
 // a child process with its memory capped, and read in this one only when that read came
 // through. => nothing, or what is wrong with the file.
 std::string trial_read(const std::string& path, const std::string& name) {
+  const uint64_t file_bytes = std::filesystem::file_size(path);  // here: nothing may throw in the child
   int channel[2];
   if (pipe(channel) != 0) return "";  // no trial without a pipe: the read in this process is the only one
   const pid_t child = fork();
@@ -438,12 +442,17 @@ std::string trial_read(const std::string& path, const std::string& name) {
       if (std::fscanf(statm, "%llu", &pages) != 1) pages = 0;
       std::fclose(statm);
     }
-    const rlim_t cap = pages * uint64_t(sysconf(_SC_PAGESIZE)) + kTrialBytes +
-                       kTrialFileTimes * std::filesystem::file_size(path);
-    const rlimit limit = {cap, cap};
-    setrlimit(RLIMIT_AS, &limit);
+    if (pages > 0) {
+      const rlim_t cap = pages * uint64_t(sysconf(_SC_PAGESIZE)) + kTrialBytes + kTrialFileTimes * file_bytes;
+      const rlimit limit = {cap, cap};
+      setrlimit(RLIMIT_AS, &limit);
+    }
     std::string error;
-    try_read(path, name, error);
+    try {
+      try_read(path, name, error);
+    } catch (...) {  // the message's own allocation failed under the cap
+      _exit(1);
+    }
     for (size_t done = 0; done < error.size();) {
       const ssize_t n = write(channel[1], error.data() + done, error.size() - done);
       if (n <= 0) break;
@@ -452,22 +461,39 @@ std::string trial_read(const std::string& path, const std::string& name) {
     _exit(error.empty() ? 0 : 1);  // no exit handlers, no leak checks: the parent carries on
   }
   close(channel[1]);
+  // A child that neither ends nor writes within a minute and a second per MB is stopped.
+  const int seconds = int(std::min<uint64_t>(60 + (file_bytes >> 20), 3600));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
   std::string error;
-  char buffer[4096];
-  for (ssize_t n; (n = read(channel[0], buffer, sizeof buffer)) != 0;) {
+  bool late = false;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd ready = {channel[0], POLLIN, 0};
+    const int polled = poll(&ready, 1, int(std::max<int64_t>(left.count(), 0)));
+    if (polled < 0 && errno == EINTR) continue;
+    if (polled == 0) {
+      late = true;
+      kill(child, SIGKILL);
+      break;
+    }
+    char buffer[4096];
+    const ssize_t n = polled < 0 ? -1 : read(channel[0], buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) break;
+    if (n <= 0) break;
     error.append(buffer, size_t(n));
   }
   close(channel[0]);
   int status = 0;
   while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
+  if (late)
+    return "not a readable VDB file (OpenVDB's reader was still reading it after " + std::to_string(seconds) + " s)";
   if (WIFSIGNALED(status))
     return "not a readable VDB file (OpenVDB's reader failed on it with signal " + std::to_string(WTERMSIG(status)) +
            " (" + strsignal(WTERMSIG(status)) + "): the file is damaged)";
   if (WIFEXITED(status) && WEXITSTATUS(status) != 0 && error.empty())
-    return "not a readable VDB file (reading it failed without a message)";
+    return "not a readable VDB file (reading it failed without a message: it may have needed more than the " +
+           std::to_string((kTrialBytes + kTrialFileTimes * file_bytes) >> 30) + " GiB a trial read may take)";
   return error;
 }
 
