@@ -13,6 +13,8 @@
 #include "common/errors.h"
 #include "common/message_text.h"
 #include "sim/kernel_isa.h"
+#include "sim/volume_grids.h"
+#include "sim/wind_volume.h"
 #include "treeanim_version.h"
 
 namespace treeanim {
@@ -233,6 +235,9 @@ int run_reporting_errors(const Subcommands& commands, Arguments& args) {
 }  // namespace
 
 int run_command_line(int argc, char** argv) {
+  // The wind volume's reader checking a file in a process of its own (sim/volume_grids.h).
+  if (argc == 2 && std::string(argv[1]) == kVolumeTrialArgument) return serve_volume_trials();
+  allow_volume_trials();
   CLI::App app{"treeanim " TREEANIM_VERSION
                " - grows trees from L-systems and bakes their motion in wind with hierarchical "
                "shape matching"};

@@ -41,7 +41,16 @@ class VolumeGrids {
 // The module's entry point, found by this name: a frame file and its grid's name => its
 // grids read whole (no delayed loading: a truncated file fails here, not in a step), or null
 // with `error` set to what is wrong (a message that follows the file's path).
-using ReadVolumeGrids = VolumeGrids*(const std::string& path, const std::string& grid, std::string& error);
+// With `trial_program` (the treeanim binary; null: no trial), the entry point first reads a file
+// it has not read before in a process of its own, `trial_program --volume-trial` (OpenVDB's
+// reader can overflow its heap on a damaged file), whose command line calls the module's trial
+// entry: file after file from stdin, each read and let go with the process's address space
+// capped, and what is wrong, or nothing, answered on stdout => exit 0 at the end of stdin.
+using ReadVolumeGrids = VolumeGrids*(const std::string& path, const std::string& grid, const char* trial_program,
+                                     std::string& error);
 constexpr const char* kReadVolumeGrids = "treeanim_read_volume_grids";
+using ServeVolumeTrials = int();
+constexpr const char* kServeVolumeTrials = "treeanim_trial_serve_volumes";
+constexpr const char* kVolumeTrialArgument = "--volume-trial";
 
 }  // namespace treeanim

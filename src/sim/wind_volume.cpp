@@ -23,26 +23,33 @@ struct VolumeFrame {
 
 namespace {
 
-// The OpenVDB module's entry point, the module loaded from beside the running binary on first
-// use (volume_grids.h). Throws InputError when it cannot be loaded: the scene asks for a reader
-// this installation lacks.
-ReadVolumeGrids* volume_reader() {
+// The OpenVDB module's entry point `name`, the module loaded from beside the running binary on
+// first use (volume_grids.h). Throws InputError when it cannot be loaded: the scene asks for a
+// reader this installation lacks.
+void* volume_module_entry(const char* name) {
   static std::string failure;
-  static ReadVolumeGrids* const read = []() -> ReadVolumeGrids* {
+  static void* const handle = []() -> void* {
     std::error_code error;
     const std::filesystem::path module =
         std::filesystem::read_symlink("/proc/self/exe", error).parent_path() / TREEANIM_VOLUME_MODULE;
-    void* handle = dlopen(module.c_str(), RTLD_NOW | RTLD_LOCAL);
-    void* entry = handle ? dlsym(handle, kReadVolumeGrids) : nullptr;
-    if (!entry) {
+    void* loaded = dlopen(module.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!loaded) {
       const char* why = dlerror();
-      failure = "treeanim's OpenVDB reader could not be loaded (" + std::string(why ? why : "no entry point") +
+      failure = "treeanim's OpenVDB reader could not be loaded (" + std::string(why ? why : "no reason given") +
                 "): it is built beside the treeanim binary, and a binary copied elsewhere needs it beside it";
-      return nullptr;
     }
-    return reinterpret_cast<ReadVolumeGrids*>(entry);
+    return loaded;
   }();
-  if (!read) throw InputError(failure);
+  if (!handle) throw InputError(failure);
+  void* entry = dlsym(handle, name);
+  if (!entry) throw InputError("treeanim's OpenVDB reader lacks its entry point " + std::string(name));
+  return entry;
+}
+
+bool volume_trials = false;  // allow_volume_trials
+
+ReadVolumeGrids* volume_reader() {
+  static ReadVolumeGrids* const read = reinterpret_cast<ReadVolumeGrids*>(volume_module_entry(kReadVolumeGrids));
   return read;
 }
 
@@ -54,7 +61,7 @@ VolumeFrame read_frame(const std::string& path, const std::string& name) {
     throw InputError(path + ": the volume frame is missing (no such file, or not a regular file)");
   std::string what;
   VolumeFrame frame;
-  frame.grids.reset(read(path, name, what));
+  frame.grids.reset(read(path, name, volume_trials ? "/proc/self/exe" : nullptr, what));
   if (!frame.grids) throw InputError(path + ": " + what);
   note_input_file(path);
   return frame;
@@ -67,6 +74,16 @@ bool has_frame_number(const std::filesystem::path& pattern) {
 }
 
 }  // namespace
+
+void allow_volume_trials() { volume_trials = true; }
+
+int serve_volume_trials() {
+  try {
+    return reinterpret_cast<ServeVolumeTrials*>(volume_module_entry(kServeVolumeTrials))();
+  } catch (const InputError&) {  // no module: the reader that spawned this one reads unchecked
+    return 1;
+  }
+}
 
 std::string volume_frame_path(const std::filesystem::path& pattern, long long number) {
   const std::string text = pattern.filename().string();

@@ -57,6 +57,12 @@ struct VolumeSummary {
 // most max_speed m/s. Throws InputError naming the file, the grid and the voxel or time.
 VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double t1, double max_speed);
 
+// `treeanim --volume-trial` (volume_grids.h) => its exit code: the module's trial reads.
+int serve_volume_trials();
+// The running binary answers --volume-trial (the treeanim command line): each volume file is
+// then read once by a process of its own before this one reads it (volume_grids.h).
+void allow_volume_trials();
+
 class WindVolume {
  public:
   explicit WindVolume(const VolumeOptions& options);

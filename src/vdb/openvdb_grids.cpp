@@ -3,10 +3,12 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
-#include <tbb/global_control.h>
 
+#include <fcntl.h>
 #include <poll.h>
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -419,105 +421,134 @@ std::unique_ptr<OpenVdbGrids> try_read(const std::string& path, const std::strin
 // compressed file many times over.
 constexpr uint64_t kTrialBytes = uint64_t(2) << 30, kTrialFileTimes = 64;
 
+// A message or a request over the trial's socket: a length, then that many bytes. => false when
+// the other end is gone. MSG_NOSIGNAL: a trial process that died is an answer, not a SIGPIPE.
+bool send_text(int socket, const std::string& text) {
+  const uint32_t length = uint32_t(text.size());
+  std::string bytes(reinterpret_cast<const char*>(&length), sizeof length);
+  bytes += text;
+  for (size_t done = 0; done < bytes.size();) {
+    const ssize_t n = send(socket, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
+  }
+  return true;
+}
+
+// Reads `size` bytes into `to` by `deadline` (none: wait) => false at the end of the stream, an
+// error or the deadline (`late` set).
+bool receive(int socket, char* to, size_t size, const std::chrono::steady_clock::time_point* deadline, bool& late) {
+  for (size_t done = 0; done < size;) {
+    if (deadline) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - std::chrono::steady_clock::now());
+      pollfd ready = {socket, POLLIN, 0};
+      const int polled = poll(&ready, 1, int(std::max<int64_t>(left.count(), 0)));
+      if (polled < 0 && errno == EINTR) continue;
+      if (polled == 0) late = true;
+      if (polled <= 0) return false;
+    }
+    const ssize_t n = read(socket, to + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
+  }
+  return true;
+}
+bool receive_text(int socket, std::string& text, const std::chrono::steady_clock::time_point* deadline, bool& late) {
+  uint32_t length = 0;
+  if (!receive(socket, reinterpret_cast<char*>(&length), sizeof length, deadline, late)) return false;
+  text.resize(length);
+  return receive(socket, text.data(), length, deadline, late);
+}
+
 // OpenVDB's reader trusts the lengths inside a grid's tree and data: a raw chunk longer than
 // its node is read over the heap past the node's buffer (a flipped bit in a leaf's length did
-// that, and malloc aborted), and counts size what it allocates. So each file is first read in
-// a child process with its memory capped, and read in this one only when that read came
-// through. => nothing, or what is wrong with the file.
-std::string trial_read(const std::string& path, const std::string& name) {
-  const uint64_t file_bytes = std::filesystem::file_size(path);  // here: nothing may throw in the child
-  int channel[2];
-  if (pipe(channel) != 0) return "";  // no trial without a pipe: the read in this process is the only one
-  const pid_t child = fork();
-  if (child < 0) {
-    close(channel[0]), close(channel[1]);
-    return "";
-  }
-  if (child == 0) {
-    close(channel[0]);
-    // The cap is on address space, above what the child starts with: the parent's (terabytes
-    // with AddressSanitizer's shadow).
-    unsigned long long pages = 0;
-    if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
-      if (std::fscanf(statm, "%llu", &pages) != 1) pages = 0;
-      std::fclose(statm);
-    }
-    if (pages > 0) {
-      const rlim_t cap = pages * uint64_t(sysconf(_SC_PAGESIZE)) + kTrialBytes + kTrialFileTimes * file_bytes;
-      const rlimit limit = {cap, cap};
-      setrlimit(RLIMIT_AS, &limit);
-    }
+// that, and malloc aborted), and counts size what it allocates. So each file is first read by
+// a process of its own, `treeanim --volume-trial` (spawned anew, not forked: a fork of this
+// process, threads and all, could wait for ever on a lock another thread held), which reads
+// file after file until one fails or this process ends; a file is read here only when that
+// read came through.
+class TrialReader {
+ public:
+  ~TrialReader() { stop(false); }
+  // => nothing, or what is wrong with the file.
+  std::string read_file(const char* program, const std::string& path, const std::string& name) {
+    const uint64_t file_bytes = std::filesystem::file_size(path);
+    if (child_ < 0 && !start(program)) return "";  // no trial process: the read in this one is the only one
+    // A trial that neither ends nor answers within a minute and a second per MB is stopped.
+    const int seconds = int(std::min<uint64_t>(60 + (file_bytes >> 20), 3600));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
     std::string error;
-    try {
-      try_read(path, name, error);
-    } catch (...) {  // the message's own allocation failed under the cap
-      _exit(1);
-    }
-    for (size_t done = 0; done < error.size();) {
-      const ssize_t n = write(channel[1], error.data() + done, error.size() - done);
-      if (n <= 0) break;
-      done += size_t(n);
-    }
-    _exit(error.empty() ? 0 : 1);  // no exit handlers, no leak checks: the parent carries on
-  }
-  close(channel[1]);
-  // A child that neither ends nor writes within a minute and a second per MB is stopped.
-  const int seconds = int(std::min<uint64_t>(60 + (file_bytes >> 20), 3600));
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
-  std::string error;
-  bool late = false;
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    pollfd ready = {channel[0], POLLIN, 0};
-    const int polled = poll(&ready, 1, int(std::max<int64_t>(left.count(), 0)));
-    if (polled < 0 && errno == EINTR) continue;
-    if (polled == 0) {
-      late = true;
-      kill(child, SIGKILL);
-      break;
-    }
-    char buffer[4096];
-    const ssize_t n = polled < 0 ? -1 : read(channel[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    error.append(buffer, size_t(n));
-  }
-  close(channel[0]);
-  int status = 0;
-  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (late)
-    return "not a readable VDB file (OpenVDB's reader was still reading it after " + std::to_string(seconds) + " s)";
-  if (WIFSIGNALED(status))
-    return "not a readable VDB file (OpenVDB's reader failed on it with signal " + std::to_string(WTERMSIG(status)) +
-           " (" + strsignal(WTERMSIG(status)) + "): the file is damaged)";
-  if (WIFEXITED(status) && WEXITSTATUS(status) != 0 && error.empty())
+    bool late = false;
+    if (send_text(socket_, path) && send_text(socket_, name) && receive_text(socket_, error, &deadline, late))
+      return error;
+    const int status = stop(late);
+    if (late)
+      return "not a readable VDB file (OpenVDB's reader was still reading it after " + std::to_string(seconds) + " s)";
+    if (WIFSIGNALED(status))
+      return "not a readable VDB file (OpenVDB's reader failed on it with signal " + std::to_string(WTERMSIG(status)) +
+             " (" + strsignal(WTERMSIG(status)) + "): the file is damaged)";
     return "not a readable VDB file (reading it failed without a message: it may have needed more than the " +
            std::to_string((kTrialBytes + kTrialFileTimes * file_bytes) >> 30) + " GiB a trial read may take)";
-  return error;
-}
+  }
+
+ private:
+  pid_t child_ = -1;
+  int socket_ = -1;
+
+  bool start(const char* program) {
+    int ends[2];
+    if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ends) != 0) return false;
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, ends[1], STDIN_FILENO);
+    posix_spawn_file_actions_adddup2(&actions, ends[1], STDOUT_FILENO);
+    std::string binary = program, argument = kVolumeTrialArgument;
+    char* arguments[] = {binary.data(), argument.data(), nullptr};
+    const int spawned = posix_spawn(&child_, program, &actions, nullptr, arguments, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(ends[1]);
+    if (spawned != 0) {
+      close(ends[0]);
+      child_ = -1;
+      return false;
+    }
+    socket_ = ends[0];
+    return true;
+  }
+  // The trial process ended (`kill`: killed first) => its wait status.
+  int stop(bool kill_it) {
+    if (child_ < 0) return 0;
+    if (kill_it) kill(child_, SIGKILL);
+    close(socket_);  // a trial process waiting for the next file ends
+    int status = 0;
+    while (waitpid(child_, &status, 0) < 0 && errno == EINTR) {
+    }
+    child_ = -1, socket_ = -1;
+    return status;
+  }
+};
 
 // Files that came through a trial read, with their size and time then: each is tried once.
 std::mutex tried_mutex;
 std::map<std::string, std::pair<uintmax_t, std::filesystem::file_time_type>> tried;
+TrialReader trial_reader;
 
 }  // namespace
 
 }  // namespace treeanim
 
-// The entry point (sim/volume_grids.h): no exception leaves the module.
+// The entry points (sim/volume_grids.h): no exception leaves the module.
 extern "C" __attribute__((visibility("default"))) treeanim::VolumeGrids* treeanim_read_volume_grids(
-    const std::string& path, const std::string& grid, std::string& error) {
+    const std::string& path, const std::string& grid, const char* trial_program, std::string& error) {
   using namespace treeanim;
-  // OpenVDB's parallel loops (a tree's clear, its bounding box) run on the calling thread: a
-  // child forked while TBB's workers exist waits for them for ever.
-  static const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
   try {
-    std::call_once(openvdb_initialised, [] { openvdb::initialize(); });  // before the fork: the child only reads
+    std::call_once(openvdb_initialised, [] { openvdb::initialize(); });
     const auto stamp = std::make_pair(std::filesystem::file_size(path), std::filesystem::last_write_time(path));
     std::lock_guard lock(tried_mutex);
-    if (auto it = tried.find(path); it == tried.end() || it->second != stamp) {
-      error = trial_read(path, grid);
+    if (auto it = tried.find(path); trial_program && (it == tried.end() || it->second != stamp)) {
+      error = trial_reader.read_file(trial_program, path, grid);
       if (!error.empty()) return nullptr;
       tried[path] = stamp;
     }
@@ -526,4 +557,34 @@ extern "C" __attribute__((visibility("default"))) treeanim::VolumeGrids* treeani
     return nullptr;
   }
   return try_read(path, grid, error).release();
+}
+
+extern "C" __attribute__((visibility("default"))) int treeanim_trial_serve_volumes() {
+  using namespace treeanim;
+  openvdb::initialize();
+  // File after file from the socket on stdin, each answered on stdout: nothing, or what is wrong.
+  for (std::string path, grid;;) {
+    bool late = false;
+    if (!receive_text(STDIN_FILENO, path, nullptr, late) || !receive_text(STDIN_FILENO, grid, nullptr, late)) return 0;
+    std::string error;
+    try {
+      // The cap is on address space, above what the process holds now (terabytes with
+      // AddressSanitizer's shadow): the soft limit, raised or lowered for each file.
+      unsigned long long pages = 0;
+      if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(statm, "%llu", &pages) != 1) pages = 0;
+        std::fclose(statm);
+      }
+      rlimit limit = {};
+      if (pages > 0 && getrlimit(RLIMIT_AS, &limit) == 0) {
+        limit.rlim_cur = std::min<rlim_t>(limit.rlim_max, pages * uint64_t(sysconf(_SC_PAGESIZE)) + kTrialBytes +
+                                                              kTrialFileTimes * std::filesystem::file_size(path));
+        setrlimit(RLIMIT_AS, &limit);
+      }
+      try_read(path, grid, error);
+    } catch (const std::exception& e) {  // the file's size, or the message's own allocation under the cap
+      error = std::string("not a readable VDB file (") + e.what() + ")";
+    }
+    if (!send_text(STDOUT_FILENO, error)) return 0;
+  }
 }
