@@ -4,7 +4,6 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
-#include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>
 #include <sys/resource.h>
