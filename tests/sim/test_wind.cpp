@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "correlation.h"
@@ -54,6 +55,35 @@ TEST(Wind, PointsOneMetreApartFeelNearlyTheSameAir) {
     const double r = correlation(here, air_series(field, x + step, dt, 60 * 24));
     EXPECT_GT(r, 0.95) << "1 m along " << step.transpose();
     RecordProperty(step.x() > 0 ? "correlation_1m_along" : "correlation_1m_across", std::to_string(r));
+  }
+}
+
+TEST(Wind, FourPointsInLanesGetEachPointsOwnBits) {
+  // The step samples its clusters' air four at a time (WindField::velocities): each lane must be
+  // velocity()'s value for that point to the bit, in gusts, turbulence, calm and a step's averages.
+  for (const WindOptions& options : {gusty_wind(), forest_wind(4), WindOptions{}}) {
+    const WindField field(options);
+    const int P = field.phase_count();
+    std::vector<double> sin_a(4 * size_t(P) + 1), cos_a(4 * size_t(P) + 1);
+    for (int l = 0; l < 4; ++l)
+      field.spatial_phases(Eigen::Vector3d(3.7 * l - 5, 0.9 * l, 11.0 - 6.3 * l), &sin_a[size_t(l * P)],
+                           &cos_a[size_t(l * P)]);
+    const double* sin_lanes[4] = {&sin_a[0], &sin_a[size_t(P)], &sin_a[size_t(2 * P)], &sin_a[size_t(3 * P)]};
+    const double* cos_lanes[4] = {&cos_a[0], &cos_a[size_t(P)], &cos_a[size_t(2 * P)], &cos_a[size_t(3 * P)]};
+    for (const double t : {0.0, 0.37, 2.5, 7.125}) {
+      for (const double window : {0.0, 1.0 / 48}) {
+        AirSample air;
+        field.sample_time(t, window, air);
+        double v[3][4];
+        field.velocities(sin_lanes, cos_lanes, air, v);
+        for (int l = 0; l < 4; ++l) {
+          const Eigen::Vector3d one = field.velocity(sin_lanes[l], cos_lanes[l], air);
+          for (int i = 0; i < 3; ++i)
+            EXPECT_EQ(std::memcmp(&v[i][l], &one[i], sizeof(double)), 0)
+                << "t " << t << ", lane " << l << ", component " << i << ": " << v[i][l] << " against " << one[i];
+        }
+      }
+    }
   }
 }
 
