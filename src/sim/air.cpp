@@ -69,34 +69,28 @@ void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& 
 }
 
 template <typename Real>
-void sample_clusters_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
-                         StepScratch<Real>& scratch, std::span<const uint32_t> clusters) {
-  // Clusters at rest centres in air without a volume, four at a time; the others one by one.
-  const size_t P = size_t(model.wind.phase_count());
-  uint32_t lane[4];
-  size_t n = 0;
-  auto flush = [&] {
-    const double* sin_a[4];
-    const double* cos_a[4];
-    for (size_t l = 0; l < 4; ++l) {
-      const uint32_t c = lane[std::min(l, n - 1)];  // lanes past the last repeat it
-      sin_a[l] = &model.cluster_phase_sin[c * P], cos_a[l] = &model.cluster_phase_cos[c * P];
-    }
-    double v[3][4];
-    model.wind.velocities(sin_a, cos_a, scratch.air, v);
-    for (size_t l = 0; l < n; ++l)
-      for (int i = 0; i < 3; ++i) scratch.cluster_air(lane[l], i) = static_cast<Real>(v[i][l]);
-    n = 0;
-  };
-  for (const uint32_t c : clusters) {
-    if (model.wind.volume() || attachment.cluster_flying[c]) {
-      sample_cluster_air(model, attachment, state, scratch, c);
-      continue;
-    }
-    lane[n++] = c;
-    if (n == 4) flush();
+void AirLanes<Real>::add(uint32_t c) {
+  if (model_.wind.volume() || attachment_.cluster_flying[c])
+    return sample_cluster_air(model_, attachment_, state_, scratch_, c);
+  lane_[count_++] = c;
+  if (count_ == 4) flush();
+}
+
+template <typename Real>
+void AirLanes<Real>::flush() {
+  if (count_ == 0) return;
+  const size_t P = size_t(model_.wind.phase_count());
+  const double* sin_a[4];
+  const double* cos_a[4];
+  for (size_t l = 0; l < 4; ++l) {
+    const uint32_t c = lane_[std::min(l, count_ - 1)];  // lanes past the last repeat it
+    sin_a[l] = &model_.cluster_phase_sin[c * P], cos_a[l] = &model_.cluster_phase_cos[c * P];
   }
-  if (n > 0) flush();
+  double v[3][4];
+  model_.wind.velocities(sin_a, cos_a, scratch_.air, v);
+  for (size_t l = 0; l < count_; ++l)
+    for (int i = 0; i < 3; ++i) scratch_.cluster_air(lane_[l], i) = static_cast<Real>(v[i][l]);
+  count_ = 0;
 }
 
 template void set_air_time(const SolverModel<float>&, double, StepScratch<float>&);
@@ -105,9 +99,7 @@ template void sample_cluster_air(const SolverModel<float>&, const Attachment<flo
                                  StepScratch<float>&, size_t);
 template void sample_cluster_air(const SolverModel<double>&, const Attachment<double>&, const SimState&,
                                  StepScratch<double>&, size_t);
-template void sample_clusters_air(const SolverModel<float>&, const Attachment<float>&, const SimState&,
-                                  StepScratch<float>&, std::span<const uint32_t>);
-template void sample_clusters_air(const SolverModel<double>&, const Attachment<double>&, const SimState&,
-                                  StepScratch<double>&, std::span<const uint32_t>);
+template class AirLanes<float>;
+template class AirLanes<double>;
 
 }  // namespace treeanim

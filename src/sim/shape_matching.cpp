@@ -233,20 +233,17 @@ void match_clusters(const SolverModel<Real>& model, const Attachment<Real>& atta
         balanced_range(model.match_work_offsets, omp_get_thread_num(), omp_get_num_threads());
     const size_t first = range.first, last = range.second;
     MatchLanes<Real> branches(model, attachment, state, scratch, false, true);
-    uint32_t leaves[kMatchLanes];  // the leaves are matched after their branches; their air now
-    size_t n = 0;
+    AirLanes<Real> leaves_air(model, attachment, state, scratch);
     with_kernel_isa([&] {
       for (size_t c = first; c < last; ++c) {
         if (!cluster_awake(model, attachment, state, c)) continue;
-        if (attachment.cluster_pin_slot[c] == kNone) {
+        if (attachment.cluster_pin_slot[c] == kNone)
           branches.add(static_cast<uint32_t>(c));
-        } else {
-          leaves[n++] = static_cast<uint32_t>(c);
-          if (n == kMatchLanes) sample_clusters_air(model, attachment, state, scratch, {leaves, n}), n = 0;
-        }
+        else
+          leaves_air.add(static_cast<uint32_t>(c));  // the leaf is matched after its branch, its air now
       }
       branches.flush();
-      sample_clusters_air(model, attachment, state, scratch, {leaves, n});
+      leaves_air.flush();
     });
     bad = std::min(bad, branches.bad());
     if (!model.pinned_leaf_clusters.empty()) {

@@ -44,7 +44,8 @@ class MatchLanes {
  public:
   MatchLanes(const SolverModel<Real>& model, const Attachment<Real>& attachment, SimState& state,
              StepScratch<Real>& scratch, bool pinned, bool air)
-      : model_(model), attachment_(attachment), state_(state), scratch_(scratch), pinned_(pinned), air_(air) {}
+      : model_(model), attachment_(attachment), state_(state), scratch_(scratch), pinned_(pinned), air_(air),
+        lanes_air_(model, attachment, state, scratch) {}
   void add(uint32_t c) {
     clusters_[count_++] = c;
     if (count_ == kMatchLanes) flush();
@@ -54,7 +55,10 @@ class MatchLanes {
     if (count_ == 0) return;
     const std::span<const uint32_t> clusters(clusters_, count_);
     bad_ = std::min(bad_, match_in_lanes(model_, attachment_, state_, scratch_, clusters, pinned_));
-    if (air_) sample_clusters_air(model_, attachment_, state_, scratch_, clusters);
+    if (air_) {
+      for (const uint32_t c : clusters) lanes_air_.add(c);
+      lanes_air_.flush();
+    }
     count_ = 0;
   }
   // The lowest cluster whose fit was not finite, kNone for none.
@@ -66,6 +70,7 @@ class MatchLanes {
   SimState& state_;
   StepScratch<Real>& scratch_;
   const bool pinned_, air_;
+  AirLanes<Real> lanes_air_;
   uint32_t clusters_[kMatchLanes];
   size_t count_ = 0;
   uint32_t bad_ = kNone;

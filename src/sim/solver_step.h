@@ -21,11 +21,26 @@ void set_air_time(const SolverModel<Real>& model, double t, StepScratch<Real>& s
 template <typename Real>
 void sample_cluster_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                         StepScratch<Real>& scratch, size_t c);
-// The same for each of the listed clusters, those at their rest centres in air without a
-// volume four at a time (WindField::velocities), to the same bits.
+// The same for clusters added one by one: those at their rest centres in air without a volume
+// four at a time (WindField::velocities), to the same bits; the others as they come.
 template <typename Real>
-void sample_clusters_air(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
-                         StepScratch<Real>& scratch, std::span<const uint32_t> clusters);
+class AirLanes {
+ public:
+  AirLanes(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
+           StepScratch<Real>& scratch)
+      : model_(model), attachment_(attachment), state_(state), scratch_(scratch) {}
+  void add(uint32_t c);
+  // The clusters added since the last flush => their air.
+  void flush();
+
+ private:
+  const SolverModel<Real>& model_;
+  const Attachment<Real>& attachment_;
+  const SimState& state_;
+  StepScratch<Real>& scratch_;
+  uint32_t lane_[4];
+  size_t count_ = 0;
+};
 
 // --- correction.cpp: the per-vertex pass ---
 enum class VertexPass {
