@@ -289,11 +289,14 @@ class LayoutWalk {
     at_ += bytes;
     in_.seekg(std::streamoff(at_));
   }
+  void read_bytes(char* to, uint64_t bytes, const std::string& what) {
+    if (bytes > limit_ - at_) throw std::runtime_error(past_limit(what));
+    in_.read(to, std::streamsize(bytes));
+    at_ += bytes;
+  }
   template <typename T>
   void read(T& value, const std::string& what) {
-    if (sizeof value > limit_ - at_) throw std::runtime_error(past_limit(what));
-    in_.read(reinterpret_cast<char*>(&value), sizeof value);
-    at_ += sizeof value;
+    read_bytes(reinterpret_cast<char*>(&value), sizeof value, what);
   }
   void text(const std::string& what) {  // a length, then that many bytes
     uint32_t length = 0;
@@ -309,15 +312,9 @@ class LayoutWalk {
       text(what);
       uint32_t length = 0;
       read(length, what);
-      std::string type;
-      if (tree_bytes && length == kDelayedLoad.size()) {
-        type.resize(length);
-        if (length > limit_ - at_) throw std::runtime_error(past_limit(what));
-        in_.read(type.data(), length);
-        at_ += length;
-      } else {
-        skip(length, what);
-      }
+      std::string type(tree_bytes && length == kDelayedLoad.size() ? length : 0, '\0');
+      if (type.empty()) skip(length, what);
+      else read_bytes(type.data(), length, what);
       if (type == kDelayedLoad)
         delayed_load(what, *tree_bytes);
       else
