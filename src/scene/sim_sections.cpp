@@ -4,7 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 #include <sstream>
 
 #include "common/direction.h"
@@ -15,8 +14,6 @@
 namespace treeanim {
 
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Wind speed and gust amplitude, m/s: no recorded gust exceeds 113 m/s (Barrow Island, 1996), so a
 // larger value is a slip (1,000,000 for 10), not a storm.
