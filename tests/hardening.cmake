@@ -37,3 +37,10 @@ foreach(src ${fuzz_targets})
     COMMAND replay_${fuzz_name} ${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${fuzz_name})
   set_tests_properties(hardening.replay_${fuzz_name} PROPERTIES LABELS hardening TIMEOUT 300)
 endforeach()
+
+# Two bakes sharing two cores: each steps on the cores left to it, to the same bytes.
+add_test(NAME hardening.contention
+  COMMAND ${TREEANIM_PYTHON} ${CMAKE_SOURCE_DIR}/tests/hardening/contention.py
+          $<TARGET_FILE:treeanim> ${CMAKE_SOURCE_DIR}/configs/demo.json)
+set_tests_properties(hardening.contention PROPERTIES LABELS hardening TIMEOUT 300 SKIP_RETURN_CODE 77
+  RUN_SERIAL TRUE)

@@ -161,9 +161,10 @@ void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& s
   check_free_space(needs);
 }
 
-LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes) {
+LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes,
+                   ThreadGovernor& governor) {
   if (!plan.loop || !start.checkpoint.empty()) return {};
-  return warm_up_loop(simulator, start.state, plan.first, plan.last - plan.first + 1, notes);
+  return warm_up_loop(simulator, start.state, plan.first, plan.last - plan.first + 1, notes, governor);
 }
 
 void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart& start, BakeFrames& frames,
@@ -175,7 +176,7 @@ void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart
 }
 
 int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
-               const TreePlacement* placement, const BakeLog& log) {
+               const TreePlacement* placement, const BakeLog& log, ThreadGovernor& governor) {
   // A skinned mesh is placed on a thread of its own while the solver steps on, when the
   // solver's team leaves a core free for it; on every core, a thread more would preempt a member
   // of the team and stall it at each barrier, so the team places the mesh between frames. The
@@ -204,6 +205,7 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
       write_checkpoint(checkpoint_path(plan.checkpoints.dir, frame), start.state, frame, plan.key);
     }
     log.frame_done(frame - start.frame + 1);
+    governor.frame_done(frame);
   }
   if (thread) thread->finish();
   return 0;
@@ -271,11 +273,12 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);
   if (config.space_check) check_room(plan, start, simulated, layout, frames);
-  const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes);
+  ThreadGovernor governor(omp_get_max_threads(), log.notes);
+  const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes, governor);
   replay_journal(plan, layout, start, frames, log.notes);
   const auto run_began = std::chrono::steady_clock::now();
   TreeBakeResult result;
-  result.exit_code = run_frames(plan, simulator, start, frames, placement, log);
+  result.exit_code = run_frames(plan, simulator, start, frames, placement, log, governor);
   if (result.exit_code != 0) return result;
   result = finish_bake(plan, start, warmup, frames, placement, log);
   if (result.exit_code != 0) return result;

@@ -14,6 +14,7 @@
 #include "bake/bake_plan.h"
 #include "bake/bake_start.h"
 #include "bake/loop_bake.h"
+#include "bake/thread_governor.h"
 #include "formats/outputs.h"
 #include "scene/scene.h"
 #include "sim/sample_skin.h"
@@ -87,7 +88,8 @@ void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& s
 
 // Warm up: a loop that starts afresh (not from a checkpoint, which lies past the warm-up) runs
 // whole periods until the tree's motion repeats; else nothing.
-LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes);
+LoopWarmup warm_up(const BakePlan& plan, Simulator& simulator, BakeStart& start, std::FILE* notes,
+                   ThreadGovernor& governor);
 
 // Replay: this bake's journal opened when it writes checkpoints (open_bake_journal), the outputs
 // begun, and the frames written before start.frame, which no checkpoint holds, pushed from the journal.
@@ -96,9 +98,9 @@ void replay_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart
 
 // Run: frames start.frame to written.last simulated and pushed (a placed tree's in its own frame),
 // journalled and checkpointed when the plan says. Returns 0, or 130/143/129 after a signal, the
-// outputs then removed.
+// outputs then removed. After each frame the governor may resize the solver's team.
 int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, BakeFrames& frames,
-               const TreePlacement* placement, const BakeLog& log);
+               const TreePlacement* placement, const BakeLog& log, ThreadGovernor& governor);
 
 // Finish: the outputs' final names, and what the bake wrote (bounds in the world).
 TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,

@@ -29,7 +29,8 @@ double rms_distance(const float* a, const float* b, size_t values) {
   return values ? std::sqrt(sum / double(values / 3)) : 0.0;
 }
 
-LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log) {
+LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log,
+                        ThreadGovernor& governor) {
   LoopWarmup warmup;
   std::vector<float> boundary = positions_of(state);
   while (warmup.periods < kMaxLoopWarmupPeriods) {
@@ -39,6 +40,7 @@ LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, 
       // Interrupted: the frame loop that follows stops at once and removes the outputs.
       if (pending_signal()) return warmup;
       simulator.advance_frame(state, first + k);
+      governor.frame_done(first + k);
       period.add(positions_of(state));
     }
     ++warmup.periods;

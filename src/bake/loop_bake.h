@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "bake/thread_governor.h"
 #include "sim/simulator.h"
 
 namespace treeanim {
@@ -25,8 +26,9 @@ struct LoopWarmup {
 
 // Runs `frames`-frame periods from `state` (at the loop's first frame `first`) until a period
 // changes the state by at most kLoopRepeatChange, at most kMaxLoopWarmupPeriods. Notes each
-// period on `log`. Returns as soon as a signal is pending (bake/signals.h).
-LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log);
+// period on `log`, and each frame to `governor`. Returns as soon as a signal is pending (bake/signals.h).
+LoopWarmup warm_up_loop(Simulator& simulator, SimState& state, long long first, long long frames, std::FILE* log,
+                        ThreadGovernor& governor);
 
 // The seam of a baked loop: the step from its last frame back to its first, against the median
 // step between neighbouring frames (both RMS over vertices).

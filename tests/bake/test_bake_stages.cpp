@@ -182,12 +182,13 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
   BakeStart start = start_bake(plan, layout, simulator, nullptr);
-  EXPECT_EQ(warm_up(plan, simulator, start, nullptr).periods, 0);  // not a loop
+  ThreadGovernor governor(1, nullptr);  // the team as it is
+  EXPECT_EQ(warm_up(plan, simulator, start, nullptr, governor).periods, 0);  // not a loop
   replay_journal(plan, layout, start, frames, nullptr);
   std::vector<long long> done;
   BakeLog log;
   log.frame_done = [&](long long frames_done) { done.push_back(frames_done); };
-  ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log), 0);
+  ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log, governor), 0);
   EXPECT_EQ(done, (std::vector<long long>{1, 2, 3, 4, 5}));
   const TreeBakeResult result = finish_bake(plan, start, {}, frames, nullptr, log);
   EXPECT_EQ(result.written.first, 10);
@@ -308,7 +309,8 @@ TEST_F(BakeStages, ALoopWarmsUpWholePeriods) {
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   BakeStart start = start_bake(plan, journal_layout(plan, tree.model, false), simulator, nullptr);
   Notes notes;
-  const LoopWarmup warmup = warm_up(plan, simulator, start, notes.file());
+  ThreadGovernor governor(1, nullptr);
+  const LoopWarmup warmup = warm_up(plan, simulator, start, notes.file(), governor);
   EXPECT_GE(warmup.periods, 1);
   EXPECT_LE(warmup.periods, kMaxLoopWarmupPeriods);
   EXPECT_EQ(notes.text().rfind("treeanim: loop warm-up period 1: the state changed by ", 0), 0u) << notes.text();
