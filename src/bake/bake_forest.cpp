@@ -1,5 +1,7 @@
 #include "bake/bake_forest.h"
 
+#include <omp.h>
+
 #include <system_error>
 
 #include "bake/bake_plan.h"
@@ -7,6 +9,7 @@
 #include "bake/bake_tree.h"
 #include "bake/forest_manifest.h"
 #include "bake/signals.h"
+#include "bake/thread_governor.h"
 #include "common/errors.h"
 #include "files/output_lock.h"
 #include "formats/outputs.h"
@@ -97,6 +100,9 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     throw;
   }
   ForestBakeResult result;
+  // One team for the forest: what other work leaves it carries from tree to tree.
+  if (config.threads > 0) omp_set_num_threads(config.threads);
+  ThreadGovernor governor(omp_get_max_threads(), log.notes);
   for (size_t i = 0; i < trees.size(); ++i) {
     // A signal while the last tree finished: the trees baked so far stay whole.
     if (const int signal_number = pending_signal()) {
@@ -116,7 +122,7 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     }
     const Scene one = tree_scene(scene, trees[i]);
     const TreePlacement placement = make_tree_placement(tree.position, tree.rotation);
-    const TreeBakeResult baked = bake_tree(one, own, &placement, log);
+    const TreeBakeResult baked = bake_tree(one, own, &placement, log, &governor);
     if (baked.exit_code != 0) {
       result.exit_code = baked.exit_code;
       return result;

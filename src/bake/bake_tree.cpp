@@ -235,9 +235,13 @@ TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const L
 }
 
 TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const TreePlacement* placement,
-                         const BakeLog& log) {
+                         const BakeLog& log, ThreadGovernor* governor) {
   const auto began = std::chrono::steady_clock::now();
-  if (config.threads > 0) omp_set_num_threads(config.threads);
+  std::optional<ThreadGovernor> own_governor;
+  if (!governor) {
+    if (config.threads > 0) omp_set_num_threads(config.threads);
+    governor = &own_governor.emplace(omp_get_max_threads(), log.notes);
+  }
   const BakePlan plan = plan_bake(scene, config);
   // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.
   const bool sampled = scene.hsm.particles == ParticleMode::kSamples;
@@ -273,12 +277,11 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
 
   BakeStart start = start_bake(plan, layout, simulator, log.notes);
   if (config.space_check) check_room(plan, start, simulated, layout, frames);
-  ThreadGovernor governor(omp_get_max_threads(), log.notes);
-  const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes, governor);
+  const LoopWarmup warmup = warm_up(plan, simulator, start, log.notes, *governor);
   replay_journal(plan, layout, start, frames, log.notes);
   const auto run_began = std::chrono::steady_clock::now();
   TreeBakeResult result;
-  result.exit_code = run_frames(plan, simulator, start, frames, placement, log, governor);
+  result.exit_code = run_frames(plan, simulator, start, frames, placement, log, *governor);
   if (result.exit_code != 0) return result;
   result = finish_bake(plan, start, warmup, frames, placement, log);
   if (result.exit_code != 0) return result;

@@ -109,7 +109,9 @@ TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const L
 // Bakes `scene` as `config` says. With a placement the tree is simulated where it stands and its
 // outputs are written in its own frame. Throws InputError, SimulationError, OutputError; nothing
 // of a failed bake keeps a final name.
+// `governor`: the forest's, which carries what it measured from tree to tree; null: the
+// bake sets config.threads and sizes its team itself.
 TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const TreePlacement* placement,
-                         const BakeLog& log);
+                         const BakeLog& log, ThreadGovernor* governor = nullptr);
 
 }  // namespace treeanim

@@ -49,10 +49,14 @@ double now_seconds() {
 
 }  // namespace
 
-ThreadGovernor::ThreadGovernor(int most, std::FILE* notes) : policy_(most), notes_(notes) {
+ThreadGovernor::ThreadGovernor(int most, std::FILE* notes) : most_(most), policy_(most), notes_(notes) {
   last_ = read_tasks();
   active_ = most > 1 && !last_.empty();
   window_start_ = now_seconds();
+}
+
+ThreadGovernor::~ThreadGovernor() {
+  if (policy_.threads() != most_) omp_set_num_threads(most_);
 }
 
 // Each thread of the process => its CPU time and run delay (schedstat: ns on a CPU, ns

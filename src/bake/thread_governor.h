@@ -56,6 +56,10 @@ class ThreadGovernor {
   // `most`: the team the bake was given (omp_get_max_threads()); `notes`: where a change is
   // told (null: quiet). Does nothing for one thread, or where the kernel keeps no schedstat.
   ThreadGovernor(int most, std::FILE* notes);
+  // The team it was given back (the next tree of a forest starts from it).
+  ~ThreadGovernor();
+  ThreadGovernor(const ThreadGovernor&) = delete;
+  ThreadGovernor& operator=(const ThreadGovernor&) = delete;
   // After each frame, on the thread that starts the solver's parallel regions: at the end of
   // a window, the team resized for the next frames (omp_set_num_threads).
   void frame_done(long long frame);
@@ -67,6 +71,7 @@ class ThreadGovernor {
   std::map<long, TaskTimes> read_tasks() const;
   std::vector<long> team_tasks() const;
 
+  const int most_;
   TeamPolicy policy_;
   std::FILE* notes_;
   bool active_;
