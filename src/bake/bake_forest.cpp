@@ -102,7 +102,7 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
   ForestBakeResult result;
   // One team for the forest: what other work leaves it carries from tree to tree.
   if (config.threads > 0) omp_set_num_threads(config.threads);
-  ThreadGovernor governor(omp_get_max_threads(), log.notes);
+  ThreadGovernor governor(omp_get_max_threads(), log.team_resized);
   for (size_t i = 0; i < trees.size(); ++i) {
     // A signal while the last tree finished: the trees baked so far stay whole.
     if (const int signal_number = pending_signal()) {

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <functional>
+#include <string>
 
 namespace treeanim {
 
@@ -18,6 +19,8 @@ struct BakeLog {
   std::function<void(long long total)> frames_begin = [](long long) {};  // the frame loop will simulate `total`
   std::function<void(long long done)> frame_done = [](long long) {};     // `done` frames of the loop are complete
   std::function<void()> frames_end = [] {};                              // the loop ended or was interrupted
+  // The solver's team took a thread fewer or more (bake/thread_governor.h): the line to tell.
+  std::function<void(const std::string& line)> team_resized = [](const std::string&) {};
   // Outputs already removed; frame -1: between two trees of a forest, whose baked trees stay.
   std::function<void(int signal, long long frame)> interrupted = [](int, long long) {};
   std::function<void(const TreeBakeResult&)> baked = [](const TreeBakeResult&) {};      // a tree's outputs are final

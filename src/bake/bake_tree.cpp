@@ -240,7 +240,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   std::optional<ThreadGovernor> own_governor;
   if (!governor) {
     if (config.threads > 0) omp_set_num_threads(config.threads);
-    governor = &own_governor.emplace(omp_get_max_threads(), log.notes);
+    governor = &own_governor.emplace(omp_get_max_threads(), log.team_resized);
   }
   const BakePlan plan = plan_bake(scene, config);
   // hsm.particles "samples": the solver moves the samples, the mesh follows their clusters.

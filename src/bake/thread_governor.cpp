@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 namespace treeanim {
 
@@ -49,7 +51,8 @@ double now_seconds() {
 
 }  // namespace
 
-ThreadGovernor::ThreadGovernor(int most, std::FILE* notes) : most_(most), policy_(most), notes_(notes) {
+ThreadGovernor::ThreadGovernor(int most, std::function<void(const std::string&)> tell)
+    : most_(most), policy_(most), tell_(std::move(tell)) {
   last_ = read_tasks();
   active_ = most > 1 && !last_.empty();
   window_start_ = now_seconds();
@@ -107,13 +110,19 @@ void ThreadGovernor::frame_done(long long frame) {
   const int was = policy_.threads();
   const TeamPolicy::Change change = policy_.next(window);
   if (policy_.threads() != was) omp_set_num_threads(policy_.threads());
-  if (notes_ && change == TeamPolicy::Change::kShrunk)
-    std::fprintf(notes_,
-                 "treeanim: frame %lld: the solver's %d threads waited for a core %.0f %% of the time (other work, "
-                 "or more threads than cores): stepping on %d (the bytes are the same for any thread count)\n",
-                 frame, was, 100 * policy_.last_share(), policy_.threads());
-  if (notes_ && change == TeamPolicy::Change::kGrown)
-    std::fprintf(notes_, "treeanim: frame %lld: a core came free: stepping on %d threads\n", frame, policy_.threads());
+  char line[256];
+  if (change == TeamPolicy::Change::kShrunk) {
+    std::snprintf(line, sizeof line,
+                  "treeanim: frame %lld: the solver's %d threads waited for a core %.0f %% of the time (other work, or "
+                  "more threads than cores): stepping on %d (the bytes are the same for any thread count)",
+                  frame, was, 100 * policy_.last_share(), policy_.threads());
+    tell_(line);
+  }
+  if (change == TeamPolicy::Change::kGrown) {
+    std::snprintf(line, sizeof line, "treeanim: frame %lld: a core came free: stepping on %d threads", frame,
+                  policy_.threads());
+    tell_(line);
+  }
   last_ = std::move(tasks);
   window_start_ = now;
 }

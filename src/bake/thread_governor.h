@@ -8,8 +8,9 @@
 // helper threads (writers, the frame thread), and drops a thread when other work took more
 // than a tenth of the team's time; later it tries a thread more, and keeps it while no one
 // waits. The bytes are the same for any thread count: no change of the team changes a file.
-#include <cstdio>
+#include <functional>
 #include <map>
+#include <string>
 #include <vector>
 
 namespace treeanim {
@@ -53,9 +54,10 @@ class TeamPolicy {
 
 class ThreadGovernor {
  public:
-  // `most`: the team the bake was given (omp_get_max_threads()); `notes`: where a change is
-  // told (null: quiet). Does nothing for one thread, or where the kernel keeps no schedstat.
-  ThreadGovernor(int most, std::FILE* notes);
+  // `most`: the team the bake was given (omp_get_max_threads()); `tell`: takes the line that
+  // says a change (BakeLog::team_resized). Does nothing for one thread, or where the kernel
+  // keeps no schedstat.
+  ThreadGovernor(int most, std::function<void(const std::string&)> tell);
   // The team it was given back (the next tree of a forest starts from it).
   ~ThreadGovernor();
   ThreadGovernor(const ThreadGovernor&) = delete;
@@ -73,7 +75,7 @@ class ThreadGovernor {
 
   const int most_;
   TeamPolicy policy_;
-  std::FILE* notes_;
+  std::function<void(const std::string&)> tell_;
   bool active_;
   double window_start_ = 0;
   std::map<long, TaskTimes> last_;

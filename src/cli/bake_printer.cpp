@@ -27,6 +27,11 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
   log_.frames_begin = [this](long long total) { progress_.emplace(total, verbosity_, stderr); };
   log_.frame_done = [this](long long done) { progress_->update(done); };
   log_.frames_end = [this] { progress_->finish(); };
+  if (!quiet)
+    log_.team_resized = [this](const std::string& line) {
+      if (progress_) progress_->note(line);
+      else std::fprintf(stderr, "%s\n", line.c_str());
+    };
   log_.interrupted = [this](int signal_number, long long frame) {
     const char* name = interrupt_name(signal_number);
     if (frame < 0) {

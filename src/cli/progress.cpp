@@ -64,6 +64,16 @@ void Progress::finish() {
   if (enabled_ && terminal_) std::fprintf(out_, "\n");
 }
 
+void Progress::note(const std::string& line) {
+  if (!enabled_) return;
+  if (terminal_) {
+    std::fprintf(out_, "\r\033[K");  // the bar's line cleared
+    last_draw_ = -1;                 // and drawn again at the next update
+  }
+  std::fprintf(out_, "%s\n", line.c_str());
+  std::fflush(out_);
+}
+
 void GrowthProgress::update(int step, int steps, size_t modules) {
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdio>
+#include <string>
 
 namespace treeanim {
 
@@ -17,6 +18,9 @@ class Progress {
   void update(long long done);
   // Ends the bar line (terminal) after the last update.
   void finish();
+  // A line to tell while the bar runs: on a terminal the bar is cleared, the line printed and
+  // the bar drawn again at the next update.
+  void note(const std::string& line);
 
  private:
   double elapsed() const;

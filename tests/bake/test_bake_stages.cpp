@@ -182,7 +182,7 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   const JournalLayout layout = journal_layout(plan, tree.model, frames.outputs.wants_velocities());
   BakeStart start = start_bake(plan, layout, simulator, nullptr);
-  ThreadGovernor governor(1, nullptr);  // the team as it is
+  ThreadGovernor governor(1, [](const std::string&) {});  // the team as it is
   EXPECT_EQ(warm_up(plan, simulator, start, nullptr, governor).periods, 0);  // not a loop
   replay_journal(plan, layout, start, frames, nullptr);
   std::vector<long long> done;
@@ -309,7 +309,7 @@ TEST_F(BakeStages, ALoopWarmsUpWholePeriods) {
   Simulator simulator(tree.model, line.hsm, line.wind, plan.frame_dt, line.time.substeps);
   BakeStart start = start_bake(plan, journal_layout(plan, tree.model, false), simulator, nullptr);
   Notes notes;
-  ThreadGovernor governor(1, nullptr);
+  ThreadGovernor governor(1, [](const std::string&) {});
   const LoopWarmup warmup = warm_up(plan, simulator, start, notes.file(), governor);
   EXPECT_GE(warmup.periods, 1);
   EXPECT_LE(warmup.periods, kMaxLoopWarmupPeriods);

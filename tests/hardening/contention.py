@@ -5,8 +5,8 @@ usage: contention.py TREEANIM DEMO_SCENE     (exit 0 pass, 1 fail, 77 skipped)
 
 Both are pinned to the same CPUs (two of this process's, or its only one), so their four
 spinning threads share two cores: each bake must tell that its threads waited for a core
-and step on one, and its files must be byte for byte those of a bake on one thread
-alone. Without the governor each frame took 5-80 ms instead of 0.7 (docs/benchmarks.md,
+and step on one (the second's stderr is a terminal, whose progress bar is cleared for the
+line), and its files must be byte for byte those of a bake on one thread alone. Without the governor each frame took 5-80 ms instead of 0.7 (docs/benchmarks.md,
 "Threads"); the test asserts no time, only what the bakes say and write.
 """
 import filecmp
@@ -15,9 +15,23 @@ import os
 import subprocess
 import sys
 import tempfile
+import threading
 
 SKIP = 77
 GUSTS = [{"time": 0, "speed": 9, "direction": [1, 0, 0.3], "gust": 3}]  # no calm: no island sleeps
+
+
+def read_all(fd, chunks):
+    """A terminal's output until its last writer closes it (EIO on Linux)."""
+    while True:
+        try:
+            chunk = os.read(fd, 65536)
+        except OSError:
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    os.close(fd)
 
 
 def main():
@@ -30,9 +44,9 @@ def main():
             'outputs=[{"format":"hdf5","path":"a.h5","velocities":true},{"format":"pc2","path":"a.pc2"}]']
     args = [a for s in sets for a in ("--set", s)]
     with tempfile.TemporaryDirectory() as work:
-        def bake(name, threads, pinned):
+        def bake(name, threads, pinned, stderr=subprocess.PIPE):
             command = [treeanim, "run", scene, "-o", os.path.join(work, name), "--threads", str(threads)] + args
-            return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=stderr, text=True,
                                     preexec_fn=(lambda: os.sched_setaffinity(0, cpus)) if pinned else None)
 
         alone = bake("alone", 1, False)
@@ -40,14 +54,28 @@ def main():
         if alone.returncode != 0:
             print(f"FAIL: the one-thread bake exited {alone.returncode}: {err}")
             return 1
-        pair = [bake("first", 2, True), bake("second", 2, True)]
+        # The second bake's stderr is a terminal: its progress bar is cleared for the line.
+        master, terminal = os.openpty()
+        pair = [bake("first", 2, True), bake("second", 2, True, terminal)]
+        os.close(terminal)
+        screen = []
+        reader = threading.Thread(target=read_all, args=(master, screen))
+        reader.start()
         failed = False
         for name, process in zip(["first", "second"], pair):
             out, err = process.communicate()
-            said = [line for line in err.splitlines() if "waited for a core" in line]
+            if name == "second":
+                reader.join()
+                err = b"".join(screen).decode(errors="replace")
+            said = [line.split("\x1b[K")[-1] for line in err.replace("\r", "\n").splitlines()
+                    if "waited for a core" in line]
             print(f"{name}: exit {process.returncode}; " + (said[0] if said else "said nothing of waiting for cores"))
             if process.returncode != 0 or not any("stepping on 1" in line for line in said):
                 failed = True
+            if name == "second":
+                cleared = "\r\x1b[Ktreeanim: frame" in err
+                print(f"  on a terminal: the progress bar {'cleared' if cleared else 'NOT cleared'} for that line")
+                failed |= not cleared
             for file in ("a.h5", "a.pc2"):
                 same = filecmp.cmp(os.path.join(work, "alone", file), os.path.join(work, name, file), shallow=False)
                 print(f"  {file}: {'the same bytes as' if same else 'DIFFERS from'} the one-thread bake")
