@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -31,7 +32,8 @@ TeamPolicy::Change TeamPolicy::next(const TeamWindow& window) {
     return Change::kGrown;
   }
   if (crowded && threads_ > 1) {
-    --threads_;
+    const int running = int(std::lround(threads_ * (1 - last_share_)));
+    threads_ = std::max(1, std::min({threads_ - 1, cores_, running}));
     wait_ = kFirstWait, since_ = 0;
     return Change::kShrunk;
   }
@@ -52,7 +54,7 @@ double now_seconds() {
 }  // namespace
 
 ThreadGovernor::ThreadGovernor(int most, std::function<void(const std::string&)> tell)
-    : most_(most), policy_(most), tell_(std::move(tell)) {
+    : most_(most), policy_(most, omp_get_num_procs()), tell_(std::move(tell)) {
   last_ = read_tasks();
   active_ = most > 1 && !last_.empty();
   window_start_ = now_seconds();

@@ -28,7 +28,8 @@ class TeamPolicy {
  public:
   // A window shorter than this is extended: its sums would be a few scheduler ticks.
   static constexpr double kWindowSeconds = 0.25;
-  // Other work keeping the team waiting more than this share of its time shrinks the team.
+  // Other work keeping the team waiting more than this share of its time shrinks the team: to
+  // the threads that share leaves running, at most as many as there are cores, and by one at least.
   static constexpr double kShrinkShare = 0.10;
   // After a shrink (or a try that failed), the next try of a thread more waits this long,
   // doubled after each failed try up to kLongestWait.
@@ -37,7 +38,8 @@ class TeamPolicy {
   // What a window's end changed.
   enum class Change { kNone, kShrunk, kTrying, kTryFailed, kGrown };
 
-  explicit TeamPolicy(int most) : most_(most), threads_(most) {}
+  // `most`: the team it was given; `cores`: the CPUs the process may run on.
+  TeamPolicy(int most, int cores) : most_(most), cores_(cores), threads_(most) {}
   // The window just ended => the team's size for the next (threads()).
   Change next(const TeamWindow& window);
   int threads() const { return threads_; }
@@ -45,7 +47,7 @@ class TeamPolicy {
   double last_share() const { return last_share_; }
 
  private:
-  int most_, threads_;
+  int most_, cores_, threads_;
   double wait_ = kFirstWait;  // s before the next try of a thread more
   double since_ = 0;          // s since the last change
   bool trying_ = false;       // the window that ended ran a thread more on trial

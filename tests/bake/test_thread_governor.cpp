@@ -19,7 +19,7 @@ TeamWindow window(int threads, double share, double seconds = 0.25, double helpe
 }
 
 TEST(TeamPolicy, KeepsItsTeamWhileNoOtherWorkWaits) {
-  TeamPolicy policy(4);
+  TeamPolicy policy(4, 4);
   for (int k = 0; k < 1000; ++k) {
     // The bake's own writers may keep the team waiting as long as they run: that is not other work.
     ASSERT_EQ(policy.next(window(4, 0.02, 0.25, 0.2)), Change::kNone);
@@ -28,7 +28,7 @@ TEST(TeamPolicy, KeepsItsTeamWhileNoOtherWorkWaits) {
 }
 
 TEST(TeamPolicy, DropsAThreadAWindowWhileOtherWorkKeepsItWaiting) {
-  TeamPolicy policy(3);
+  TeamPolicy policy(3, 4);
   EXPECT_EQ(policy.next(window(3, 0.5)), Change::kShrunk);
   EXPECT_EQ(policy.threads(), 2);
   EXPECT_DOUBLE_EQ(policy.last_share(), 0.5);
@@ -38,8 +38,20 @@ TEST(TeamPolicy, DropsAThreadAWindowWhileOtherWorkKeepsItWaiting) {
   EXPECT_EQ(policy.threads(), 1);
 }
 
+TEST(TeamPolicy, DropsToTheThreadsThatRanAndNoMoreThanTheCores) {
+  TeamPolicy many(8, 2);  // more threads than cores: they waited 31 % of the time, asleep the rest
+  EXPECT_EQ(many.next(window(8, 0.31)), Change::kShrunk);
+  EXPECT_EQ(many.threads(), 2);
+  TeamPolicy shared(8, 8);  // other work on half the cores
+  EXPECT_EQ(shared.next(window(8, 0.5)), Change::kShrunk);
+  EXPECT_EQ(shared.threads(), 4);
+  TeamPolicy crowded(4, 4);  // all but nothing left
+  EXPECT_EQ(crowded.next(window(4, 0.95)), Change::kShrunk);
+  EXPECT_EQ(crowded.threads(), 1);
+}
+
 TEST(TeamPolicy, TriesAThreadMoreLaterAndWaitsTwiceAsLongEachTimeItFails) {
-  TeamPolicy policy(2);
+  TeamPolicy policy(2, 2);
   ASSERT_EQ(policy.next(window(2, 0.5)), Change::kShrunk);
   double wait = TeamPolicy::kFirstWait;
   for (int attempt = 0; attempt < 8; ++attempt) {
@@ -58,7 +70,7 @@ TEST(TeamPolicy, TriesAThreadMoreLaterAndWaitsTwiceAsLongEachTimeItFails) {
 }
 
 TEST(TeamPolicy, KeepsTheThreadItTriedWhenNoOneWaits) {
-  TeamPolicy policy(3);
+  TeamPolicy policy(3, 4);
   ASSERT_EQ(policy.next(window(3, 0.5)), Change::kShrunk);
   ASSERT_EQ(policy.next(window(2, 0.5)), Change::kShrunk);
   Change change = Change::kNone;
