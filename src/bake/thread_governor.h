@@ -5,9 +5,10 @@
 // threads each on the same two cores stepped 10-140 times slower than one thread alone.
 // Between frames the governor reads how long the team's threads waited for a core (the
 // kernel's run delay, /proc/self/task/*/schedstat) beyond the CPU time of the bake's own
-// helper threads (writers, the frame thread), and drops a thread when other work took more
-// than a tenth of the team's time; later it tries a thread more, and keeps it while no one
-// waits. The bytes are the same for any thread count: no change of the team changes a file.
+// helper threads (writers, the frame thread); when other work took more than a tenth of the
+// team's time it steps on the threads that kept running; later it tries a thread more, and
+// keeps it while no one waits. The bytes are the same for any thread count: no change of the
+// team changes a file.
 #include <functional>
 #include <map>
 #include <string>
