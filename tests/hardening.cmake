@@ -1,6 +1,7 @@
 # Hardening tests, label `hardening`: the bad-input corpus, failure injection around a
-# real bake, and a replay of every fuzz corpus (seeds + kept reproducers) through the fuzz
-# targets built with the normal compiler. Included by CMakeLists.txt inside the test block.
+# real bake, a replay of every fuzz corpus (seeds + kept reproducers) through the fuzz
+# targets built with the normal compiler, and two bakes sharing two cores. Included by
+# CMakeLists.txt inside the test block.
 find_program(TREEANIM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)  # the one with h5py
 if(NOT TREEANIM_PYTHON)
   find_program(TREEANIM_PYTHON python3 REQUIRED)
