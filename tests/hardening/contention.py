@@ -16,9 +16,25 @@ import subprocess
 import sys
 import tempfile
 import threading
+import time
 
 SKIP = 77
 GUSTS = [{"time": 0, "speed": 9, "direction": [1, 0, 0.3], "gust": 3}]  # no calm: no island sleeps
+
+
+def schedstat_counts():
+    """Whether this thread's schedstat exists and counts its time on a CPU (a sandbox may show zeros)."""
+    def cpu_ns():
+        with open("/proc/thread-self/schedstat") as f:
+            return int(f.read().split()[0])
+    try:
+        before = cpu_ns()
+        end = time.monotonic() + 0.05
+        while time.monotonic() < end:
+            pass
+        return cpu_ns() > before
+    except (OSError, ValueError, IndexError):
+        return False
 
 
 def read_all(fd, chunks):
@@ -36,7 +52,7 @@ def read_all(fd, chunks):
 
 def main():
     treeanim, scene = sys.argv[1], sys.argv[2]
-    if not os.path.exists("/proc/thread-self/schedstat"):
+    if not schedstat_counts():
         print("skipped: the kernel keeps no schedstat, so a bake cannot see other work")
         return SKIP
     cpus = sorted(os.sched_getaffinity(0))[:2]
