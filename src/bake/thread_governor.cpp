@@ -54,14 +54,14 @@ double now_seconds() {
 }  // namespace
 
 ThreadGovernor::ThreadGovernor(int most, std::function<void(const std::string&)> tell)
-    : most_(most), policy_(most, omp_get_num_procs()), tell_(std::move(tell)) {
+    : policy_(most, omp_get_num_procs()), tell_(std::move(tell)) {
   last_ = read_tasks();
   active_ = most > 1 && !last_.empty();
   window_start_ = now_seconds();
 }
 
 ThreadGovernor::~ThreadGovernor() {
-  if (policy_.threads() != most_) omp_set_num_threads(most_);
+  if (policy_.threads() != policy_.most()) omp_set_num_threads(policy_.most());
 }
 
 // Each thread of the process => its CPU time and run delay (schedstat: ns on a CPU, ns

@@ -44,6 +44,7 @@ class TeamPolicy {
   // The window just ended => the team's size for the next (threads()).
   Change next(const TeamWindow& window);
   int threads() const { return threads_; }
+  int most() const { return most_; }
   // The share of the team's time that other work kept it waiting in the last window.
   double last_share() const { return last_share_; }
 
@@ -76,7 +77,6 @@ class ThreadGovernor {
   std::map<long, TaskTimes> read_tasks() const;
   std::vector<long> team_tasks() const;
 
-  const int most_;
   TeamPolicy policy_;
   std::function<void(const std::string&)> tell_;
   bool active_;
