@@ -605,6 +605,45 @@ void write_run(const SolverModel<Real>& model, const Attachment<Real>& attachmen
   }
 }
 
+// A leaf's card => its four vertices' goals and damping compliances, a vertex per lane, each
+// lane the vertex loop's sums over its memberships in order (the shared vertex's branch
+// first): a released membership adds nothing, an absent one +0, which leaves every sum as it
+// was (0 + x is -0 only for x = -0 and 0, so adding +0 after it changes nothing).
+template <typename Real>
+void write_card(const SolverModel<Real>& model, const Attachment<Real>& attachment, const StepScratch<Real>& scratch,
+                const GoalRows<Real>& out, const LeafCard& card) {
+  using V4 = typename Lanes4<Real>::type;
+  const V4 zero = {};
+  V4 ax, ay, az, share;
+  std::memcpy(&ax, model.member_arm.col(0).data() + card.slot, sizeof ax);
+  std::memcpy(&ay, model.member_arm.col(1).data() + card.slot, sizeof ay);
+  std::memcpy(&az, model.member_arm.col(2).data() + card.slot, sizeof az);
+  std::memcpy(&share, attachment.vertex_inv_count.data() + card.vertex, sizeof share);
+  const uint8_t* active = attachment.member_active.data();
+  V4 ox = zero, oy = zero, oz = zero, back = zero;
+  if (active[card.pin_slot]) {
+    const size_t s = card.pin_slot;
+    Real x = 0, y = 0, z = 0, b = 0;
+    add_deflected(&scratch.cluster_pose(0, card.pin_cluster), model.member_arm(s, 0), model.member_arm(s, 1),
+                  model.member_arm(s, 2), x, y, z, b);
+    ox[0] = x, oy[0] = y, oz[0] = z, back[0] = b;
+  }
+  const Real* k = &scratch.cluster_pose(0, card.cluster);
+  V4 on;
+  for (int l = 0; l < 4; ++l) on[l] = active[card.slot + l] ? Real(1) : Real(0);
+  const auto kept = on != zero;
+  ox += kept ? ((k[0] * ax + k[3] * ay) + k[6] * az) + k[9] : zero;
+  oy += kept ? ((k[1] * ax + k[4] * ay) + k[7] * az) + k[10] : zero;
+  oz += kept ? ((k[2] * ax + k[5] * ay) + k[8] * az) + k[11] : zero;
+  back += kept ? ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15] : zero;
+  ox *= share, oy *= share, oz *= share, back *= share;
+  back = back < zero ? zero : back;  // std::max(back, 0)
+  std::memcpy(out.x + card.vertex, &ox, sizeof ox);
+  std::memcpy(out.y + card.vertex, &oy, sizeof oy);
+  std::memcpy(out.z + card.vertex, &oz, sizeof oz);
+  std::memcpy(out.compliance + card.vertex, &back, sizeof back);
+}
+
 }  // namespace
 
 template <typename Real>
@@ -625,10 +664,19 @@ void write_static_offsets(const SolverModel<Real>& model, const Attachment<Real>
   const GoalRows<Real> out = {prediction.goal.col(0).data(), prediction.goal.col(1).data(),
                               prediction.goal.col(2).data(), prediction.damping_compliance.data()};
   const std::vector<VertexRun>& runs = model.vertex_runs;
+  const std::vector<LeafCard>& cards = model.leaf_cards;
   with_kernel_isa([&] {
     auto run = std::upper_bound(runs.begin(), runs.end(), begin,
                                 [](size_t v, const VertexRun& r) { return v < r.end; });  // the first ending after begin
+    auto card = std::lower_bound(cards.begin(), cards.end(), begin,
+                                 [](const LeafCard& c, size_t v) { return c.vertex < v; });  // the first from begin
     for (size_t v = begin; v < end;) {
+      // A card across the range's end is taken vertex by vertex below, to the same bits.
+      if (card != cards.end() && card->vertex == v && v + 4 <= end) {
+        write_card(model, attachment, scratch, out, *card++);
+        v += 4;
+        continue;
+      }
       if (run != runs.end() && run->begin <= v) {
         const size_t stop = std::min<size_t>(run->end, end);
         switch (run->count) {

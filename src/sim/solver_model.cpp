@@ -1,5 +1,6 @@
 // Precompute (libigl's split of a solver into precompute + solve): TreeModel + options =>
 // SolverModel, whose Attachment has every leaf attached; and the per-step scratch.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -18,6 +19,23 @@ namespace {
 uint32_t find_root(std::vector<uint32_t>& parent, uint32_t a) {
   while (parent[a] != a) a = parent[a] = parent[parent[a]];
   return a;
+}
+
+// The leaves whose four vertices are a card (SolverModel::leaf_cards), in vertex order.
+std::vector<LeafCard> leaf_cards(const TreeModel& tree) {
+  std::vector<LeafCard> cards;
+  const uint32_t *offsets = tree.vertex_cluster_offsets.data(), *memberships = tree.vertex_memberships.data();
+  for (size_t l = 0; l < tree.leaf_count(); ++l) {
+    const uint32_t c = tree.leaf_cluster[l], v = tree.leaf_attachment_vertex[l], slot = tree.cluster_offsets[c];
+    bool card = tree.cluster_offsets[c + 1] - slot == 4 && offsets[v + 1] - offsets[v] == 2 &&
+                memberships[offsets[v] + 1] == slot && tree.member_cluster[memberships[offsets[v]]] < c;
+    for (uint32_t k = 0; card && k < 4; ++k)
+      card = tree.cluster_members[slot + k] == v + k && (k == 0 || (offsets[v + k + 1] - offsets[v + k] == 1 &&
+                                                                    memberships[offsets[v + k]] == slot + k));
+    if (card) cards.push_back({v, c, slot, tree.member_cluster[memberships[offsets[v]]], memberships[offsets[v]]});
+  }
+  std::sort(cards.begin(), cards.end(), [](const LeafCard& a, const LeafCard& b) { return a.vertex < b.vertex; });
+  return cards;
 }
 
 // Model CSR => per-membership cluster ids, and per vertex its counts, correction row and
@@ -69,9 +87,11 @@ void precompute_members(SolverModel<Real>& m, Attachment<Real>& a) {
       m.shared_correction_rows.push_back(m.member_correction_row[tree.vertex_memberships[s]]);
     m.shared_row_offsets.push_back(static_cast<uint32_t>(m.shared_correction_rows.size()));
   }
-  // A leaf's shared vertex is in no run: its memberships may be released.
+  // A leaf's shared vertex is in no run: its memberships may be released. Nor is a card's.
   std::vector<uint8_t> excluded(m.V, 0);
   for (size_t l = 0; l < m.L; ++l) excluded[tree.leaf_attachment_vertex[l]] = 1;
+  m.leaf_cards = leaf_cards(tree);
+  for (const LeafCard& card : m.leaf_cards) std::fill_n(excluded.begin() + card.vertex, 4, uint8_t(1));
   m.vertex_runs = vertex_runs(tree, excluded);
 }
 

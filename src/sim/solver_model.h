@@ -103,6 +103,12 @@ struct Attachment {
   std::vector<uint8_t> vertex_flying;      // (V) 1: on a detached leaf (gravity on, global off)
 };
 
+// A leaf's card: vertices vertex..vertex + 3 in `cluster` at memberships slot..slot + 3, and
+// the first, the leaf's shared vertex, in its branch `pin_cluster` at `pin_slot` before that.
+struct LeafCard {
+  uint32_t vertex, cluster, slot, pin_cluster, pin_slot;
+};
+
 // Everything the step needs that never changes during a bake.
 template <typename Real>
 struct SolverModel {
@@ -174,6 +180,9 @@ struct SolverModel {
   // its clusters' values, read from this table in order (not through each vertex's memberships,
   // a chain of dependent loads per run).
   std::vector<VertexRun> vertex_runs;
+  // The leaves whose four vertices are a card (every leaf of four vertices in either particle
+  // mode), ascending: the goal writes take its vertices in one vector's lanes.
+  std::vector<LeafCard> leaf_cards;
   // --- the step in cache blocks (cache_blocks.cpp; docs/solver.md, "Cache blocks") ---
   // B blocks of clusters of about the constructor's block_memberships memberships, each
   // predicted, matched, corrected and loaded in turn while its data is in cache; empty (the

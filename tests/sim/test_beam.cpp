@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numbers>
 #include <random>
 #include <string>
@@ -164,8 +165,43 @@ TEST(Beam, GoalRunsHoldVerticesInTheSameClustersWithConsecutiveMemberships) {
     if (n > 1) shared_in_runs += end - v;
     previous_end = end;
   }
-  EXPECT_GT(in_runs, tree.vertex_count() * 9 / 10);
+  EXPECT_GT(in_runs + 4 * model.leaf_cards.size(), tree.vertex_count() * 9 / 10);
   EXPECT_GT(shared_in_runs, 0u);
+}
+
+TEST(Beam, GoalsAreTheSameBitsWhetherACardRunOrAVertexWritesThem) {
+  // A leaf's card takes its four vertices in one vector's lanes (beam_statics.cpp); a range that
+  // cuts it takes them one by one, through each vertex's memberships. Both must give the same
+  // bits, for cards with a released membership too, in both precisions of the build.
+  const TreeModel tree = testing::grown_tree(4, 2, 2);
+  auto expect_same = [&](auto real) {
+    using Real = decltype(real);
+    const SolverModel<Real> model(tree, HsmOptions{}, WindOptions{}, 1.0 / 24, 2);
+    ASSERT_GE(model.leaf_cards.size(), 2u);
+    Attachment<Real> attachment = model.all_attached;
+    for (const uint32_t slot : {model.leaf_cards[0].pin_slot, model.leaf_cards[1].slot + 2})
+      attachment.member_active[slot] = 0;
+    attachment.vertex_inv_count[model.leaf_cards[0].vertex] = 1;
+    attachment.vertex_inv_count[model.leaf_cards[1].vertex + 2] = 0;
+    StepScratch<Real> scratch(model);
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> any(-0.3, 0.3);
+    for (Eigen::Index i = 0; i < scratch.cluster_pose.size(); ++i) scratch.cluster_pose.data()[i] = Real(any(random));
+    StepPrediction<Real> whole, single;
+    for (StepPrediction<Real>* p : {&whole, &single}) {
+      p->goal.setConstant(model.V, 3, Real(9));
+      p->damping_compliance.setConstant(model.V, Real(9));
+    }
+    write_static_offsets(model, attachment, scratch, whole, 0, model.V);
+    for (size_t v = 0; v < model.V; ++v) write_static_offsets(model, attachment, scratch, single, v, v + 1);
+    EXPECT_EQ(std::memcmp(whole.goal.data(), single.goal.data(), sizeof(Real) * whole.goal.size()), 0);
+    EXPECT_EQ(std::memcmp(whole.damping_compliance.data(), single.damping_compliance.data(),
+                          sizeof(Real) * model.V),
+              0);
+    EXPECT_EQ(whole.goal(model.leaf_cards[1].vertex + 2, 0), Real(0));  // a released vertex's goal
+  };
+  expect_same(float{});
+  expect_same(double{});
 }
 
 TEST(Beam, CorrectionRowsAreOneAMembershipAndAFreeVertexInOneClusterWritesItsOwn) {
