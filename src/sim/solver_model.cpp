@@ -28,7 +28,7 @@ std::vector<LeafCard> leaf_cards(const TreeModel& tree) {
   for (size_t l = 0; l < tree.leaf_count(); ++l) {
     const uint32_t c = tree.leaf_cluster[l], v = tree.leaf_attachment_vertex[l], slot = tree.cluster_offsets[c];
     bool card = tree.cluster_offsets[c + 1] - slot == 4 && offsets[v + 1] - offsets[v] == 2 &&
-                memberships[offsets[v] + 1] == slot && tree.member_cluster[memberships[offsets[v]]] < c;
+                memberships[offsets[v] + 1] == slot;
     for (uint32_t k = 0; card && k < 4; ++k)
       card = tree.cluster_members[slot + k] == v + k && (k == 0 || (offsets[v + k + 1] - offsets[v + k] == 1 &&
                                                                     memberships[offsets[v + k]] == slot + k));
