@@ -326,7 +326,6 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
   const double *moment = scratch.cluster_moment.data(), *load = scratch.cluster_load.data();
   const double* damping_moment = scratch.cluster_damping_moment.data();
   double *path = scratch.cluster_damping_path.data(), *rotation = scratch.cluster_static_rotation.data();
-  const Mask4 averaged = Mask4{} + (point != nullptr ? -1 : 0);
   double d[6][3] = {};
   for (int k = 0; point && k < 6; ++k)
     for (int i = 0; i < 3; ++i) d[k][i] = (*point)[k][i];
@@ -356,31 +355,36 @@ void turn_joints_quickly(const SolverModel<Real>& model, const Attachment<Real>&
         // The damping's own term C_j S_j, with the compliance a joint at its yield turn has left
         // for a moment across its turn (none along it): a yielded joint does not move back.
         const Double4 give = angle > largest ? largest / angle : one;
-        // Without a drag area or unresolved air, the capped turn (capped_turn).
-        const Mask4 mean = averaged & (drag_area > zero);
-        const Double4 per_area = 1 / drag_area;
-        const Double4 gx = g[0] * per_area, gy = g[1] * per_area, gz = g[2] * per_area;
-        Double4 size = (gx * gx + gy * gy) + gz * gz;
-        sqrt_lanes(size);
-        sqrt_lanes(size);
-        const Double4 per_size = size > zero ? 1 / size : zero;
-        const Double4 ux = gx * per_size, uy = gy * per_size, uz = gz * per_size;
-        Double4 fx = zero, fy = zero, fz = zero, fastest = zero;
-        for (int p = 0; p < 6; ++p) {
-          const Double4 ax = ux + d[p][0], ay = uy + d[p][1], az = uz + d[p][2];
-          Double4 speed = (ax * ax + ay * ay) + az * az;
-          sqrt_lanes(speed);
-          fx += speed * ax, fy += speed * ay, fz += speed * az;
-          fastest = fastest < speed ? speed : fastest;  // std::max
+        // Without a drag area or unresolved air, the capped turn (capped_turn); in air without
+        // unresolved gusts (no points) no lane takes the mean, which is then not computed.
+        Double4 tx = lx * give, ty = ly * give, tz = lz * give;
+        Mask4 yields = {};
+        if (point != nullptr) {
+          const Mask4 mean = drag_area > zero;
+          const Double4 per_area = 1 / drag_area;
+          const Double4 gx = g[0] * per_area, gy = g[1] * per_area, gz = g[2] * per_area;
+          Double4 size = (gx * gx + gy * gy) + gz * gz;
+          sqrt_lanes(size);
+          sqrt_lanes(size);
+          const Double4 per_size = size > zero ? 1 / size : zero;
+          const Double4 ux = gx * per_size, uy = gy * per_size, uz = gz * per_size;
+          Double4 fx = zero, fy = zero, fz = zero, fastest = zero;
+          for (int p = 0; p < 6; ++p) {
+            const Double4 ax = ux + d[p][0], ay = uy + d[p][1], az = uz + d[p][2];
+            Double4 speed = (ax * ax + ay * ay) + az * az;
+            sqrt_lanes(speed);
+            fx += speed * ax, fy += speed * ay, fz += speed * az;
+            fastest = fastest < speed ? speed : fastest;  // std::max
+          }
+          const Double4 rx = j * r[0], ry = j * r[1], rz = j * r[2];
+          const Double4 wx = fx * (1.0 / 6) - gx, wy = fy * (1.0 / 6) - gy, wz = fz * (1.0 / 6) - gz;
+          tx = mean ? lx + (ry * wz - rz * wy) : tx;
+          ty = mean ? ly + (rz * wx - rx * wz) : ty;
+          tz = mean ? lz + (rx * wy - ry * wx) : tz;
+          Double4 reach = (rx * rx + ry * ry) + rz * rz;
+          sqrt_lanes(reach);
+          yields = mean & ~(angle + reach * (fastest + size) * spread <= largest);
         }
-        const Double4 rx = j * r[0], ry = j * r[1], rz = j * r[2];
-        const Double4 wx = fx * (1.0 / 6) - gx, wy = fy * (1.0 / 6) - gy, wz = fz * (1.0 / 6) - gz;
-        const Double4 tx = mean ? lx + (ry * wz - rz * wy) : lx * give;
-        const Double4 ty = mean ? ly + (rz * wx - rx * wz) : ly * give;
-        const Double4 tz = mean ? lz + (rx * wy - ry * wx) : lz * give;
-        Double4 reach = (rx * rx + ry * ry) + rz * rz;
-        sqrt_lanes(reach);
-        const Mask4 yields = mean & ~(angle + reach * (fastest + size) * spread <= largest);
         const Double4 a2 = (tx * tx + ty * ty) + tz * tz;
         const Mask4 small = a2 < 0.0025, wide = a2 < kWideTurn2;
         const Double4 share = j * give;
