@@ -66,7 +66,11 @@ const Json* SceneObject::find(const std::string& key) const {
   return it == node_->end() ? nullptr : &*it;
 }
 
-bool SceneObject::has(const std::string& key) const { return find(key) != nullptr; }
+bool SceneObject::has(const std::string& key) const {
+  reader_->register_key(pointer_, key);  // a key asked about is a key of this object, given or not
+  const Json* value = find(key);
+  return value && !value->is_null();
+}
 
 void SceneObject::declare(const std::string& key) { reader_->register_key(pointer_, key); }
 

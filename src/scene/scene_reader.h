@@ -63,6 +63,7 @@ class SceneObject {
 
   // Nested object; created as {} when missing. Its keys are checked for unknowns too.
   SceneObject object(const std::string& key);
+  // Whether the key is given: present with a value other than null (null takes the default).
   bool has(const std::string& key) const;
   // Array whose elements must all be objects; [] when missing (and written as []).
   std::vector<SceneObject> array_of_objects(const std::string& key);

@@ -189,6 +189,26 @@ TEST(Forest, Refusals) {
   EXPECT_EQ(error_of(R"({"trees": [{}], "sprcing": 1})"), "f.json: /forest/sprcing: unknown key (did you mean /forest/spacing?)");
 }
 
+// null is an unset value: a forest of null is the one tree, and a null section within a forest
+// or a variant takes what a missing one would (docs/scene.md).
+TEST(Forest, NullSectionsTakeTheirDefaults) {
+  const Scene one = load_scene_text(R"({"lsystem": {"axiom": "F", "iterations": 0}, "forest": null,
+      "wind": {"volume": null}, "outputs": [{"format": "usd", "path": "a.usda", "max_joints": null}]})",
+                                    "f.json", "/scenes", {});
+  EXPECT_FALSE(one.forest);
+  EXPECT_FALSE(one.wind.volume);
+  const Scene scene = load_scene_text(R"({"lsystem": {"axiom": "F", "iterations": 0}, "tree": {"scale": 2},
+      "forest": {"variants": [{"name": "a", "tree": null, "lsystem": null, "hsm": null}], "trees": [{}],
+      "scatter": null}})",
+                                      "f.json", "/scenes", {});
+  ASSERT_TRUE(scene.forest);
+  EXPECT_EQ(scene.forest->trees.size(), 1u);
+  const Scene tree = tree_scene(scene, 0);
+  EXPECT_EQ(tree.tree.scale, 2.0);  // the top level's tree, as for a variant without one
+  EXPECT_EQ(tree.lsystem.axiom, "F");
+  EXPECT_EQ(load(R"({"variants": null, "trees": [{}]})").forest->trees.size(), 1u);
+}
+
 TEST(Forest, OneTreeSceneRefusesThePlaceholder) {
   try {
     load_scene_text(R"({"lsystem": {"axiom": "F"}, "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]})", "s.json",

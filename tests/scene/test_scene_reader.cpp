@@ -35,6 +35,20 @@ TEST(SceneReader, DefaultsAreWrittenIntoTheResolvedScene) {
   EXPECT_EQ(document["time"]["fps"], 30);
 }
 
+TEST(SceneReader, ANullKeyIsNotGivenAndNotUnknown) {
+  // null takes the default like a missing key (docs/scene.md): has() says not given, and the
+  // key is still one of the object's, not an unknown one.
+  Json document = Json::parse(R"({"forest": null, "wind": {"volume": null, "speed": 3}})");
+  SceneReader reader(document, "/scenes");
+  SceneObject root = reader.root();
+  EXPECT_FALSE(root.has("forest"));
+  EXPECT_FALSE(root.has("lsystem"));
+  SceneObject wind = root.object("wind");
+  EXPECT_FALSE(wind.has("volume"));
+  EXPECT_TRUE(wind.has("speed"));
+  EXPECT_NO_THROW(reader.check_unknown_keys());
+}
+
 TEST(SceneReader, UnknownKeySuggestsTheClosestValidKey) {
   EXPECT_EQ(error_of(R"({"wind": {"sped": 3}})",
                      [](SceneObject& root) { root.object("wind").number("speed", 1); }),
