@@ -13,7 +13,7 @@ namespace treeanim {
 using Json = nlohmann::ordered_json;
 
 // Deepest nesting of arrays and objects in a scene, counted from its root. The deepest key a
-// scene reads is three levels down (/outputs/0/path); 256 leaves room for any free-form value.
+// scene reads is six levels down (/forest/variants/0/tree/leaf/size); 256 leaves room for any free-form value.
 constexpr int kMaxJsonDepth = 256;
 
 // Text that is not JSON at all (as opposed to JSON that breaks a limit).

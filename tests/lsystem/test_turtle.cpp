@@ -308,7 +308,7 @@ TEST(Turtle, MaterialIncrementsDecrementsAndSets) {
             (std::vector<int32_t>{0, 1, 5, 4, 0, 0, 3}));
 }
 
-// cpfg's modules (docs/turtle.md "cpfg modules"): ';' and ',' step the colour index, '#' and
+// cpfg's modules (docs/turtle.md "Symbols"): ';' and ',' step the colour index, '#' and
 // '!' the width by the view file's increment.
 TEST(Turtle, CpfgColourIndexSemicolonAndComma) {
   EXPECT_EQ(draw("F;F;(5)F,F,(0)F;F").segment_material, (std::vector<int32_t>{0, 1, 5, 4, 0, 1}));
