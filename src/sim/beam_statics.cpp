@@ -561,9 +561,9 @@ namespace {
 
 // Rest arm (ax, ay, az) from the joint of a cluster with deflected pose k (StepScratch::
 // cluster_pose) => its offset from rest in the deflected pose, (R - I) a + J - j, and
-// C_j S_j . a + lever, added to the sums.
-template <typename Real>
-inline void add_deflected(const Real* k, Real ax, Real ay, Real az, Real& ox, Real& oy, Real& oz, Real& back) {
+// C_j S_j . a + lever, added to the sums. T: a Real, or four vertices in lanes (write_card).
+template <typename Real, typename T>
+inline void add_deflected(const Real* k, const T& ax, const T& ay, const T& az, T& ox, T& oy, T& oz, T& back) {
   ox += ((k[0] * ax + k[3] * ay) + k[6] * az) + k[9];
   oy += ((k[1] * ax + k[4] * ay) + k[7] * az) + k[10];
   oz += ((k[2] * ax + k[5] * ay) + k[8] * az) + k[11];
@@ -632,14 +632,13 @@ void write_card(const SolverModel<Real>& model, const Attachment<Real>& attachme
                   model.member_arm(s, 2), x, y, z, b);
     ox[0] = x, oy[0] = y, oz[0] = z, back[0] = b;
   }
-  const Real* k = &scratch.cluster_pose(0, card.cluster);
-  V4 on;
+  // The card's own terms, each 0 + term: +0 for -0, which the sum after 0 or after the
+  // shared vertex's branch term takes as the term itself.
+  V4 tx = zero, ty = zero, tz = zero, tb = zero, on;
+  add_deflected(&scratch.cluster_pose(0, card.cluster), ax, ay, az, tx, ty, tz, tb);
   for (int l = 0; l < 4; ++l) on[l] = active[card.slot + l] ? Real(1) : Real(0);
   const auto kept = on != zero;
-  ox += kept ? ((k[0] * ax + k[3] * ay) + k[6] * az) + k[9] : zero;
-  oy += kept ? ((k[1] * ax + k[4] * ay) + k[7] * az) + k[10] : zero;
-  oz += kept ? ((k[2] * ax + k[5] * ay) + k[8] * az) + k[11] : zero;
-  back += kept ? ((k[12] * ax + k[13] * ay) + k[14] * az) + k[15] : zero;
+  ox += kept ? tx : zero, oy += kept ? ty : zero, oz += kept ? tz : zero, back += kept ? tb : zero;
   ox *= share, oy *= share, oz *= share, back *= share;
   back = back < zero ? zero : back;  // std::max(back, 0)
   std::memcpy(out.x + card.vertex, &ox, sizeof ox);
