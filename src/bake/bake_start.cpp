@@ -46,8 +46,25 @@ BakeStart start_bake(const BakePlan& plan, const JournalLayout& layout, const Si
   start.state = simulator.initial_state(frame_time(plan, plan.first));
   if (!plan.use_checkpoints) return start;
   const bool resume = plan.checkpoints.resume;
+  // Checkpoints after the frames to write (the newest first) are passed over, with one note.
+  fs::path newest_later;
+  long long later = 0;
+  auto tell_later = [&] {
+    if (later == 0 || !notes) return;
+    const std::string newest = printable_text(newest_later.string());
+    if (later == 1)
+      std::fprintf(notes, "treeanim: not resuming from %s: it is after frame %lld, the last to write\n", newest.c_str(),
+                   plan.written.last);
+    else
+      std::fprintf(notes, "treeanim: not resuming from %s or the %lld other checkpoints after frame %lld, the last to write\n",
+                   newest.c_str(), later - 1, plan.written.last);
+  };
   for (const auto& [frame, path] : list_checkpoints(plan.checkpoints.dir)) {
-    if (frame < plan.first || frame > plan.written.last || (!resume && frame > plan.written.first)) continue;
+    if (resume && frame > plan.written.last) {
+      if (later++ == 0) newest_later = path;
+      continue;
+    }
+    if (frame < plan.first || (!resume && frame > plan.written.first)) continue;
     auto [stored_frame, state] = read_checkpoint(path, plan.key, start.state);
     if (stored_frame != frame)
       throw InputError(path.string() + ": holds frame " + std::to_string(stored_frame) + ", not the frame in its name");
@@ -60,10 +77,12 @@ BakeStart start_bake(const BakePlan& plan, const JournalLayout& layout, const Si
     start.state = std::move(state);
     start.checkpoint = path;
     start.journal = std::move(journal);
+    tell_later();
     if (notes) std::fprintf(notes, "treeanim: resuming at frame %lld from %s\n", start.frame,
                             printable_text(path.string()).c_str());
     return start;
   }
+  tell_later();
   if (resume && notes)
     std::fprintf(notes, "treeanim: no usable checkpoint in %s: baking from frame %lld\n",
                  printable_text(plan.checkpoints.dir.string()).c_str(), plan.first);

@@ -27,7 +27,7 @@ void note_input_file(const std::filesystem::path& path) {
   if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return;
   InputFiles& files = input_files();
   const std::lock_guard<std::mutex> lock(files.mutex);
-  files.named[status.st_dev].emplace(status.st_ino, path.string());
+  files.named[status.st_dev].insert_or_assign(status.st_ino, path.string());  // the newest name: an inode freed since may be a new file's
 }
 
 std::string input_file_at(const std::filesystem::path& path) {
@@ -38,7 +38,12 @@ std::string input_file_at(const std::filesystem::path& path) {
   const auto device = files.named.find(status.st_dev);
   if (device == files.named.end()) return "";
   const auto file = device->second.find(status.st_ino);
-  return file == device->second.end() ? "" : file->second;
+  if (file == device->second.end()) return "";
+  // Only while its name still leads to it: an input removed since gave its inode to a new file.
+  struct stat noted;
+  if (::stat(file->second.c_str(), &noted) != 0 || noted.st_dev != status.st_dev || noted.st_ino != status.st_ino)
+    return "";
+  return file->second;
 }
 
 }  // namespace treeanim

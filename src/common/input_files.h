@@ -13,7 +13,7 @@ namespace treeanim {
 void note_input_file(const std::filesystem::path& path);
 
 // A path => the input file it names (through links), as it was named when noted; "" when it
-// names none (or nothing). Thread-safe.
+// names none (or nothing), or the input's name no longer leads to that file. Thread-safe.
 std::string input_file_at(const std::filesystem::path& path);
 
 }  // namespace treeanim

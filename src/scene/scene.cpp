@@ -14,6 +14,7 @@
 #include "scene/species.h"
 #include "scene/tree_section.h"
 #include "sim/wind_keys.h"
+#include "tree/tree_build_steps.h"
 
 namespace treeanim {
 
@@ -199,9 +200,15 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   auto add_grammar_files = [&](const LsystemOptions& options) {
     for (std::filesystem::path& path : grammar_input_files(options)) scene.input_paths.push_back(std::move(path));
   };
-  if (top_lsystem) add_grammar_files(scene.lsystem);
+  // And the files a custom leaf mesh is read from: a glTF's buffer edited is a new bake.
+  auto add_tree_files = [&](const LsystemOptions& lsystem, const TreeOptions& tree) {
+    add_grammar_files(lsystem);
+    if (tree.leaf.mesh)
+      for (std::filesystem::path& path : load_leaf_template(tree.leaf).files) scene.input_paths.push_back(std::move(path));
+  };
+  if (top_lsystem) add_tree_files(scene.lsystem, scene.tree);
   if (scene.forest)
-    for (const ForestVariant& variant : scene.forest->variants) add_grammar_files(variant.lsystem);
+    for (const ForestVariant& variant : scene.forest->variants) add_tree_files(variant.lsystem, variant.tree);
   if (scene.volume)
     for (long long frame = scene.volume->first_frame; frame <= scene.volume->last_frame; ++frame)
       scene.volume_frames.push_back(volume_frame_path(scene.wind.volume->path, frame));

@@ -1,6 +1,7 @@
 // Leaf meshes: the default quad, a custom mesh read with assimp, the grammar's '{ . }' outlines,
 // or the meshes the turtle placed (cpfg surfaces, spheres, circles).
 #include <Eigen/Geometry>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -142,9 +143,30 @@ LeafTemplate default_leaf_template(const LeafOptions& options) {
   return t;
 }
 
+// assimp's own file access, each file it opens noted: the files a mesh names (a glTF's buffers,
+// an OBJ's materials) are its inputs as much as the mesh, which no output may replace and whose
+// bytes a bake's key holds.
+class NotingFiles final : public Assimp::DefaultIOSystem {
+ public:
+  explicit NotingFiles(std::vector<std::filesystem::path>& files) : files_(files) {}
+  Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+    Assimp::IOStream* stream = DefaultIOSystem::Open(file, mode);
+    if (stream) {
+      note_input_file(file);
+      files_.push_back(std::filesystem::path(file).lexically_normal());
+    }
+    return stream;
+  }
+
+ private:
+  std::vector<std::filesystem::path>& files_;
+};
+
 LeafTemplate load_leaf_template(const LeafOptions& options) {
   const std::string file = options.mesh->string();
+  LeafTemplate t;
   Assimp::Importer importer;
+  importer.SetIOHandler(new NotingFiles(t.files));  // the importer owns it
   // Normals and colours are dropped before joining so that vertices split only for shading
   // merge back: the simulation wants one particle per surface point.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
@@ -162,7 +184,6 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   if (!std::filesystem::is_regular_file(status)) throw InputError(file + ": cannot read leaf mesh: not a regular file");
   check_ply_header(file);
   const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);
-  note_input_file(file);
   if (scene) scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode)
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
@@ -179,7 +200,6 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
     throw InputError(file + ": cannot read leaf mesh: " + importer.GetErrorString());
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2f> uvs;
-  LeafTemplate t;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) append_ai_mesh(*scene->mMeshes[m], points, uvs, t.triangles);
   if (t.triangles.empty()) throw InputError(file + ": leaf mesh has no triangles");
   t.positions.resize(3, Eigen::Index(points.size()));

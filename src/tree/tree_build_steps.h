@@ -3,6 +3,7 @@
 // topology => radii => branch mesh => leaf mesh => clusters => masses.
 #include <Eigen/Core>
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include "lsystem/skeleton.h"
@@ -60,6 +61,7 @@ struct LeafTemplate {
   uint32_t attachment = 0;          // the vertex nearest the petiole base (origin)
   double area = 0;                  // m^2
   double length = 0;                // m, extent along y
+  std::vector<std::filesystem::path> files;  // a custom mesh's files read: the mesh, and those it names (a glTF's buffers)
 };
 
 // leaf options => the default rhombus quad, base vertex at y = petiole.

@@ -9,6 +9,7 @@
 #include "bake/bake_tree.h"
 #include "bake/checkpoint.h"
 #include "bake/prepare_tree.h"
+#include "common/input_files.h"
 #include "sim/simulator.h"
 #include "temp_folder_test.h"
 
@@ -135,6 +136,34 @@ TEST_F(BakeStages, TheKeyHoldsWhatTheGrammarReadsInTurn) {
   EXPECT_EQ(key(), data);
 }
 
+// A glTF leaf keeps its vertices in a buffer file it names: that file is an input as the mesh
+// is (no output may replace it), and an edited buffer is a new bake.
+TEST_F(BakeStages, TheKeyHoldsTheFilesALeafMeshNames) {
+  auto write_buffer = [&](float width) {
+    const float positions[12] = {-width, 0.5f, 0, 0, 0, 0, width, 0.5f, 0, 0, 1, 0};
+    const uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    std::ofstream out(dir_ / "leaf.bin", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(positions), sizeof positions);
+    out.write(reinterpret_cast<const char*>(indices), sizeof indices);
+  };
+  write_buffer(0.5f);
+  std::ofstream(dir_ / "leaf.gltf") << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    "buffers": [{"uri": "leaf.bin", "byteLength": 60}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, 0, 0], "max": [0.5, 1, 0]},
+                  {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+  const char* scene = R"({"lsystem": {"axiom": "F", "iterations": 0}, "tree": {"leaf": {"mesh": "leaf.gltf"}},
+    "time": {"frames": 2}, "outputs": []})";
+  auto key = [&] { return bake_key(load_scene_text(scene, "s.json", dir_, {}), treeanim_generator()); };
+  const std::string first = key();
+  EXPECT_FALSE(input_file_at(dir_ / "leaf.bin").empty());
+  write_buffer(0.25f);
+  EXPECT_NE(key(), first);
+  write_buffer(0.5f);
+  EXPECT_EQ(key(), first);
+}
+
 TEST_F(BakeStages, StartFreshThenFromACheckpoint) {
   const Scene line = scene();
   BakeConfig resume = config();
@@ -171,6 +200,16 @@ TEST_F(BakeStages, StartFreshThenFromACheckpoint) {
   EXPECT_EQ(start.checkpoint, checkpoint);
   EXPECT_EQ(start.state.positions, fresh.state.positions);
   EXPECT_EQ(resumed.text(), "treeanim: resuming at frame 11 from " + checkpoint.string() + "\n");
+
+  // --resume of frames 10:10 only: the checkpoint after them is passed over, and said so.
+  BakeConfig first_only = resume;
+  first_only.frames = FrameRange{10, 10};
+  const BakePlan first_plan = plan_bake(line, first_only);
+  Notes passed;
+  EXPECT_EQ(start_bake(first_plan, journal_layout(first_plan, tree.model, false), simulator, passed.file()).frame, 10);
+  EXPECT_EQ(passed.text(), "treeanim: not resuming from " + checkpoint.string() +
+                               ": it is after frame 10, the last to write\ntreeanim: no usable checkpoint in " +
+                               (dir_ / "checkpoints").string() + ": baking from frame 10\n");
 }
 
 TEST_F(BakeStages, RunAFewFramesAndFinish) {
