@@ -56,7 +56,8 @@ BakeStart start_bake(const BakePlan& plan, const JournalLayout& layout, const Si
       std::fprintf(notes, "treeanim: not resuming from %s: it is after frame %lld, the last to write\n", newest.c_str(),
                    plan.written.last);
     else
-      std::fprintf(notes, "treeanim: not resuming from %s or the %lld other checkpoints after frame %lld, the last to write\n",
+      std::fprintf(notes,
+                   "treeanim: not resuming from %s or the %lld other checkpoints after frame %lld, the last to write\n",
                    newest.c_str(), later - 1, plan.written.last);
   };
   for (const auto& [frame, path] : list_checkpoints(plan.checkpoints.dir)) {

@@ -27,7 +27,8 @@ void note_input_file(const std::filesystem::path& path) {
   if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return;
   InputFiles& files = input_files();
   const std::lock_guard<std::mutex> lock(files.mutex);
-  files.named[status.st_dev].insert_or_assign(status.st_ino, path.string());  // the newest name: an inode freed since may be a new file's
+  // The newest name: an inode freed since may be a new file's.
+  files.named[status.st_dev].insert_or_assign(status.st_ino, path.string());
 }
 
 std::string input_file_at(const std::filesystem::path& path) {

@@ -204,7 +204,8 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   auto add_tree_files = [&](const LsystemOptions& lsystem, const TreeOptions& tree) {
     add_grammar_files(lsystem);
     if (tree.leaf.mesh)
-      for (std::filesystem::path& path : load_leaf_template(tree.leaf).files) scene.input_paths.push_back(std::move(path));
+      for (std::filesystem::path& path : load_leaf_template(tree.leaf).files)
+        scene.input_paths.push_back(std::move(path));
   };
   if (top_lsystem) add_tree_files(scene.lsystem, scene.tree);
   if (scene.forest)

@@ -61,7 +61,8 @@ struct LeafTemplate {
   uint32_t attachment = 0;          // the vertex nearest the petiole base (origin)
   double area = 0;                  // m^2
   double length = 0;                // m, extent along y
-  std::vector<std::filesystem::path> files;  // a custom mesh's files read: the mesh, and those it names (a glTF's buffers)
+  // A custom mesh's files as read: the mesh, and those it names (a glTF's buffers).
+  std::vector<std::filesystem::path> files;
 };
 
 // leaf options => the default rhombus quad, base vertex at y = petiole.
