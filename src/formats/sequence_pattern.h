@@ -14,10 +14,10 @@ struct SequencePattern {
   std::filesystem::path rest() const;  // the number replaced by "rest"
 };
 
-// An output path => its sequence pattern. A path with one "%d" or "%0Nd" field keeps it;
-// any other path gets ".%04d<extension>" appended (after dropping a trailing `extension`).
-// Throws InputError "<pointer>/path: ..." for other '%' fields, and for a field not followed
-// by a name that ends in `extension`.
+// An output path => its sequence pattern. A file name with a frame field (common/frame_field.h:
+// ####, "%d" or "%0Nd") keeps it; any other path gets ".%04d<extension>" appended (after
+// dropping a trailing `extension`). Throws InputError "<pointer>/path: ..." for a name no field
+// can be read from, and for a field not followed by a name that ends in `extension`.
 SequencePattern sequence_pattern(const std::filesystem::path& path, const std::string& extension,
                                  const std::string& pointer);
 

@@ -1,6 +1,7 @@
 #include "scene/scene.h"
 
 #include <algorithm>
+#include <map>
 #include <sstream>
 
 #include "common/errors.h"
@@ -97,18 +98,20 @@ VolumeSummary check_volume(const SceneReader& reader, const Scene& scene) {
   }
 }
 
+// Named in messages, cut like describe_json: a value may be a long text.
+std::string override_name(const std::string& assignment) { return "--set '" + excerpt(assignment) + "'"; }
+
 }  // namespace
 
-void apply_override(Json& document, const std::string& assignment) {
+std::string apply_override(Json& document, const std::string& assignment) {
+  const std::string shown = override_name(assignment);
   // The file's strings were checked by the JSON parser; command-line bytes were not, and the
   // resolved scene (written into every output) must stay valid JSON text.
   try {
     (void)Json(assignment).dump();
   } catch (const nlohmann::json::type_error&) {
-    throw InputError("--set '" + excerpt(assignment) + "': not valid UTF-8 text");
+    throw InputError(shown + ": not valid UTF-8 text");
   }
-  // Named in messages, cut like describe_json: a value may be a long text.
-  const std::string shown = "--set '" + excerpt(assignment) + "'";
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0)
     throw InputError(shown + ": expected PATH=VALUE, e.g. lsystem.iterations=6");
@@ -155,6 +158,7 @@ void apply_override(Json& document, const std::string& assignment) {
     }
   }
   *node = std::move(value);
+  return target;
 }
 
 Scene load_scene_text(const std::string& text, const std::string& name,
@@ -162,9 +166,18 @@ Scene load_scene_text(const std::string& text, const std::string& name,
                       const std::vector<std::string>& overrides) {
   Scene scene;
   scene.resolved = parse_json_text(text, name);
-  for (const std::string& assignment : overrides) apply_override(scene.resolved, assignment);
-
   SceneReader reader(scene.resolved, base_dir, name);
+  std::map<std::string, std::string> set_by;  // pointer => the override that set it
+  for (const std::string& assignment : overrides) {
+    const std::string target = apply_override(scene.resolved, assignment);
+    // As a key given twice in the file: which one was meant is no one's guess to make.
+    const auto [earlier, first] = set_by.emplace(target, override_name(assignment));
+    if (!first)
+      throw InputError(override_name(assignment) + ": " + target + " is set already by " + earlier->second +
+                       ": expected each path once");
+    reader.note_override(target, override_name(assignment));
+  }
+
   SceneObject root = reader.root();
   root.optional_string("description");
   scene.seed = static_cast<uint64_t>(root.integer("seed", 1, 0, (1LL << 53)));

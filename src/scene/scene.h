@@ -47,8 +47,10 @@ struct Scene {
 };
 
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a
-// string; JSON nested too deep, with a repeated key or an out-of-range number is refused). Missing intermediate objects are created. Throws InputError on a malformed override.
-void apply_override(Json& document, const std::string& assignment);
+// string; JSON nested too deep, with a repeated key or an out-of-range number is refused). Missing
+// intermediate objects are created. => the JSON pointer it set. Throws InputError on a malformed
+// override.
+std::string apply_override(Json& document, const std::string& assignment);
 
 // Loads, overrides, validates. Errors: InputError "file: /pointer: message" (exit 2).
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);

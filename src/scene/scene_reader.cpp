@@ -147,12 +147,19 @@ std::string SceneObject::string(const std::string& key, const std::string& fallb
 
 std::string SceneObject::choice(const std::string& key, const std::string& fallback,
                                 const std::vector<std::string>& choices) {
-  const std::string v = string(key, fallback);
-  if (std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
+  declare(key);
+  const Json* value = find(key);
+  if (!value || value->is_null()) {
+    (*node_)[key] = fallback;
+    return fallback;
+  }
+  // A value of another type is told the choices too, not only that a string was expected.
+  const std::string v = value->is_string() ? value->get<std::string>() : std::string();
+  if (value->is_string() && std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
   std::string expected = "one of";
   for (size_t i = 0; i < choices.size(); ++i) expected += (i ? ", \"" : " \"") + choices[i] + "\"";
-  const std::string near = closest_match(v, choices);
-  fail(key, "expected " + expected + ", got " + describe_json(*find(key)) +
+  const std::string near = value->is_string() ? closest_match(v, choices) : std::string();
+  fail(key, "expected " + expected + ", got " + describe_json(*value) +
                 (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
 }
 
@@ -241,7 +248,10 @@ SceneReader::SceneReader(Json& root, std::filesystem::path scene_dir, std::strin
 
 void SceneReader::fail(const std::string& pointer, const std::string& message) const {
   const std::string where = pointer.empty() ? std::string("/") : pointer;
-  throw InputError((source_name_.empty() ? "" : source_name_ + ": ") + where + ": " + message);
+  std::string source = source_name_;
+  for (const auto& [target, argument] : overrides_)
+    if (pointer == target || pointer.starts_with(target + "/")) source = argument;
+  throw InputError((source.empty() ? "" : source + ": ") + where + ": " + message);
 }
 
 const std::string& SceneObject::source_name() const { return reader_->source_name(); }

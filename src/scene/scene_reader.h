@@ -15,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/json_text.h"
@@ -113,6 +114,11 @@ class SceneReader {
   void register_object(const std::string& object_pointer);
   // Called by SceneObject::optional_path: the files the scene names, in the order read.
   void note_path(const std::filesystem::path& path) { paths_.push_back(path); }
+  // The value at `pointer`, and all below it, came from the command line: a message about it
+  // names `argument` ("--set 'time.fps=5000'"), not the scene file.
+  void note_override(std::string pointer, std::string argument) {
+    overrides_.emplace_back(std::move(pointer), std::move(argument));
+  }
   const std::vector<std::filesystem::path>& paths() const { return paths_; }
 
  private:
@@ -122,6 +128,7 @@ class SceneReader {
   std::string source_name_;
   std::map<std::string, std::vector<std::string>> valid_keys_;  // object pointer => keys
   std::vector<std::filesystem::path> paths_;
+  std::vector<std::pair<std::string, std::string>> overrides_;  // pointer, argument
 };
 
 // Compact one-line rendering of a JSON value for messages (strings quoted, long values cut).

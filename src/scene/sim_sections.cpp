@@ -1,13 +1,14 @@
 #include "scene/sim_sections.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <utility>
 
 #include "common/direction.h"
 #include "common/errors.h"
+#include "common/frame_field.h"
 #include "common/message_text.h"
 #include "common/read_text_file.h"
 
@@ -26,6 +27,15 @@ const Range kWindTime = Range::between(-1e10, 1e10);
 // the solver resolves up to pi/(2h) = 1.57e7 rad/s; a larger cap or floor resolves nothing more.
 const Range kSolverFrequency = {0, 1.5e7, true, false};
 
+// The hsm keys that one stiffness mode reads and the other does not (docs/solver.md, "Stiffness").
+constexpr std::pair<const char*, StiffnessMode> kModeKeys[] = {
+    {"alpha", StiffnessMode::kPerStep},
+    {"k_d", StiffnessMode::kPerStep},
+    {"global_scale", StiffnessMode::kPhysical},
+    {"max_frequency", StiffnessMode::kPhysical},
+    {"max_limb_frequency", StiffnessMode::kPhysical},
+    {"min_limb_frequency", StiffnessMode::kPhysical},
+};
 
 // One field of a CSV line => finite number within `range`; throws "name:line: column 'what': ...".
 double csv_number(const std::string& cell, const std::string& where, const std::string& column,
@@ -67,32 +77,15 @@ std::string order_error(const std::vector<WindKey>& keys, size_t i) {
          number_text(keys[i - 1].time);
 }
 
-// A frame pattern names the frame number at most once, as #### or %d / %0Nd (printf's, so
-// nothing else after a % is let through), at most 18 digits wide (a long long's).
-bool valid_frame_pattern(const std::string& text) {
-  const size_t hash = text.find('#'), percent = text.find('%');
-  if (hash != std::string::npos && percent != std::string::npos) return false;
-  if (hash != std::string::npos) {
-    const size_t end = std::min(text.find_first_not_of('#', hash), text.size());
-    return end - hash <= 18 && text.find('#', end) == std::string::npos;
-  }
-  if (percent == std::string::npos) return true;
-  size_t i = percent + 1;
-  if (i < text.size() && text[i] == '0') ++i;
-  const size_t digits = i;
-  while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
-  return i - digits <= 2 && std::atoi(text.c_str() + digits) <= 18 && i < text.size() && text[i] == 'd' &&
-         text.find('%', i) == std::string::npos;
-}
-
 // /wind/volume => where the volume's frames are, how they are timed and placed.
 VolumeOptions read_volume_options(SceneObject section) {
   VolumeOptions o;
   const std::optional<std::filesystem::path> path = section.optional_path("path");
   if (!path) section.fail("path", "expected the volume's frame files, e.g. \"smoke/vel.####.vdb\"");
-  if (!valid_frame_pattern(path->filename().string()))
-    section.fail("path", "expected one frame number in the file name, as #### or %04d, got '" +
-                             path->filename().string() + "'");
+  FrameField field;
+  if (!read_frame_field(path->filename().string(), field))
+    section.fail("path", "expected at most one frame number in the file name, as #### or %04d (at most " +
+                             std::to_string(kMostFrameDigits) + " digits), got '" + path->filename().string() + "'");
   o.path = *path;
   o.grid = section.string("grid", o.grid);
   if (o.grid.empty()) section.fail("grid", "expected a grid's name, e.g. \"vel\"");
@@ -119,8 +112,21 @@ HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
   o.stiffness = section.choice("stiffness", o.stiffness == StiffnessMode::kPhysical ? "physical" : "per_step", {"physical", "per_step"}) == "physical"
                     ? StiffnessMode::kPhysical
                     : StiffnessMode::kPerStep;
-  o.alpha = section.number("alpha", o.alpha, Range::between(0, 1));
-  o.k_d = section.number("k_d", o.k_d, Range::between(0, 1));
+  const bool physical = o.stiffness == StiffnessMode::kPhysical;
+  // A key of the other mode would be read past while its scene expects it to matter: refused,
+  // and left out of the resolved scene, which so reads back in its own mode.
+  for (const auto& [key, mode] : kModeKeys)
+    if (mode != o.stiffness) {
+      if (section.has(key))
+        section.fail_expected(key, std::string("no ") + key + " where stiffness is \"" + (physical ? "physical" : "per_step") +
+                                       "\" (" + key + " is read by \"stiffness\": \"" +
+                                       (physical ? "per_step" : "physical") + "\" alone)");
+      section.declare(key);
+    }
+  if (!physical) {
+    o.alpha = section.number("alpha", o.alpha, Range::between(0, 1));
+    o.k_d = section.number("k_d", o.k_d, Range::between(0, 1));
+  }
   o.leaf_alpha = section.number("leaf_alpha", o.leaf_alpha, Range::between(0, 1));
   o.leaf_turn = section.number("leaf_turn", o.leaf_turn, Range::between(0, 1));
   o.yield_strain = section.number("yield_strain", o.yield_strain, {0, 0.1, true, false});
@@ -128,14 +134,20 @@ HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
   // Below ~1 MPa (softer than any self-supporting plant tissue; green wood is 5-12 GPa) a
   // branch has no stiffness to speak of and the wind carries the tree away.
   o.youngs_modulus = section.number("youngs_modulus", o.youngs_modulus, Range::between(1e6, 5e10));
-  o.global_scale = section.number("global_scale", o.global_scale, Range::between(0, 100));
-  o.max_frequency = section.number("max_frequency", o.max_frequency, kSolverFrequency);
-  o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, kSolverFrequency);
-  o.min_limb_frequency = section.number("min_limb_frequency", o.min_limb_frequency, Range::between(0, 1.5e7));
-  if (o.min_limb_frequency > o.max_limb_frequency)  // which bound would win is no one's guess to make
-    section.fail("min_limb_frequency", "the floor " + number_text(o.min_limb_frequency) +
-                                           " rad/s is above max_limb_frequency, " + number_text(o.max_limb_frequency) +
-                                           " rad/s: expected a floor at or below the cap");
+  if (physical) {
+    o.global_scale = section.number("global_scale", o.global_scale, Range::between(0, 100));
+    o.max_frequency = section.number("max_frequency", o.max_frequency, kSolverFrequency);
+    o.max_limb_frequency = section.number("max_limb_frequency", o.max_limb_frequency, kSolverFrequency);
+    // A cap set below the default floor takes the floor down with it: the floor guards vanishing
+    // limbs, and a scene that asks for slower limbs than it has said nothing against.
+    o.min_limb_frequency = section.number("min_limb_frequency", std::min(o.min_limb_frequency, o.max_limb_frequency),
+                                          Range::between(0, 1.5e7));
+    // Both given and crossed: which would win is no one's guess to make.
+    if (o.min_limb_frequency > o.max_limb_frequency)
+      section.fail("min_limb_frequency", "the floor " + number_text(o.min_limb_frequency) +
+                                             " rad/s is above max_limb_frequency, " + number_text(o.max_limb_frequency) +
+                                             " rad/s: expected a floor at or below the cap");
+  }
   o.damping_ratio = section.number("damping_ratio", o.damping_ratio, Range::between(0, 10));
   o.leaf_detach_force = section.number("leaf_detach_force", o.leaf_detach_force, Range::between(0, 1e4));
   o.gravity = section.vector3("gravity", o.gravity, Range::between(-100, 100));
@@ -151,7 +163,7 @@ HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
                     : ParticleMode::kSamples;
   // Per-step rates of 0 for both terms leave nothing holding the tree: refuse, not bake a
   // tree that blows away.
-  if (o.stiffness == StiffnessMode::kPerStep && o.alpha == 0 && (o.k_d == 0 || !o.global_matching))
+  if (!physical && o.alpha == 0 && (o.k_d == 0 || !o.global_matching))
     section.fail("alpha", "expected a number in (0, 1] when k_d is 0 or global_matching is off "
                           "(nothing would hold the tree), got 0");
   return o;

@@ -5,11 +5,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <numbers>
 
 #include "common/errors.h"
+#include "common/frame_field.h"
 #include "common/input_files.h"
 #include "common/message_text.h"
 #include "sim/volume_grids.h"
@@ -67,10 +66,10 @@ VolumeFrame read_frame(const std::string& path, const std::string& name) {
   return frame;
 }
 
-// A file name with #### or %d is one file per frame; without, one file for all time.
+// A file name with a frame field is one file per frame; without, one file for all time.
 bool has_frame_number(const std::filesystem::path& pattern) {
-  const std::string name = pattern.filename().string();
-  return name.find('#') != std::string::npos || name.find('%') != std::string::npos;
+  FrameField field;
+  return read_frame_field(pattern.filename().string(), field) && field.begin != std::string::npos;
 }
 
 }  // namespace
@@ -86,23 +85,10 @@ int serve_volume_trials() {
 }
 
 std::string volume_frame_path(const std::filesystem::path& pattern, long long number) {
-  const std::string text = pattern.filename().string();
-  // #### is printf's %04d (a negative frame -001, as Houdini's $F4 writes it).
-  size_t begin = text.find('#'), end = 0;
-  int width = 0;
-  if (begin != std::string::npos) {
-    end = text.find_first_not_of('#', begin);
-    if (end == std::string::npos) end = text.size();
-    width = int(end - begin);
-  } else if ((begin = text.find('%')) != std::string::npos) {
-    end = text.find('d', begin) + 1;
-    width = std::atoi(text.substr(begin + 1, end - begin - 2).c_str());
-  } else {
-    return pattern.string();
-  }
-  char digits[64];  // the scene reader allows a width of 18 at most
-  std::snprintf(digits, sizeof digits, "%0*lld", width, number);
-  return (pattern.parent_path() / (text.substr(0, begin) + digits + text.substr(end))).string();
+  const std::string name = pattern.filename().string();
+  FrameField field;  // the scene reader let through only a name with at most one field
+  if (!read_frame_field(name, field) || field.begin == std::string::npos) return pattern.string();
+  return (pattern.parent_path() / with_frame_number(name, field, number)).string();
 }
 
 VolumeFrames volume_frames_at(const VolumeOptions& options, double t) {

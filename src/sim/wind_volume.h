@@ -37,8 +37,8 @@ struct VolumeFrames {
 };
 VolumeFrames volume_frames_at(const VolumeOptions& options, double t);
 
-// The file of frame `number`: #### (as many digits as #) or %d / %0Nd in the file name replaced;
-// a name without either is the one file of every frame.
+// The file of frame `number`: the file name's frame field (common/frame_field.h) replaced;
+// a name without one is the one file of every frame.
 std::string volume_frame_path(const std::filesystem::path& pattern, long long number);
 
 // What `info` prints and `validate` checks (check_wind_volume).

@@ -1,6 +1,7 @@
 #include "tree/build_tree_model.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -93,6 +94,9 @@ void assign_masses(const SegmentTopology& topology, const TreeOptions& options,
       spread(model, c, options.drag_share * leaves.area[l], is_leaf, model.vertex_drag_area);
     }
   }
+  // A drawn size past double's range (two steps of 1e300) overflows the volumes, not the points.
+  if (!std::all_of(model.vertex_mass.begin(), model.vertex_mass.end(), [](double m) { return std::isfinite(m); }))
+    throw TreeModelError("the tree is larger than a number holds: a segment's length or volume is not finite (a step such as F(1e300))");
   // Below the floor everywhere: segments of no length (F(0), a step of 1e-300) and no leaf, a
   // tree of floors alone whose motion would mean nothing.
   if (std::none_of(model.vertex_mass.begin(), model.vertex_mass.end(), [](double m) { return m >= kMinVertexMass; }))

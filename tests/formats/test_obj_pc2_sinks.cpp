@@ -58,13 +58,16 @@ TEST(SequencePattern, NamesFramesAndRest) {
   EXPECT_EQ(field.frame(7), "a%b/leaf_007_x.obj");
   EXPECT_EQ(field.rest(), "a%b/leaf_rest_x.obj");
   EXPECT_EQ(sequence_pattern("t%d.glb", ".glb", "").frame(42), "t42.glb");
+  const SequencePattern hashes = sequence_pattern("o/f.####.obj", ".obj", "");  // Houdini's $F4
+  EXPECT_EQ(hashes.frame(7), "o/f.0007.obj");
+  EXPECT_EQ(hashes.rest(), "o/f.rest.obj");
   try {
     sequence_pattern("t%04d_%d.obj", ".obj", "/outputs/3");
     FAIL() << "two fields accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "/outputs/3/path: expected at most one frame-number field \"%d\" or \"%0Nd\" (N 1-9) in the file "
-              "name, got \"t%04d_%d.obj\"");
+              "/outputs/3/path: expected at most one frame-number field, #### or \"%d\" / \"%0Nd\" (at most 18 "
+              "digits), in the file name, got \"t%04d_%d.obj\"");
   }
   EXPECT_THROW(sequence_pattern("t%s.obj", ".obj", ""), InputError);
 }

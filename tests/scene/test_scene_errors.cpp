@@ -102,7 +102,7 @@ TEST(SceneErrors, SectionMustBeAnObject) {
 
 TEST(SceneErrors, OverrideIntroducesUnknownKey) {
   EXPECT_EQ(error_of(kValid, {"time.fsp=30"}),
-            "s.json: /time/fsp: unknown key (did you mean /time/fps?)");
+            "--set 'time.fsp=30': /time/fsp: unknown key (did you mean /time/fps?)");
 }
 
 TEST(SceneErrors, OverrideWithoutEquals) {
@@ -112,7 +112,18 @@ TEST(SceneErrors, OverrideWithoutEquals) {
 
 TEST(SceneErrors, OverrideValueIsValidated) {
   EXPECT_EQ(error_of(kValid, {"time.fps=-1"}),
-            "s.json: /time/fps: expected a number in [1, 1000], got -1");
+            "--set 'time.fps=-1': /time/fps: expected a number in [1, 1000], got -1");
+  // Below an override's path the value is the override's; beside it, the file's.
+  EXPECT_EQ(error_of(kValid, {"wind={\"keys\": [{\"time\": 0, \"speed\": -3}]}"}),
+            "--set 'wind={\"keys\": [{\"time\": 0, \"speed\": -3}]}': /wind/keys/0/speed: expected a number in "
+            "[0, 113], got -3");
+  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": -1}})", {"time.fps=30"}),
+            "s.json: /time/frames: expected an integer in [1, 10000000], got -1");
+}
+
+TEST(SceneErrors, OverrideOfOnePathTwice) {
+  EXPECT_EQ(error_of(kValid, {"time.fps=30", "time.frames=4", "time.fps=24"}),
+            "--set 'time.fps=24': /time/fps is set already by --set 'time.fps=30': expected each path once");
 }
 
 TEST(SceneErrors, MissingFileNamesTheResolvedPath) {

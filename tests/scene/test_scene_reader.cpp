@@ -91,6 +91,8 @@ TEST(SceneReader, ChoiceListsTheChoicesAndSuggests) {
   EXPECT_EQ(error_of(R"({"format": "hdf"})",
                      [](SceneObject& root) { root.choice("format", "hdf5", {"hdf5", "obj"}); }),
             "s.json: /format: expected one of \"hdf5\", \"obj\", got \"hdf\" (did you mean \"hdf5\"?)");
+  EXPECT_EQ(error_of(R"({"format": 5})", [](SceneObject& root) { root.choice("format", "hdf5", {"hdf5", "obj"}); }),
+            "s.json: /format: expected one of \"hdf5\", \"obj\", got 5");
 }
 
 TEST(SceneReader, Vector3NeedsThreeNumbers) {

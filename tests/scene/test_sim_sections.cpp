@@ -60,6 +60,50 @@ TEST(HsmOptions, ReadsParticles) {
       << error;
 }
 
+TEST(HsmOptions, ACapBelowTheDefaultFloorTakesTheFloorDown) {
+  Json document = Json::parse(R"({"hsm": {"max_limb_frequency": 1}})");
+  SceneReader reader(document, "/scenes", "s.json");
+  const HsmOptions o = read_hsm_options(reader.root().object("hsm"));
+  EXPECT_EQ(o.max_limb_frequency, 1);
+  EXPECT_EQ(o.min_limb_frequency, 1);
+  EXPECT_EQ(document["hsm"]["min_limb_frequency"], 1);  // the resolved scene reads back
+  EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"max_limb_frequency": 30}})")).min_limb_frequency, 1.25);
+  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"max_limb_frequency": 1, "min_limb_frequency": 2}})")); }),
+            "s.json: /hsm/min_limb_frequency: the floor 2 rad/s is above max_limb_frequency, 1 rad/s: expected a "
+            "floor at or below the cap");
+}
+
+TEST(HsmOptions, RefusesTheKeysOfTheOtherStiffnessMode) {
+  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"alpha": 0.3}})")); }),
+            "s.json: /hsm/alpha: expected no alpha where stiffness is \"physical\" (alpha is read by "
+            "\"stiffness\": \"per_step\" alone), got 0.3");
+  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "min_limb_frequency": 2}})")); }),
+            "s.json: /hsm/min_limb_frequency: expected no min_limb_frequency where stiffness is \"per_step\" "
+            "(min_limb_frequency is read by \"stiffness\": \"physical\" alone), got 2");
+  for (const std::string mode : {"physical", "per_step"})
+    for (const std::string key : {"k_d", "global_scale", "max_frequency", "max_limb_frequency"}) {
+      const bool physical_key = key != "k_d";
+      if (physical_key == (mode == "physical")) continue;
+      const std::string error = error_of([&] {
+        read_hsm(Json::parse(R"({"hsm": {"stiffness": ")" + mode + R"(", ")" + key + R"(": 0.5}})"));
+      });
+      EXPECT_NE(error.find("/hsm/" + key + ": expected no " + key), std::string::npos) << error;
+    }
+  // null takes the default, as anywhere; the resolved scene holds its own mode's keys alone, so
+  // it reads back.
+  Json document = Json::parse(R"({"hsm": {"stiffness": "per_step", "global_scale": null}})");
+  SceneReader reader(document, "/scenes", "s.json");
+  EXPECT_EQ(read_hsm_options(reader.root().object("hsm")).stiffness, StiffnessMode::kPerStep);
+  EXPECT_TRUE(document["hsm"].contains("alpha"));
+  EXPECT_FALSE(document["hsm"].contains("max_frequency"));
+  Json physical = Json::parse(R"({"hsm": {}})");
+  SceneReader physical_reader(physical, "/scenes", "s.json");
+  (void)read_hsm_options(physical_reader.root().object("hsm"));
+  EXPECT_TRUE(physical["hsm"].contains("max_frequency"));
+  EXPECT_FALSE(physical["hsm"].contains("alpha"));
+  EXPECT_FALSE(physical["hsm"].contains("k_d"));
+}
+
 TEST(HsmOptions, ReadsPerStepStiffness) {
   const HsmOptions o = read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 0.3, "k_d": 0.05,
                                                        "global_matching": false, "sleep": false}})"));
@@ -71,7 +115,7 @@ TEST(HsmOptions, ReadsPerStepStiffness) {
 }
 
 TEST(HsmOptions, RejectsOutOfRangeAndUnknownKeys) {
-  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"alpha": 1.5}})")); }),
+  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 1.5}})")); }),
             "s.json: /hsm/alpha: expected a number in [0, 1], got 1.5");
   EXPECT_NE(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stifness": "physical"}})")); }).find("did you mean /hsm/stiffness"),
             std::string::npos);

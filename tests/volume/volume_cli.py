@@ -150,7 +150,8 @@ def check_bad(treeanim, tmp):
          "fast/vel.0001.vdb: grid 'vel', voxel (0, 0, 0): a speed of 150 m/s, beyond the wind's 113 m/s"),
         ("units-too-fast", volume(vol, units=20), nine, "a speed of 160 m/s, beyond the wind's 113 m/s"),
         ("bad-pattern", volume(vol) | {"volume": {"path": os.path.join(vol, "vel.%s.vdb")}}, nine,
-         "/wind/volume/path: expected one frame number in the file name, as #### or %04d, got 'vel.%s.vdb'"),
+         "/wind/volume/path: expected at most one frame number in the file name, as #### or %04d (at most 18 "
+         "digits), got 'vel.%s.vdb'"),
         ("no-path", {"volume": {"grid": "vel"}}, nine, "/wind/volume/path: expected the volume's frame files"),
         ("loop", volume(vol), {"fps": 24, "frames": 9, "loop": True},
          "/wind/volume: a loop needs a wind that repeats"),
