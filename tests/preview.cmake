@@ -24,7 +24,7 @@ add_test(NAME preview.bake
 \"$t\" run configs/demo.json -o '${preview_out}/demo' --quiet ${preview_scene_colors} --set time.frames=96 --set '${preview_page_only}' && \
 exec \"$t\" run configs/conifer.json -o '${preview_out}/conifer' --quiet ${preview_scene_colors} --set time.frames=72 --set '${preview_page_only}'"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP preview_pages TIMEOUT 300)
+set_tests_properties(preview.bake PROPERTIES LABELS preview FIXTURES_SETUP preview_pages TIMEOUT 300 COST 100)
 
 find_program(TREEANIM_NODE node)
 set(preview_client ${CMAKE_SOURCE_DIR}/tests/clients/node/preview_page.js)
@@ -39,8 +39,9 @@ function(preview_client_test name command page)
     add_test(NAME preview.${name}
              COMMAND sh -c "echo 'preview.${name}: node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
   endif()
+  # COST (tests/stress.cmake): a page in software GL takes some 20-50 s; started early.
   set_tests_properties(preview.${name} PROPERTIES LABELS preview FIXTURES_REQUIRED preview_pages TIMEOUT 300
-                       WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+                       WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} COST 30)
 endfunction()
 function(preview_page_test name page)
   preview_client_test(${name} check ${page} ${preview_colors} ${ARGN})

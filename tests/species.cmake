@@ -32,7 +32,7 @@ foreach(i RANGE ${species_last})
   add_test(NAME species.${name}
            COMMAND /usr/bin/python3 ${species_check} --treeanim $<TARGET_FILE:treeanim> ${name}
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-  set_tests_properties(species.${name} PROPERTIES LABELS species TIMEOUT 600)
+  set_tests_properties(species.${name} PROPERTIES LABELS species TIMEOUT 600 COST 40)  # COST: tests/stress.cmake
 
   species_color(${i} bark_color bark)
   species_color(${i} leaf_color leaf)
@@ -50,7 +50,7 @@ exec '${TREEANIM_NODE}' tests/clients/node/preview_page.js check '${page}/page.h
     add_test(NAME species.preview_${name}
              COMMAND sh -c "echo 'node, chromium or playwright-core not installed (run scripts/setup test)'; exit 1")
   endif()
-  set_tests_properties(species.preview_${name} PROPERTIES LABELS "species;preview" TIMEOUT 300)
+  set_tests_properties(species.preview_${name} PROPERTIES LABELS "species;preview" TIMEOUT 300 COST 20)
 endforeach()
 
 # configs/forest-species.json seen whole: a wood of nine species, its leaves (needle sprays and

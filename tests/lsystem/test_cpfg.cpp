@@ -17,7 +17,7 @@
 namespace treeanim {
 namespace {
 
-Grammar parse(const std::string& text) { return parse_grammar({{"plant.l", text, false}}, {}); }
+Grammar parse_plant(const std::string& text) { return parse_grammar({{"plant.l", text, false}}, {}); }
 
 // word => "A(1,2)B" (parameters truncated).
 std::string text_of(const ModuleString& word) {
@@ -32,7 +32,7 @@ std::string text_of(const ModuleString& word) {
 }
 
 std::string derive_text(const std::string& grammar, int steps) {
-  return text_of(derive(parse(grammar), {steps, 1, 1'000'000}));
+  return text_of(derive(parse_plant(grammar), {steps, 1, 1'000'000}));
 }
 
 TEST(Cpfg, HeadersCommentsMacrosAndRulesOverLines) {
@@ -50,7 +50,9 @@ TEST(Cpfg, MacroArgumentsAreExpandedFirst) {
   EXPECT_EQ(derive_text("#define N 3\n#define D(a) (a*2)\naxiom: F(D(N))\n", 0), "F(6)");
   std::string deep = "1";
   for (int i = 0; i < 40; ++i) deep = "D(" + deep + ")";
-  EXPECT_NE(input_error_of([&] { parse("#define D(a) (a+1)\naxiom: F(" + deep + ")\n"); }).find("macros expand more than 32 levels deep"),
+  EXPECT_NE(input_error_of([&] {
+              parse_plant("#define D(a) (a+1)\naxiom: F(" + deep + ")\n");
+            }).find("macros expand more than 32 levels deep"),
             std::string::npos);
 }
 
@@ -80,8 +82,9 @@ TEST(Cpfg, BlocksVariablesAndControlBlocks) {
 
 // The homomorphism reads the globals as the derivation's End block leaves them.
 TEST(Cpfg, HomomorphismReadsTheGlobalsTheDerivationLeaves) {
-  const Grammar g = parse("Start: {ang = 30;}\nEnd: {ang = ang + 1;}\nderivation length: 1\naxiom: A\n"
-                          "homomorphism\nA --> +(ang) F\n");
+  const Grammar g = parse_plant(
+      "Start: {ang = 30;}\nEnd: {ang = ang + 1;}\nderivation length: 1\naxiom: A\n"
+      "homomorphism\nA --> +(ang) F\n");
   std::vector<double> variables;
   const ModuleString word = derive(g, {1, 1, 100}, {}, &variables);
   const ModuleString drawn = apply_homomorphism(g, word, {1, 1, 100}, &variables);
@@ -91,8 +94,9 @@ TEST(Cpfg, HomomorphismReadsTheGlobalsTheDerivationLeaves) {
 }
 
 TEST(Cpfg, SameSymbolWithDifferentAritiesAndDeepHomomorphism) {
-  const Grammar g = parse("axiom: A A(3)\nA --> B\nA(n) --> A(n,n)\nhomomorphism\nmaximum depth: 1000\n"
-                          "C(n) : n > 0 --> F C(n-1)\n");
+  const Grammar g = parse_plant(
+      "axiom: A A(3)\nA --> B\nA(n) --> A(n,n)\nhomomorphism\nmaximum depth: 1000\n"
+      "C(n) : n > 0 --> F C(n-1)\n");
   EXPECT_EQ(derive(g, {1, 1, 100}).size(), 2u);
   ModuleString word;
   word.clear();
@@ -101,23 +105,25 @@ TEST(Cpfg, SameSymbolWithDifferentAritiesAndDeepHomomorphism) {
   EXPECT_EQ(apply_homomorphism(g, word, {0, 1, 10'000}).size(), 901u);
 }
 
-std::string error_of(const std::string& text, int steps = 1) {
+std::string plant_error_of(const std::string& text, int steps = 1) {
   return input_error_of([&] { derive_text(text, steps); });
 }
 
 TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
-  EXPECT_EQ(error_of("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n", 0), "no error");
-  EXPECT_EQ(error_of("#define F(x) x\naxiom: F(1,2)\n"), "plant.l:2:8: macro 'F' expects 1 arguments, got 2");
-  EXPECT_EQ(error_of("axiom: A\nA --> B ?(3, 0.5) C $\n"),
+  EXPECT_EQ(plant_error_of("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n", 0), "no error");
+  EXPECT_EQ(plant_error_of("#define F(x) x\naxiom: F(1,2)\n"), "plant.l:2:8: macro 'F' expects 1 arguments, got 2");
+  EXPECT_EQ(plant_error_of("axiom: A\nA --> B ?(3, 0.5) C $\n"),
             "plant.l:2:9: '?(3, ...)' calls L-system 3, but the file has no 'lsystem: 3' (it has 0)");
-  EXPECT_EQ(error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
-            "plant.l:3:10: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4' (rule at 3:1)");
-  EXPECT_EQ(error_of("axiom: A\nA --> B(\"x\")\n"),
-            "plant.l:2:9: a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
-  EXPECT_EQ(error_of("axiom: A ?E(1)\n"),
+  EXPECT_EQ(plant_error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
+            "plant.l:3:10: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4' (rule "
+            "at 3:1)");
+  EXPECT_EQ(
+      plant_error_of("axiom: A\nA --> B(\"x\")\n"),
+      "plant.l:2:9: a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
+  EXPECT_EQ(plant_error_of("axiom: A ?E(1)\n"),
             "plant.l:1:10: '?E' communicates with an environment process, which is not supported (CPFG manual 6.9)");
-  EXPECT_EQ(error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
-  EXPECT_EQ(error_of("axiom: A\nA --> F @PS(1, 1) @PC(1, 0, 0) @PD(1, 4, 4)\n"),
+  EXPECT_EQ(plant_error_of("axiom: A\nA[B] --> C\n"), "plant.l:2:2: a bracket cannot be in a predecessor");
+  EXPECT_EQ(plant_error_of("axiom: A\nA --> F @PS(1, 1) @PC(1, 0, 0) @PD(1, 4, 4)\n"),
             "plant.l:2:9: '@P' (@PS, @PC, @PD: a bicubic patch from turtle positions, CPFG manual 6.7.2) is not "
             "supported; draw the surface from a '.s' file with '~id' (a 'surface:' line of the view file)");
 }
@@ -127,7 +133,8 @@ TEST(Cpfg, EqualsInARightContextSkipsTheRestOfTheBranch) {
   EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [B=]D --> X\n", 1), "X[BC]D");
   EXPECT_EQ(derive_text("axiom: A[C][BE]F\nA > [=][B=]F --> X\n", 1), "X[C][BE]F");
   EXPECT_EQ(derive_text("axiom: A[BC]D\nA > [C=]D --> X\n", 1), "A[BC]D");
-  EXPECT_EQ(error_of("axiom: A\nA > B=(x) --> X\n"), "plant.l:2:6: '=' (the rest of the branch) takes no parameters");
+  EXPECT_EQ(plant_error_of("axiom: A\nA > B=(x) --> X\n"),
+            "plant.l:2:6: '=' (the rest of the branch) takes no parameters");
 }
 
 // A strict predecessor of several modules (CPFG manual 3.1) replaces them all, with the right
@@ -137,7 +144,7 @@ TEST(Cpfg, PredecessorOfSeveralModules) {
   EXPECT_EQ(derive_text("axiom: A(1)B(2)C\nA(x)B(y) --> D(x+y)\n", 1), "D(3)C");
   EXPECT_EQ(derive_text("axiom: A B C A B\nA B > C --> X\nB --> Y\n", 1), "XCAY");
   EXPECT_EQ(derive_text("axiom: A(1)B(2)\nA(x)B(y) : x > y --> Z\n", 1), "A(1)B(2)");
-  const Grammar g = parse("axiom: A B A\nhomomorphism\nA B --> F(2)\n");
+  const Grammar g = parse_plant("axiom: A B A\nhomomorphism\nA B --> F(2)\n");
   const ModuleString drawn = apply_homomorphism(g, derive(g, {0, 1, 100}), {0, 1, 100});
   ASSERT_EQ(drawn.size(), 2u);
   EXPECT_EQ(drawn.symbols[0], 'F');
@@ -145,7 +152,7 @@ TEST(Cpfg, PredecessorOfSeveralModules) {
   // Within a successor (vlab's HilbertPanels: L --> Sl Tl, Sl --> ...), its parameters bound,
   // not across the successor's end, and a tail the rule does not take left to the next module.
   auto homomorphism = [](const std::string& text) {
-    const Grammar h = parse(text);
+    const Grammar h = parse_plant(text);
     return text_of(apply_homomorphism(h, derive(h, {0, 1, 100}), {0, 1, 100}));
   };
   EXPECT_EQ(homomorphism("axiom: A\nhomomorphism\nmaximum depth: 2\nA --> F B(1)C(2)\nB(x)C(y) --> G(x+y)\n"), "FG(3)");
@@ -161,13 +168,14 @@ TEST(Cpfg, Arrays) {
   const std::string arrays = "define: {\n  array a[2][3] = {1, 2, 3,\n\n 4, 5, 6};\n  array b[2];\n}\n";
   EXPECT_EQ(derive_text(arrays + "Start: {b[1] = a[1][2] + a[0, 1];}\naxiom: A(b[1]) A(b[0])\n", 0), "A(8)A(0)");
   EXPECT_EQ(derive_text(arrays + "axiom: A(0)\nA(i) : {b[i] = b[i] + a[i][i];} * --> A(b[i] * 10 + i)\n", 1), "A(10)");
-  EXPECT_EQ(error_of(arrays + "axiom: A(a[2][0])\n"), "plant.l:7:12: array index 2 is outside 0 ... 1");
-  EXPECT_EQ(error_of(arrays + "axiom: A(1)\nA(x) --> A(a[0][x + 2])\n"),
+  EXPECT_EQ(plant_error_of(arrays + "axiom: A(a[2][0])\n"), "plant.l:7:12: array index 2 is outside 0 ... 1");
+  EXPECT_EQ(plant_error_of(arrays + "axiom: A(1)\nA(x) --> A(a[0][x + 2])\n"),
             "plant.l:8:17: array index 3 is outside 0 ... 2 while deriving step 1 (rule at 8:1)");
-  EXPECT_EQ(error_of("define: { array c[2] = {1, 2, 3}; }\naxiom: A\n"),
+  EXPECT_EQ(plant_error_of("define: { array c[2] = {1, 2, 3}; }\naxiom: A\n"),
             "plant.l:1:31: more values than the 2 elements of 'c'");
-  EXPECT_EQ(error_of("define: { array c[0]; }\naxiom: A\n"), "plant.l:1:19: expected an integer in [1, 1000000], got 0");
-  EXPECT_EQ(error_of("define: { array c[2]; }\naxiom: A(c)\n"),
+  EXPECT_EQ(plant_error_of("define: { array c[0]; }\naxiom: A\n"),
+            "plant.l:1:19: expected an integer in [1, 1000000], got 0");
+  EXPECT_EQ(plant_error_of("define: { array c[2]; }\naxiom: A(c)\n"),
             "plant.l:2:11: expected '[' after the array 'c', got ')'");
 }
 
@@ -194,8 +202,9 @@ TEST(Cpfg, ConditionalsContinuationsAndHashInsideALine) {
   EXPECT_EQ(derive_text("#ifndef TALL\n#ifdef TALL\naxiom: A\n#endif\naxiom: B\n#endif\n", 0), "B");
   EXPECT_EQ(derive_text("#define GROW(x) \\\n  (x) + 1\n#define M 2 \\\\\n + 2\naxiom: A(GROW(M))\n", 0), "A(5)");
   EXPECT_EQ(derive_text("axiom: F # F ! F\n", 0), "F#F!F");
-  EXPECT_EQ(error_of("axiom: A\n  #ifdef X\naxiom: A\n"), "plant.l:2:3: #ifdef or #ifndef is never closed (expected #endif)");
-  EXPECT_EQ(error_of("axiom: A\n#else\n"), "plant.l:2:1: '#else' without #ifdef or #ifndef");
+  EXPECT_EQ(plant_error_of("axiom: A\n  #ifdef X\naxiom: A\n"),
+            "plant.l:2:3: #ifdef or #ifndef is never closed (expected #endif)");
+  EXPECT_EQ(plant_error_of("axiom: A\n#else\n"), "plant.l:2:1: '#else' without #ifdef or #ifndef");
 }
 
 // What cpp (which cpfg runs) reads as comments and what stays modules; an axiom's unclosed
@@ -207,7 +216,7 @@ TEST(Cpfg, CommentsCutsPolygonsAndLabels) {
   EXPECT_EQ(derive_text("axiom: F{.+F.A\nA --> F.}\n", 1), "F{.+F.F.}");
   EXPECT_EQ(derive_text("axiom: F[+A%FF]F\nA --> AF\n", 2), "F[+AFF]F");
   EXPECT_EQ(derive_text("lsystem: 123456789\naxiom: A\n", 0), "A");
-  EXPECT_EQ(error_of("lsystem: 1000000001\naxiom: A\n"),
+  EXPECT_EQ(plant_error_of("lsystem: 1000000001\naxiom: A\n"),
             "plant.l:1:10: expected a label of at most 9 digits (a call names it as a number)");
 }
 
@@ -236,7 +245,7 @@ TEST(Cpfg, ConditionalChainsAndNesting) {
   for (int k = 0; k < 300; ++k) nested += "1?";
   nested += "1";
   for (int k = 0; k < 300; ++k) nested += ":0";
-  EXPECT_NE(error_of(nested + ")\n", 0).find("expression too deeply nested"), std::string::npos);
+  EXPECT_NE(plant_error_of(nested + ")\n", 0).find("expression too deeply nested"), std::string::npos);
 }
 
 // What a grammar may grow to: a module's parameters count against lsystem.max_modules (4 a
@@ -244,7 +253,7 @@ TEST(Cpfg, ConditionalChainsAndNesting) {
 TEST(Cpfg, ParametersAndExpandedTextAreBounded) {
   std::string many = "axiom: A\nA --> AA B(";
   for (int k = 0; k < 100; ++k) many += k ? ",1" : "1";
-  const Grammar g = parse(many + ")\n");
+  const Grammar g = parse_plant(many + ")\n");
   EXPECT_EQ(input_error_of([&] { derive(g, {10, 1, 10000}); }),
             "plant.l: derivation step 9 of 10 reached 40100 parameters, more than 4 x lsystem.max_modules = 10000 "
             "(lower lsystem.iterations or raise lsystem.max_modules)");
@@ -254,8 +263,9 @@ TEST(Cpfg, ParametersAndExpandedTextAreBounded) {
     doubling += "#define M" + std::to_string(k) + " M" + std::to_string(k - 1) + " M" + std::to_string(k - 1) + "\n";
   std::string uses;
   for (int k = 0; k < 200; ++k) uses += "A --> M15\n";
-  EXPECT_NE(error_of(doubling + "axiom: A\n" + uses, 0).find(": the grammar grows past 64 MiB with its #includes and "
-                                                             "macros expanded"),
+  EXPECT_NE(plant_error_of(doubling + "axiom: A\n" + uses, 0)
+                .find(": the grammar grows past 64 MiB with its #includes and "
+                      "macros expanded"),
             std::string::npos);
 }
 
@@ -295,7 +305,7 @@ TEST(Cpfg, SubLsystemsRewriteTheModulesTheyAreCalledFor) {
   EXPECT_EQ(derive_text(kSubLsystems, 1), "F?(2,2)B(1)$AB(2)");
   EXPECT_EQ(derive_text(kSubLsystems, 2), "F?(2,2)C(1)B(10)$F?(2,2)B(1)$AB(3)");
   // Each L-system's homomorphism draws its own modules: C is drawn only inside a call of 2.
-  const Grammar g = parse(kSubLsystems + "");
+  const Grammar g = parse_plant(kSubLsystems + "");
   ModuleString word;
   word.clear();
   const double one = 1, call[2] = {2, 1};
@@ -306,7 +316,7 @@ TEST(Cpfg, SubLsystemsRewriteTheModulesTheyAreCalledFor) {
   const ModuleString drawn = apply_homomorphism(g, word, {0, 1, 100});
   EXPECT_EQ(std::string(drawn.symbols.begin(), drawn.symbols.end()), "C?F$");
   // A sub-L-system's control blocks would need variables per call.
-  EXPECT_EQ(error_of("lsystem: 1\naxiom: A\nA --> ?(2) B $\nendlsystem\nlsystem: 2\nStart: {x = 1;}\n"),
+  EXPECT_EQ(plant_error_of("lsystem: 1\naxiom: A\nA --> ?(2) B $\nendlsystem\nlsystem: 2\nStart: {x = 1;}\n"),
             "plant.l:6:1: a sub-L-system's 'start:' block is not supported (cpfg gives each call of a sub-L-system its "
             "own copy of the variables, CPFG manual 7.2)");
 }
@@ -322,8 +332,9 @@ TEST(Cpfg, ContextsOfASubLsystemUseItsOwnIgnoreList) {
 
 // The turtle scales lengths, widths and surfaces by a call's s until its '$' (cpfg's interpret.c).
 TEST(Cpfg, CallsScaleTheTurtle) {
-  const Grammar g = parse("lsystem: 1\naxiom: !(1) F(1) ?(2, 0.5) F(2) [ !(2) F(2) ] $ F(1)\nendlsystem\n"
-                          "lsystem: 2\naxiom: F\nendlsystem\n");
+  const Grammar g = parse_plant(
+      "lsystem: 1\naxiom: !(1) F(1) ?(2, 0.5) F(2) [ !(2) F(2) ] $ F(1)\nendlsystem\n"
+      "lsystem: 2\naxiom: F\nendlsystem\n");
   TurtleSettings turtle;
   turtle.calls = g.calls;
   const Skeleton k = interpret(derive(g, {0, 1, 100}), turtle);
@@ -363,11 +374,11 @@ TEST(Cpfg, IgnoredBracketsChangeRightContexts) {
 // its number in the file and the turtle draws nothing.
 TEST(Cpfg, LabelsTakeAStringAndDrawNothing) {
   EXPECT_EQ(derive_text("axiom: F @L(\"age %.f\", 3) @L(\"a \\\"b\\\"\") @S(\"ls\")\n", 0), "F@L(0,3)@L(1)@S(2)");
-  const Grammar g = parse("axiom: F @L(\"x\", 3) F\n");
+  const Grammar g = parse_plant("axiom: F @L(\"x\", 3) F\n");
   const Skeleton k = interpret(derive(g, {0, 1, 100}), {});
   EXPECT_EQ(k.segment_end.size(), 2u);
   EXPECT_TRUE(k.leaf_segment.empty());
-  EXPECT_EQ(error_of("axiom: @L(\"open)\n"), "plant.l:1:11: the string is never closed (expected '\"')");
+  EXPECT_EQ(plant_error_of("axiom: @L(\"open)\n"), "plant.l:1:11: the string is never closed (expected '\"')");
 }
 
 // curveX/curveY/curveZ/curveGAL (CPFG manual 5.5) read the view file's curves by arc length.
@@ -395,12 +406,14 @@ TEST(Cpfg, CurveFunctions) {
 // Homomorphism rules match contexts in the word being drawn; a module a homomorphism rule
 // produces takes the contexts of the module it comes from (CPFG manual 4.3.2).
 TEST(Cpfg, HomomorphismContextsAreTheDerivedWords) {
-  const Grammar g = parse("derivation length: 0\naxiom: F P(1,2) F P(1,5) [Q] F\nignore: Q\n"
-                          "homomorphism\nF > P(x,y) : y > 3 --> f\nP(x,y) < F --> G(x)\n");
+  const Grammar g = parse_plant(
+      "derivation length: 0\naxiom: F P(1,2) F P(1,5) [Q] F\nignore: Q\n"
+      "homomorphism\nF > P(x,y) : y > 3 --> f\nP(x,y) < F --> G(x)\n");
   const ModuleString word = derive(g, {0, 1, 100});
   EXPECT_EQ(text_of(apply_homomorphism(g, word, {0, 1, 100})), "FP(1,2)fP(1,5)[Q]G(1)");
-  const Grammar deep = parse("axiom: F P(1,2) F P(1,5)\nhomomorphism\nmaximum depth: 2\n"
-                             "F --> G P(0,0)\nG > P(x,y) : y > 3 --> f\n");
+  const Grammar deep = parse_plant(
+      "axiom: F P(1,2) F P(1,5)\nhomomorphism\nmaximum depth: 2\n"
+      "F --> G P(0,0)\nG > P(x,y) : y > 3 --> f\n");
   EXPECT_EQ(text_of(apply_homomorphism(deep, derive(deep, {0, 1, 100}), {0, 1, 100})),
             "GP(0,0)P(1,2)fP(0,0)P(1,5)");
 }
@@ -409,13 +422,13 @@ TEST(Cpfg, HomomorphismContextsAreTheDerivedWords) {
 // whatever the derivation's seed, which it leaves as it is.
 TEST(Cpfg, HomomorphismSeedKeysOnlyTheHomomorphism) {
   const std::string text = "axiom: A\nhomomorphism\nseed: 5\nA --> F(ran(1000))\n";
-  const Grammar g = parse(text);
+  const Grammar g = parse_plant(text);
   EXPECT_EQ(g.seed, 0u);
   const ModuleString word = derive(g, {0, 1, 100});
   EXPECT_EQ(apply_homomorphism(g, word, {0, 1, 100}).params, apply_homomorphism(g, word, {0, 2, 100}).params);
-  const Grammar unseeded = parse("axiom: A\nhomomorphism\nA --> F(ran(1000))\n");
+  const Grammar unseeded = parse_plant("axiom: A\nhomomorphism\nA --> F(ran(1000))\n");
   EXPECT_NE(apply_homomorphism(unseeded, word, {0, 1, 100}).params, apply_homomorphism(unseeded, word, {0, 2, 100}).params);
-  EXPECT_EQ(error_of("axiom: A\ndecomposition\nseed: 5\n"),
+  EXPECT_EQ(plant_error_of("axiom: A\ndecomposition\nseed: 5\n"),
             "plant.l:3:1: a decomposition draws with the productions' random numbers: 'seed:' belongs before "
             "'decomposition' (CPFG manual 4.4)");
 }
@@ -467,7 +480,7 @@ TEST(Cpfg, FscanReadsADataFileBesideTheGrammar) {
 }
 
 TEST(Cpfg, EndlessLoopStopsWithItsPlace) {
-  const Grammar g = parse("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n");
+  const Grammar g = parse_plant("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n");
   try {
     derive(g, {1, 1, 100});
     FAIL() << "no error";

@@ -12,10 +12,10 @@
 namespace treeanim {
 namespace {
 
-Grammar parse(const std::string& text) { return parse_grammar({{"g.lsys", text, false}}, {}); }
+Grammar parse_lsys(const std::string& text) { return parse_grammar({{"g.lsys", text, false}}, {}); }
 
 ModuleString run(const std::string& text, int iterations, uint64_t seed = 1, size_t max_modules = 20'000'000) {
-  return derive(parse(text), DerivationSettings{iterations, seed, max_modules});
+  return derive(parse_lsys(text), DerivationSettings{iterations, seed, max_modules});
 }
 
 std::string symbols(const ModuleString& word) { return std::string(word.symbols.begin(), word.symbols.end()); }
@@ -43,7 +43,7 @@ size_t expected_length(const std::string& axiom, const std::map<char, std::strin
 TEST(Derive, ClosedFormForAbop124a) {
   // F --> F[+F]F[-F]F: F_n = 5^n, and each rewritten F adds 6 other modules:
   // total_n = 5^n + 6 (5^n - 1) / 4.
-  const Grammar g = parse("axiom: F\nF --> F[+F]F[-F]F\n");
+  const Grammar g = parse_lsys("axiom: F\nF --> F[+F]F[-F]F\n");
   size_t five = 1;
   for (int n = 0; n <= 6; ++n) {
     EXPECT_EQ(derive(g, {n, 1, 20'000'000}).size(), five + 6 * (five - 1) / 4) << n;
@@ -68,7 +68,7 @@ TEST(Derive, CountsPerStepForAbopBracketedGrammars) {
   for (const Case& c : cases) {
     std::string text = "axiom: " + c.axiom + "\n";
     for (const auto& [symbol, successor] : c.rules) text += std::string(1, symbol) + " --> " + successor + "\n";
-    const Grammar g = parse(text);
+    const Grammar g = parse_lsys(text);
     for (int n = 0; n <= 5; ++n)
       EXPECT_EQ(derive(g, {n, 1, 20'000'000}).size(), expected_length(c.axiom, c.rules, n)) << text << n;
   }
@@ -77,7 +77,7 @@ TEST(Derive, CountsPerStepForAbopBracketedGrammars) {
 TEST(Derive, ClosedFormForParametricAbop26) {
   // Fig. 2.6: each apex (A, B, C) becomes 2 apices and 6 other modules (! F [ & ] / or
   // ! F [ - $ ]): apices_n = 2^n, total_n = 2^n + 6 (2^n - 1).
-  const Grammar g = parse(
+  const Grammar g = parse_lsys(
       "#define r1 0.9\n#define r2 0.6\n#define a0 45\n#define a2 45\n#define d 137.5\n#define wr 0.707\n"
       "axiom: A(1,10)\n"
       "A(l,w) --> !(w)F(l)[&(a0)B(l*r2,w*wr)]/(d)A(l*r1,w*wr)\n"
@@ -121,7 +121,7 @@ TEST(Derive, ConditionsPickTheFirstApplicableRule) {
 // ABOP Fig. 1.31a: an acropetal signal b climbs the main axis and enters each branch,
 // skipping branches to its left (left context climbs out of branches and skips complete ones).
 TEST(Derive, AcropetalSignalWithLeftContext) {
-  const Grammar g = parse("ignore: +-F\naxiom: Fb[+Fa]Fa[-Fa]Fa[+Fa]Fa\nb < a --> b\nb --> a\n");
+  const Grammar g = parse_lsys("ignore: +-F\naxiom: Fb[+Fa]Fa[-Fa]Fa[+Fa]Fa\nb < a --> b\nb --> a\n");
   const std::string expected[] = {
       "Fb[+Fa]Fa[-Fa]Fa[+Fa]Fa", "Fa[+Fb]Fb[-Fa]Fa[+Fa]Fa", "Fa[+Fa]Fa[-Fb]Fb[+Fa]Fa",
       "Fa[+Fa]Fa[-Fa]Fa[+Fb]Fb", "Fa[+Fa]Fa[-Fa]Fa[+Fa]Fa"};
@@ -131,7 +131,7 @@ TEST(Derive, AcropetalSignalWithLeftContext) {
 // ABOP Fig. 1.31b: a basipetal signal moves down the main axis; the right context skips the
 // lateral branches, and a module at the end of a branch (before ']') has no right context.
 TEST(Derive, BasipetalSignalWithRightContext) {
-  const Grammar g = parse("ignore: +-F\naxiom: Fa[+Fa]Fa[-Fa]Fa[+Fa]Fb\na > b --> b\nb --> a\n");
+  const Grammar g = parse_lsys("ignore: +-F\naxiom: Fa[+Fa]Fa[-Fa]Fa[+Fa]Fb\na > b --> b\nb --> a\n");
   const std::string expected[] = {
       "Fa[+Fa]Fa[-Fa]Fa[+Fa]Fb", "Fa[+Fa]Fa[-Fa]Fb[+Fa]Fa", "Fa[+Fa]Fb[-Fa]Fa[+Fa]Fa",
       "Fb[+Fa]Fa[-Fa]Fa[+Fa]Fa", "Fa[+Fa]Fa[-Fa]Fa[+Fa]Fa"};
@@ -163,7 +163,7 @@ TEST(Derive, RightContextWithBrackets) {
 
 TEST(Derive, StochasticChoiceIsReproducibleAndSeedDependent) {
   const std::string text = "axiom: F\nF --> F[+F]F[-F]F : 0.33\nF --> F[+F]F : 0.33\nF --> F[-F]F : 0.34\n";
-  const Grammar g = parse(text);
+  const Grammar g = parse_lsys(text);
   const std::string a = symbols(derive(g, {5, 7, 20'000'000}));
   EXPECT_EQ(a, symbols(derive(g, {5, 7, 20'000'000})));
   int different = 0;
@@ -194,16 +194,16 @@ TEST(Derive, DecompositionAfterEveryStepUpToMaximumDepth) {
   auto with_depth = [](const std::string& depth) {
     return "axiom: A\nA --> AB\ndecomposition\nmaximum depth: " + depth + "\nB --> CD\nC --> E\n";
   };
-  const Grammar deep = parse(with_depth("2"));
+  const Grammar deep = parse_lsys(with_depth("2"));
   EXPECT_EQ(symbols(derive(deep, {1, 1, 1000})), "AED");
   EXPECT_EQ(symbols(derive(deep, {3, 1, 1000})), "AEDEDED");
   // Depth 1 leaves C of step 1 undecomposed; step 2 decomposes it (decomposition applies to
   // every module after each step): AB C D => A CD E D.
-  EXPECT_EQ(symbols(derive(parse(with_depth("1")), {2, 1, 1000})), "ACDED");
+  EXPECT_EQ(symbols(derive(parse_lsys(with_depth("1")), {2, 1, 1000})), "ACDED");
 }
 
 TEST(Derive, HomomorphismOnlyForInterpretation) {
-  const Grammar g = parse("axiom: A(2)\nA(x) --> A(x+1)\nF(l) --> G\nhomomorphism\nA(x) --> F(x*2)+\n");
+  const Grammar g = parse_lsys("axiom: A(2)\nA(x) --> A(x+1)\nF(l) --> G\nhomomorphism\nA(x) --> F(x*2)+\n");
   const DerivationSettings settings{2, 1, 1000};
   const ModuleString word = derive(g, settings);
   ASSERT_EQ(symbols(word), "A");  // the derivation never sees the homomorphism's F

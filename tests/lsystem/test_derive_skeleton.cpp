@@ -16,7 +16,7 @@ std::filesystem::path grammar_file(const std::string& name) {
   return std::filesystem::path(TREEANIM_SOURCE_DIR) / "grammars" / name;
 }
 
-std::string error_of(const LsystemOptions& options) {
+std::string derive_error_of(const LsystemOptions& options) {
   GrowthStats stats;
   return input_error_of([&] { grow_skeleton(options, &stats); });
 }
@@ -78,15 +78,15 @@ TEST(GrowSkeleton, SceneDefineMustExistInTheFile) {
   options.grammar = grammar_file("abop-2.6a-monopodial.lsys");
   options.defines = {{"r9", 0.5}};
   options.scene_name = "scene.json";
-  EXPECT_EQ(error_of(options), "scene.json: /lsystem/defines/r9: the grammar " + options.grammar->string() +
-                                   " has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)");
+  EXPECT_EQ(derive_error_of(options), "scene.json: /lsystem/defines/r9: the grammar " + options.grammar->string() +
+                                          " has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)");
 }
 
 TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
   LsystemOptions options;
   options.axiom = std::string("F");  // (a plain = "F" trips g++ 12's false -Wrestrict)
   options.productions = {"F --> FF"};
-  EXPECT_EQ(error_of(options),
+  EXPECT_EQ(derive_error_of(options),
             "/lsystem/axiom: the grammar has no 'derivation length:'; give the number of steps as "
             "/lsystem/iterations");
 }
@@ -94,7 +94,7 @@ TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
 TEST(GrowSkeleton, MissingFile) {
   LsystemOptions options;
   options.grammar = "/nonexistent/tree.lsys";
-  EXPECT_EQ(error_of(options), "/nonexistent/tree.lsys: cannot read the grammar file (no such file)");
+  EXPECT_EQ(derive_error_of(options), "/nonexistent/tree.lsys: cannot read the grammar file (no such file)");
 }
 
 TEST(GrowSkeleton, InlineErrorsNameTheRule) {
@@ -102,7 +102,7 @@ TEST(GrowSkeleton, InlineErrorsNameTheRule) {
   options.axiom = "A(1)";
   options.productions = {"A(x) --> A(x)", "A(x) --> B(x, q)"};
   options.iterations = 1;
-  EXPECT_EQ(error_of(options),
+  EXPECT_EQ(derive_error_of(options),
             "/lsystem/productions/1, column 15: unknown name 'q' (expected a formal parameter (x))");
 }
 

@@ -13,16 +13,16 @@
 namespace treeanim {
 namespace {
 
-Grammar parse(const std::string& text, const std::vector<std::pair<std::string, double>>& defines = {}) {
+Grammar parse_defined(const std::string& text, const std::vector<std::pair<std::string, double>>& defines = {}) {
   return parse_grammar({{"g.lsys", text, false}}, defines);
 }
 
-std::string error_of(const std::string& text) {
-  return input_error_of([&] { parse(text); });
+std::string grammar_error_of(const std::string& text) {
+  return input_error_of([&] { parse_defined(text); });
 }
 
 TEST(Grammar, DirectivesAndRules) {
-  const Grammar g = parse(
+  const Grammar g = parse_defined(
       "# a comment line\n"
       "#define r 0.5   /* trailing comment */\n"
       "#define q r*4\n"
@@ -70,7 +70,7 @@ TEST(Grammar, DirectivesAndRules) {
 }
 
 TEST(Grammar, ArrowsAndTurnSymbolsAsPredecessors) {
-  const Grammar g = parse("axiom: A\nA->B\n- --> +\n--->&\n+ > - --> ^\n");
+  const Grammar g = parse_defined("axiom: A\nA->B\n- --> +\n--->&\n+ > - --> ^\n");
   ASSERT_EQ(g.lsystems[0].productions.rules.size(), 4u);
   EXPECT_EQ(g.lsystems[0].productions.rules[0].predecessor, 'A');
   EXPECT_EQ(g.lsystems[0].productions.successor[g.lsystems[0].productions.rules[0].successor_begin].symbol, 'B');
@@ -82,7 +82,7 @@ TEST(Grammar, ArrowsAndTurnSymbolsAsPredecessors) {
 }
 
 TEST(Grammar, SceneDefinesOverrideFileDefines) {
-  const Grammar g = parse("#define a 1\n#define b a+1\naxiom: F\n", {{"a", 10}});
+  const Grammar g = parse_defined("#define a 1\n#define b a+1\naxiom: F\n", {{"a", 10}});
   ASSERT_EQ(g.defines.size(), 2u);
   EXPECT_EQ(g.defines[0], (std::pair<std::string, double>("a", 10)));
   EXPECT_EQ(g.defines[1], (std::pair<std::string, double>("b", 11)));
@@ -172,7 +172,7 @@ TEST(Grammar, MalformedGrammarsReportFileLineColumn) {
       {"#define a 1\n#define a 2\naxiom: A\n", "g.lsys:2:9: 'a' is already defined"},
       {"axiom: A\nmaximum depth: 0\n", "g.lsys:2:16: expected an integer in [1, 100000], got 0"},
   };
-  for (const Malformed& c : cases) EXPECT_EQ(error_of(c.text), c.message) << c.text;
+  for (const Malformed& c : cases) EXPECT_EQ(grammar_error_of(c.text), c.message) << c.text;
 }
 
 // The message starts with the name the text was given (a path for files).

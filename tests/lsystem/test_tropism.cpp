@@ -9,8 +9,9 @@
 #include <numbers>
 #include <string>
 
-#include "temp_folder_test.h"
+#include "expect_near.h"
 #include "lsystem/lsystem.h"
+#include "temp_folder_test.h"
 
 namespace treeanim {
 namespace {
@@ -35,10 +36,6 @@ class Tropism : public TempFolderTest {
 
 // The unit vector at angle a (radians) from +y toward +x.
 Vector3d in_plane(double a) { return {std::sin(a), std::cos(a), 0.0}; }
-
-void expect_near(const Vector3d& a, const Vector3d& b) {
-  EXPECT_NEAR((a - b).norm(), 0.0, 1e-12) << a.transpose() << " vs " << b.transpose();
-}
 
 // Two tropisms and a torque, switched per branch by @Ts: the bend comes before the move, is
 // |H x V| radians, and each branch keeps its own elasticities.

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "expect_near.h"
 #include "lsystem/surface_file.h"
 #include "lsystem/turtle.h"
 
@@ -20,7 +21,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr double kTol = 1e-12;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 // "F(1)[+(90,2)F]" => modules: one character each, numeric parameters in parentheses.
@@ -46,11 +46,6 @@ ModuleString word(const std::string& text) {
 
 Skeleton draw(const std::string& text, const TurtleSettings& settings = {}) {
   return interpret(word(text), settings);
-}
-
-void expect_near(const Vector3d& actual, const Vector3d& expected, double tol = kTol) {
-  EXPECT_LE((actual - expected).norm(), tol) << "actual " << actual.transpose() << " expected "
-                                             << expected.transpose();
 }
 
 struct Frame {

@@ -9,15 +9,15 @@
 namespace treeanim {
 namespace {
 
-Scene load(const std::string& forest, const std::string& outputs = "[]") {
+Scene load_forest(const std::string& forest, const std::string& outputs = "[]") {
   return load_scene_text(R"({"lsystem": {"axiom": "F", "iterations": 0}, "forest": )" + forest +
                              R"(, "outputs": )" + outputs + "}",
                          "f.json", "/scenes", {});
 }
 
-std::string error_of(const std::string& forest, const std::string& outputs = "[]") {
+std::string forest_error_of(const std::string& forest, const std::string& outputs = "[]") {
   try {
-    load(forest, outputs);
+    load_forest(forest, outputs);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -77,11 +77,11 @@ TEST(ForestLayout, CloserThanNamesThePair) {
 }
 
 TEST(Forest, ListedAndScatteredTrees) {
-  const Scene scene = load(R"({"spacing": 1, "variants": [{"name": "a", "weight": 1}, {"name": "b", "weight": 3,
+  const Scene scene = load_forest(R"({"spacing": 1, "variants": [{"name": "a", "weight": 1}, {"name": "b", "weight": 3,
       "lsystem": {"axiom": "FF", "iterations": 0}}], "trees": [{"id": "hero", "variant": "b", "position": [1, 0, 2],
       "rotation": 30, "scale": 2, "seed": 5}, {}], "scatter": {"count": 40, "min": [-10, -10], "max": [10, 10],
       "seed": 3}})",
-                           R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
+                                  R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
   const Forest& forest = *scene.forest;
   ASSERT_EQ(forest.trees.size(), 42u);
   EXPECT_EQ(forest.trees[0].id, "hero");
@@ -100,7 +100,7 @@ TEST(Forest, ListedAndScatteredTrees) {
   EXPECT_GT(b, 20u);  // weight 3 of 4
   EXPECT_LT(b, 40u);
   // The same scene places the same trees.
-  const Scene again = load(scene.resolved["forest"].dump(), R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
+  const Scene again = load_forest(scene.resolved["forest"].dump(), R"([{"format": "hdf5", "path": "t/{tree}.h5"}])");
   for (size_t t = 0; t < 42; ++t) {
     EXPECT_EQ(again.forest->trees[t].position, forest.trees[t].position);
     EXPECT_EQ(again.forest->trees[t].seed, forest.trees[t].seed);
@@ -111,9 +111,9 @@ TEST(Forest, ListedAndScatteredTrees) {
 // draw as 1 and 1, a subnormal weight beside 0 takes every tree, and a weight 0 none.
 TEST(Forest, WeightsDrawByTheirRatiosAlone) {
   auto variants_of = [](const std::string& a, const std::string& b) {
-    const Scene scene = load(R"({"spacing": 1, "variants": [{"name": "a", "weight": )" + a +
-                             R"(}, {"name": "b", "weight": )" + b +
-                             R"(}], "scatter": {"count": 30, "min": [-10, -10], "max": [10, 10], "seed": 3}})");
+    const Scene scene =
+        load_forest(R"({"spacing": 1, "variants": [{"name": "a", "weight": )" + a + R"(}, {"name": "b", "weight": )" +
+                    b + R"(}], "scatter": {"count": 30, "min": [-10, -10], "max": [10, 10], "seed": 3}})");
     std::vector<size_t> variants;
     for (const ForestTree& tree : scene.forest->trees) variants.push_back(tree.variant);
     return variants;
@@ -130,19 +130,21 @@ TEST(Forest, WeightsDrawByTheirRatiosAlone) {
 // A scatter of no trees (a count set to 0 to leave it out for a while) holds the keys of one of
 // more, checked as they are there, and places nothing.
 TEST(Forest, ScatterOfNoTreesKeepsItsKeys) {
-  const Scene scene = load(R"({"trees": [{}], "scatter": {"count": 0, "min": [-10, -10], "max": [10, 10],
+  const Scene scene = load_forest(R"({"trees": [{}], "scatter": {"count": 0, "min": [-10, -10], "max": [10, 10],
       "seed": 3, "attempts": 50, "rotation": [0, 90], "scale": [0.5, 2]}})");
   EXPECT_EQ(scene.forest->trees.size(), 1u);
-  EXPECT_EQ(error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0], "max": [1, 1], "scale": [2, 1]}})"),
-            "f.json: /forest/scatter/scale: expected [lo, hi] with lo <= hi, got [2,1]");
-  EXPECT_EQ(error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0]}})"),
+  EXPECT_EQ(
+      forest_error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0], "max": [1, 1], "scale": [2, 1]}})"),
+      "f.json: /forest/scatter/scale: expected [lo, hi] with lo <= hi, got [2,1]");
+  EXPECT_EQ(forest_error_of(R"({"trees": [{}], "scatter": {"count": 0, "min": [0, 0]}})"),
             "f.json: /forest/scatter/max: expected the area's corners min and max, each [x, z] in m");
 }
 
 TEST(Forest, TreeSceneIsTheTreesOwnScene) {
-  const Scene scene = load(R"({"variants": [{"name": "a"}, {"name": "b", "lsystem": {"axiom": "FF", "iterations": 0},
+  const Scene scene =
+      load_forest(R"({"variants": [{"name": "a"}, {"name": "b", "lsystem": {"axiom": "FF", "iterations": 0},
       "tree": {"ring_sides": 5}}], "trees": [{"id": "x"}, {"id": "y", "variant": "b", "scale": 2, "seed": 9}]})",
-                           R"([{"format": "hdf5", "path": "t/{tree}/{tree}.h5"}])");
+                  R"([{"format": "hdf5", "path": "t/{tree}/{tree}.h5"}])");
   const Scene y = tree_scene(scene, 1);
   EXPECT_EQ(y.outputs[0].path, "t/y/y.h5");
   EXPECT_EQ(y.lsystem.axiom, "FF");
@@ -162,31 +164,34 @@ TEST(Forest, TreeSceneIsTheTreesOwnScene) {
 }
 
 TEST(Forest, Refusals) {
-  EXPECT_EQ(error_of(R"({"trees": []})"),
+  EXPECT_EQ(forest_error_of(R"({"trees": []})"),
             "f.json: /forest/trees: a forest with no trees: list trees in /forest/trees or give "
             "/forest/scatter/count >= 1");
-  EXPECT_EQ(error_of(R"({"spacing": 2, "trees": [{"position": [5, 9, 0]}, {"position": [1, 0, 0.5]},
+  EXPECT_EQ(forest_error_of(R"({"spacing": 2, "trees": [{"position": [5, 9, 0]}, {"position": [1, 0, 0.5]},
       {"position": [0.5, 0, 1]}]})"),
             "f.json: /forest/trees/2/position: 0.707107 m from /forest/trees/1 on the ground, closer than "
             "/forest/spacing = 2 m: move one of them or lower the spacing");
-  EXPECT_NE(error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
-                .find("f.json: /forest/scatter/count: placed "),
-            std::string::npos);
-  EXPECT_NE(error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
-                .find(" of 50 trees in the area with /forest/spacing 2 m (100 darts each)"),
-            std::string::npos);
-  EXPECT_EQ(error_of(R"({"trees": [{"variant": "oak"}]})"),
+  EXPECT_NE(
+      forest_error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
+          .find("f.json: /forest/scatter/count: placed "),
+      std::string::npos);
+  EXPECT_NE(
+      forest_error_of(R"({"spacing": 2, "scatter": {"count": 50, "min": [0, 0], "max": [4, 4], "attempts": 100}})")
+          .find(" of 50 trees in the area with /forest/spacing 2 m (100 darts each)"),
+      std::string::npos);
+  EXPECT_EQ(forest_error_of(R"({"trees": [{"variant": "oak"}]})"),
             "f.json: /forest/trees/0/variant: expected one of the variants' names (\"default\"), got \"oak\"");
-  EXPECT_EQ(error_of(R"({"trees": [{"id": "a"}, {"id": "a"}]})"),
+  EXPECT_EQ(forest_error_of(R"({"trees": [{"id": "a"}, {"id": "a"}]})"),
             "f.json: /forest/trees: two trees have the id \"a\" (/forest/trees/0 and /forest/trees/1): ids name the "
             "trees' files, give each its own");
-  EXPECT_EQ(error_of(R"({"trees": [{"id": "../x"}]})"),
+  EXPECT_EQ(forest_error_of(R"({"trees": [{"id": "../x"}]})"),
             "f.json: /forest/trees/0/id: expected an id of 1 to 64 letters, digits, '_', '-' or '.' (not first), got "
             "\"../x\"");
-  EXPECT_EQ(error_of(R"({"trees": [{}, {}]})", R"([{"format": "hdf5", "path": "bake.h5"}])"),
+  EXPECT_EQ(forest_error_of(R"({"trees": [{}, {}]})", R"([{"format": "hdf5", "path": "bake.h5"}])"),
             "f.json: /outputs/0/path: the forest has 2 trees and this path no {tree}: every tree would write the same "
             "file; put the tree's id in it, e.g. \"trees/{tree}.h5\"");
-  EXPECT_EQ(error_of(R"({"trees": [{}], "sprcing": 1})"), "f.json: /forest/sprcing: unknown key (did you mean /forest/spacing?)");
+  EXPECT_EQ(forest_error_of(R"({"trees": [{}], "sprcing": 1})"),
+            "f.json: /forest/sprcing: unknown key (did you mean /forest/spacing?)");
 }
 
 // null is an unset value: a forest of null is the one tree, and a null section within a forest
@@ -206,7 +211,7 @@ TEST(Forest, NullSectionsTakeTheirDefaults) {
   const Scene tree = tree_scene(scene, 0);
   EXPECT_EQ(tree.tree.scale, 2.0);  // the top level's tree, as for a variant without one
   EXPECT_EQ(tree.lsystem.axiom, "F");
-  EXPECT_EQ(load(R"({"variants": null, "trees": [{}]})").forest->trees.size(), 1u);
+  EXPECT_EQ(load_forest(R"({"variants": null, "trees": [{}]})").forest->trees.size(), 1u);
 }
 
 TEST(Forest, OneTreeSceneRefusesThePlaceholder) {

@@ -15,7 +15,7 @@ LsystemOptions read(Json& scene) {
   return options;
 }
 
-std::string error_of(const char* text) {
+std::string lsystem_error_of(const char* text) {
   Json scene = Json::parse(text);
   return input_error_of([&] { read(scene); });
 }
@@ -38,7 +38,7 @@ TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {
 TEST(LsystemOptions, TropismOfAnyLength) {
   Json tiny = Json::parse(R"json({"lsystem": {"grammar": "tree.lsys", "tropism": [1e-300, 0, 0]}})json");
   EXPECT_EQ(*read(tiny).tropism, Eigen::Vector3d(1e-300, 0, 0));
-  EXPECT_NE(error_of(R"json({"lsystem": {"grammar": "tree.lsys", "tropism": [0, 0, 0]}})json")
+  EXPECT_NE(lsystem_error_of(R"json({"lsystem": {"grammar": "tree.lsys", "tropism": [0, 0, 0]}})json")
                 .find("/lsystem/tropism: expected a non-zero direction"),
             std::string::npos);
 }
@@ -62,29 +62,29 @@ TEST(LsystemOptions, InlineGrammar) {
 }
 
 TEST(LsystemOptions, ErrorsAreJsonPointers) {
-  EXPECT_EQ(error_of(R"({"lsystem": {}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {}})"),
             "scene.json: /lsystem/grammar: expected a grammar file, or an inline grammar as /lsystem/axiom and "
             "/lsystem/productions (or a /species, which brings its own)");
-  EXPECT_EQ(error_of(R"({"lsystem": {"grammar": "a.lsys", "axiom": "F"}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"grammar": "a.lsys", "axiom": "F"}})"),
             "scene.json: /lsystem/axiom: give either a grammar file (/lsystem/grammar) or an inline grammar "
             "(/lsystem/axiom), not both");
-  EXPECT_EQ(error_of(R"({"lsystem": {"grammar": "a.lsys", "productions": ["F --> FF"]}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"grammar": "a.lsys", "productions": ["F --> FF"]}})"),
             "scene.json: /lsystem/productions: inline productions go with /lsystem/axiom, not with a grammar "
             "file (/lsystem/grammar)");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "productions": ["F --> FF", 3]}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "productions": ["F --> FF", 3]}})"),
             "scene.json: /lsystem/productions: expected an array of strings (one production each), got "
             "[\"F --> FF\",3]");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "defines": {"k": "x"}}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "defines": {"k": "x"}}})"),
             "scene.json: /lsystem/defines/k: expected a finite number, got \"x\"");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "defines": {"2k": 1}}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "defines": {"2k": 1}}})"),
             "scene.json: /lsystem/defines/2k: expected a name of letters, digits and '_' (not starting with a digit)");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "iterations": -1}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "iterations": -1}})"),
             "scene.json: /lsystem/iterations: expected an integer in [0, 100000], got -1");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "step": 0}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "step": 0}})"),
             "scene.json: /lsystem/step: expected a number > 0, got 0");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "tropism": [0, 0, 0]}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "tropism": [0, 0, 0]}})"),
             "scene.json: /lsystem/tropism: expected a non-zero direction [x, y, z] at most 1e6 long, got [0,0,0]");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F", "iteration": 3}})"),
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "iteration": 3}})"),
             "scene.json: /lsystem/iteration: unknown key (did you mean /lsystem/iterations?)");
 }
 

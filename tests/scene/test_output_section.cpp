@@ -19,7 +19,7 @@ OutputOptions read_first(const std::string& text, Json* resolved = nullptr) {
   return options;
 }
 
-std::string error_of(const std::string& text) {
+std::string outputs_error_of(const std::string& text) {
   return input_error_of([&] { read_first(text); });
 }
 
@@ -56,25 +56,26 @@ TEST(OutputOptions, GltfAndGlbCarryNormalsUnlessTurnedOff) {
 }
 
 TEST(OutputOptions, ErrorsNameTheKey) {
-  EXPECT_EQ(error_of(R"({"outputs": [{"path": "b.h5"}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"path": "b.h5"}]})"),
             "/outputs/0/format: required (one of hdf5, obj, gltf, glb, pc2, mdd, vat, skinned_glb, usd, html)");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf"}]})"),
-            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", \"skinned_glb\", \"usd\", \"html\", got \"hdf\" "
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "hdf"}]})"),
+            "/outputs/0/format: expected one of \"hdf5\", \"obj\", \"gltf\", \"glb\", \"pc2\", \"mdd\", \"vat\", "
+            "\"skinned_glb\", \"usd\", \"html\", got \"hdf\" "
             "(did you mean \"hdf5\"?)");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "obj"}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "obj"}]})"),
             "/outputs/0/path: expected a non-empty path string, got nothing");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "obj", "path": ""}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "obj", "path": ""}]})"),
             "/outputs/0/path: expected a non-empty path string, got \"\"");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf5", "path": "b", "compression": 10}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "hdf5", "path": "b", "compression": 10}]})"),
             "/outputs/0/compression: expected an integer in [0, 9], got 10");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "pc2", "path": "b", "frame_step": 0}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "pc2", "path": "b", "frame_step": 0}]})"),
             "/outputs/0/frame_step: expected an integer in [1, 1000000], got 0");
 }
 
 TEST(OutputOptions, Hdf5OnlyKeysAreUnknownElsewhere) {
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "obj", "path": "o", "compression": 4}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "obj", "path": "o", "compression": 4}]})"),
             "/outputs/0/compression: unknown key");
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf5", "path": "o", "compresion": 4}]})"),
+  EXPECT_EQ(outputs_error_of(R"({"outputs": [{"format": "hdf5", "path": "o", "compresion": 4}]})"),
             "/outputs/0/compresion: unknown key (did you mean /outputs/0/compression?)");
 }
 

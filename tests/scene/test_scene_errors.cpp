@@ -10,7 +10,7 @@ namespace {
 // A minimal valid scene: inline grammar, no outputs.
 const char* kValid = R"({"lsystem": {"axiom": "F", "iterations": 0}})";
 
-std::string error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
+std::string scene_error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
   try {
     load_scene_text(text, "s.json", "/scenes", overrides);
   } catch (const InputError& e) {
@@ -19,110 +19,109 @@ std::string error_of(const std::string& text, const std::vector<std::string>& ov
   return "";
 }
 
-TEST(SceneErrors, ValidSceneLoads) { EXPECT_EQ(error_of(kValid), ""); }
+TEST(SceneErrors, ValidSceneLoads) { EXPECT_EQ(scene_error_of(kValid), ""); }
 
 TEST(SceneErrors, SyntaxErrorGivesLineAndColumn) {
-  const std::string message = error_of("{\n  \"time\": {\"fps\": 24,}\n}");
+  const std::string message = scene_error_of("{\n  \"time\": {\"fps\": 24,}\n}");
   EXPECT_EQ(message.rfind("s.json:2:22: JSON syntax error: ", 0), 0u) << message;
 }
 
 TEST(SceneErrors, UnterminatedStringGivesLineAndColumn) {
-  const std::string message = error_of("{\"lsystem\": {\"axiom\": \"F}}\n");
+  const std::string message = scene_error_of("{\"lsystem\": {\"axiom\": \"F}}\n");
   EXPECT_EQ(message.rfind("s.json:1:", 0), 0u) << message;
   EXPECT_NE(message.find("JSON syntax error"), std::string::npos) << message;
 }
 
 TEST(SceneErrors, EmptyFileIsASyntaxError) {
-  EXPECT_EQ(error_of("").rfind("s.json:1:1: JSON syntax error: ", 0), 0u) << error_of("");
+  EXPECT_EQ(scene_error_of("").rfind("s.json:1:1: JSON syntax error: ", 0), 0u) << scene_error_of("");
 }
 
 TEST(SceneErrors, TopLevelMustBeAnObject) {
-  EXPECT_EQ(error_of("[1, 2]"), "s.json: /: expected a JSON object at the top level, got [1,2]");
+  EXPECT_EQ(scene_error_of("[1, 2]"), "s.json: /: expected a JSON object at the top level, got [1,2]");
 }
 
 TEST(SceneErrors, UnknownTopLevelKey) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "tme": {}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "tme": {}})"),
             "s.json: /tme: unknown key (did you mean /time?)");
 }
 
 TEST(SceneErrors, UnknownTimeKey) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fsp": 30}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fsp": 30}})"),
             "s.json: /time/fsp: unknown key (did you mean /time/fps?)");
 }
 
 TEST(SceneErrors, FpsWrongType) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": "fast"}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": "fast"}})"),
             "s.json: /time/fps: expected a number in [1, 1000], got \"fast\"");
 }
 
 TEST(SceneErrors, FpsZero) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": 0}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"fps": 0}})"),
             "s.json: /time/fps: expected a number in [1, 1000], got 0");
 }
 
 TEST(SceneErrors, FramesZero) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": 0}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": 0}})"),
             "s.json: /time/frames: expected an integer in [1, 10000000], got 0");
 }
 
 TEST(SceneErrors, FramesFractional) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": 2.5}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": 2.5}})"),
             "s.json: /time/frames: expected an integer in [1, 10000000], got 2.5");
 }
 
 TEST(SceneErrors, SubstepsNegative) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"substeps": -1}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"substeps": -1}})"),
             "s.json: /time/substeps: expected an integer in [1, 10000], got -1");
 }
 
 TEST(SceneErrors, SeedNegative) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "seed": -3})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "seed": -3})"),
             "s.json: /seed: expected an integer in [0, 9007199254740992], got -3");
 }
 
 TEST(SceneErrors, OutputsMustBeAnArray) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "outputs": {"format": "hdf5"}})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "outputs": {"format": "hdf5"}})"),
             "s.json: /outputs: expected an array of objects, got {\"format\":\"hdf5\"}");
 }
 
 TEST(SceneErrors, OutputElementMustBeAnObject) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "outputs": ["bake.h5"]})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "outputs": ["bake.h5"]})"),
             "s.json: /outputs/0: expected an object, got \"bake.h5\"");
 }
 
 TEST(SceneErrors, DescriptionMustBeAString) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "description": 5})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "description": 5})"),
             "s.json: /description: expected a string, got 5");
 }
 
 TEST(SceneErrors, SectionMustBeAnObject) {
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": [24]})"),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": [24]})"),
             "s.json: /time: expected an object, got [24]");
 }
 
 TEST(SceneErrors, OverrideIntroducesUnknownKey) {
-  EXPECT_EQ(error_of(kValid, {"time.fsp=30"}),
+  EXPECT_EQ(scene_error_of(kValid, {"time.fsp=30"}),
             "--set 'time.fsp=30': /time/fsp: unknown key (did you mean /time/fps?)");
 }
 
 TEST(SceneErrors, OverrideWithoutEquals) {
-  EXPECT_EQ(error_of(kValid, {"time.fps"}),
-            "--set 'time.fps': expected PATH=VALUE, e.g. lsystem.iterations=6");
+  EXPECT_EQ(scene_error_of(kValid, {"time.fps"}), "--set 'time.fps': expected PATH=VALUE, e.g. lsystem.iterations=6");
 }
 
 TEST(SceneErrors, OverrideValueIsValidated) {
-  EXPECT_EQ(error_of(kValid, {"time.fps=-1"}),
+  EXPECT_EQ(scene_error_of(kValid, {"time.fps=-1"}),
             "--set 'time.fps=-1': /time/fps: expected a number in [1, 1000], got -1");
   // Below an override's path the value is the override's; beside it, the file's.
-  EXPECT_EQ(error_of(kValid, {"wind={\"keys\": [{\"time\": 0, \"speed\": -3}]}"}),
+  EXPECT_EQ(scene_error_of(kValid, {"wind={\"keys\": [{\"time\": 0, \"speed\": -3}]}"}),
             "--set 'wind={\"keys\": [{\"time\": 0, \"speed\": -3}]}': /wind/keys/0/speed: expected a number in "
             "[0, 113], got -3");
-  EXPECT_EQ(error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": -1}})", {"time.fps=30"}),
+  EXPECT_EQ(scene_error_of(R"({"lsystem": {"axiom": "F"}, "time": {"frames": -1}})", {"time.fps=30"}),
             "s.json: /time/frames: expected an integer in [1, 10000000], got -1");
 }
 
 TEST(SceneErrors, OverrideOfOnePathTwice) {
-  EXPECT_EQ(error_of(kValid, {"time.fps=30", "time.frames=4", "time.fps=24"}),
+  EXPECT_EQ(scene_error_of(kValid, {"time.fps=30", "time.frames=4", "time.fps=24"}),
             "--set 'time.fps=24': /time/fps is set already by --set 'time.fps=30': expected each path once");
 }
 

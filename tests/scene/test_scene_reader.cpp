@@ -10,7 +10,7 @@ namespace {
 
 // Runs `read` on the root of `text` and returns the InputError message ("" if none).
 template <typename Read>
-std::string error_of(const std::string& text, Read read) {
+std::string reader_error_of(const std::string& text, Read read) {
   Json document = Json::parse(text);
   try {
     SceneReader reader(document, "/scenes", "s.json");
@@ -50,64 +50,71 @@ TEST(SceneReader, ANullKeyIsNotGivenAndNotUnknown) {
 }
 
 TEST(SceneReader, UnknownKeySuggestsTheClosestValidKey) {
-  EXPECT_EQ(error_of(R"({"wind": {"sped": 3}})",
-                     [](SceneObject& root) { root.object("wind").number("speed", 1); }),
-            "s.json: /wind/sped: unknown key (did you mean /wind/speed?)");
+  EXPECT_EQ(
+      reader_error_of(R"({"wind": {"sped": 3}})", [](SceneObject& root) { root.object("wind").number("speed", 1); }),
+      "s.json: /wind/sped: unknown key (did you mean /wind/speed?)");
 }
 
 TEST(SceneReader, UnknownKeyFarFromAnyValidKeyGetsNoSuggestion) {
-  EXPECT_EQ(error_of(R"({"wind": {"zzzzzzzz": 3}})",
-                     [](SceneObject& root) { root.object("wind").number("speed", 1); }),
+  EXPECT_EQ(reader_error_of(R"({"wind": {"zzzzzzzz": 3}})",
+                            [](SceneObject& root) { root.object("wind").number("speed", 1); }),
             "s.json: /wind/zzzzzzzz: unknown key");
 }
 
 TEST(SceneReader, UnknownKeyInsideArrayElement) {
-  EXPECT_EQ(error_of(R"({"outputs": [{"format": "hdf5"}, {"formt": "obj"}]})",
-                     [](SceneObject& root) {
-                       for (SceneObject o : root.array_of_objects("outputs")) o.optional_string("format");
-                     }),
+  EXPECT_EQ(reader_error_of(R"({"outputs": [{"format": "hdf5"}, {"formt": "obj"}]})",
+                            [](SceneObject& root) {
+                              for (SceneObject o : root.array_of_objects("outputs")) o.optional_string("format");
+                            }),
             "s.json: /outputs/1/formt: unknown key (did you mean /outputs/1/format?)");
 }
 
 TEST(SceneReader, WrongTypeNamesPointerValueAndExpectation) {
-  EXPECT_EQ(error_of(R"({"time": {"fps": "fast"}})",
-                     [](SceneObject& root) { root.object("time").number("fps", 24, Range::positive()); }),
+  EXPECT_EQ(reader_error_of(R"({"time": {"fps": "fast"}})",
+                            [](SceneObject& root) { root.object("time").number("fps", 24, Range::positive()); }),
             "s.json: /time/fps: expected a number > 0, got \"fast\"");
 }
 
 TEST(SceneReader, OutOfRangeNamesTheRange) {
-  EXPECT_EQ(error_of(R"({"hsm": {"alpha": 1.5}})",
-                     [](SceneObject& root) { root.object("hsm").number("alpha", 0.5, Range::between(0, 1)); }),
+  EXPECT_EQ(reader_error_of(R"({"hsm": {"alpha": 1.5}})",
+                            [](SceneObject& root) { root.object("hsm").number("alpha", 0.5, Range::between(0, 1)); }),
             "s.json: /hsm/alpha: expected a number in [0, 1], got 1.5");
 }
 
 TEST(SceneReader, IntegerRejectsFractions) {
-  EXPECT_EQ(error_of(R"({"time": {"frames": 2.5}})",
-                     [](SceneObject& root) { root.object("time").integer("frames", 1, 1, 100); }),
+  EXPECT_EQ(reader_error_of(R"({"time": {"frames": 2.5}})",
+                            [](SceneObject& root) { root.object("time").integer("frames", 1, 1, 100); }),
             "s.json: /time/frames: expected an integer in [1, 100], got 2.5");
 }
 
 TEST(SceneReader, ChoiceListsTheChoicesAndSuggests) {
-  EXPECT_EQ(error_of(R"({"format": "hdf"})",
-                     [](SceneObject& root) { root.choice("format", "hdf5", {"hdf5", "obj"}); }),
+  EXPECT_EQ(reader_error_of(R"({"format": "hdf"})",
+                            [](SceneObject& root) {
+                              root.choice("format", "hdf5", {"hdf5", "obj"});
+                            }),
             "s.json: /format: expected one of \"hdf5\", \"obj\", got \"hdf\" (did you mean \"hdf5\"?)");
-  EXPECT_EQ(error_of(R"({"format": 5})", [](SceneObject& root) { root.choice("format", "hdf5", {"hdf5", "obj"}); }),
+  EXPECT_EQ(reader_error_of(R"({"format": 5})",
+                            [](SceneObject& root) {
+                              root.choice("format", "hdf5", {"hdf5", "obj"});
+                            }),
             "s.json: /format: expected one of \"hdf5\", \"obj\", got 5");
 }
 
 TEST(SceneReader, Vector3NeedsThreeNumbers) {
-  EXPECT_EQ(error_of(R"({"direction": [1, 0]})",
-                     [](SceneObject& root) { root.vector3("direction", {1, 0, 0}); }),
+  EXPECT_EQ(reader_error_of(R"({"direction": [1, 0]})",
+                            [](SceneObject& root) {
+                              root.vector3("direction", {1, 0, 0});
+                            }),
             "s.json: /direction: expected an array of 3 finite numbers, got [1,0]");
 }
 
 TEST(SceneReader, SectionMustBeAnObject) {
-  EXPECT_EQ(error_of(R"({"tree": 3})", [](SceneObject& root) { root.object("tree"); }),
+  EXPECT_EQ(reader_error_of(R"({"tree": 3})", [](SceneObject& root) { root.object("tree"); }),
             "s.json: /tree: expected an object, got 3");
 }
 
 TEST(SceneReader, ArrayElementsMustBeObjects) {
-  EXPECT_EQ(error_of(R"({"outputs": ["a.h5"]})", [](SceneObject& root) { root.array_of_objects("outputs"); }),
+  EXPECT_EQ(reader_error_of(R"({"outputs": ["a.h5"]})", [](SceneObject& root) { root.array_of_objects("outputs"); }),
             "s.json: /outputs/0: expected an object, got \"a.h5\"");
 }
 
@@ -121,11 +128,11 @@ TEST(SceneReader, PathsResolveAgainstTheSceneFolder) {
 }
 
 TEST(SceneReader, RawValuesAreNotCheckedForUnknownKeys) {
-  EXPECT_EQ(error_of(R"({"defines": {"anything": 1}})", [](SceneObject& root) { root.raw("defines"); }), "");
+  EXPECT_EQ(reader_error_of(R"({"defines": {"anything": 1}})", [](SceneObject& root) { root.raw("defines"); }), "");
 }
 
 TEST(SceneReader, PointerTokensAreEscaped) {
-  EXPECT_EQ(error_of(R"({"a/b": 1})", [](SceneObject&) {}), "s.json: /a~1b: unknown key");
+  EXPECT_EQ(reader_error_of(R"({"a/b": 1})", [](SceneObject&) {}), "s.json: /a~1b: unknown key");
 }
 
 TEST(SceneReader, ClosestMatch) {

@@ -27,8 +27,6 @@ WindOptions read_wind(Json document, const std::filesystem::path& dir = "/scenes
   return o;
 }
 
-std::string error_of(auto&& f) { return input_error_of(f); }
-
 TEST(HsmOptions, DefaultsAreFilledIn) {
   Json document = Json::object();
   SceneReader reader(document, "/scenes", "s.json");
@@ -46,7 +44,7 @@ TEST(HsmOptions, DefaultsAreFilledIn) {
 TEST(HsmOptions, ReadsPrecision) {
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "float"}})")).precision, Precision::kFloat);
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"precision": "double"}})")).precision, Precision::kDouble);
-  const std::string error = error_of([] { read_hsm(Json::parse(R"({"hsm": {"precision": "half"}})")); });
+  const std::string error = input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"precision": "half"}})")); });
   EXPECT_NE(error.find("/hsm/precision"), std::string::npos) << error;
   EXPECT_NE(error.find("\"float\""), std::string::npos) << error;
 }
@@ -55,7 +53,7 @@ TEST(HsmOptions, ReadsParticles) {
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {}})")).particles, ParticleMode::kVertices);
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"particles": "samples"}})")).particles, ParticleMode::kSamples);
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"particles": "vertices"}})")).particles, ParticleMode::kVertices);
-  const std::string error = error_of([] { read_hsm(Json::parse(R"({"hsm": {"particles": "foo"}})")); });
+  const std::string error = input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"particles": "foo"}})")); });
   EXPECT_NE(error.find("/hsm/particles: expected one of \"vertices\", \"samples\", got \"foo\""), std::string::npos)
       << error;
 }
@@ -68,25 +66,26 @@ TEST(HsmOptions, ACapBelowTheDefaultFloorTakesTheFloorDown) {
   EXPECT_EQ(o.min_limb_frequency, 1);
   EXPECT_EQ(document["hsm"]["min_limb_frequency"], 1);  // the resolved scene reads back
   EXPECT_EQ(read_hsm(Json::parse(R"({"hsm": {"max_limb_frequency": 30}})")).min_limb_frequency, 1.25);
-  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"max_limb_frequency": 1, "min_limb_frequency": 2}})")); }),
-            "s.json: /hsm/min_limb_frequency: the floor 2 rad/s is above max_limb_frequency, 1 rad/s: expected a "
-            "floor at or below the cap");
+  EXPECT_EQ(
+      input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"max_limb_frequency": 1, "min_limb_frequency": 2}})")); }),
+      "s.json: /hsm/min_limb_frequency: the floor 2 rad/s is above max_limb_frequency, 1 rad/s: expected a "
+      "floor at or below the cap");
 }
 
 TEST(HsmOptions, RefusesTheKeysOfTheOtherStiffnessMode) {
-  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"alpha": 0.3}})")); }),
+  EXPECT_EQ(input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"alpha": 0.3}})")); }),
             "s.json: /hsm/alpha: expected no alpha where stiffness is \"physical\" (alpha is read by "
             "\"stiffness\": \"per_step\" alone), got 0.3");
-  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "min_limb_frequency": 2}})")); }),
-            "s.json: /hsm/min_limb_frequency: expected no min_limb_frequency where stiffness is \"per_step\" "
-            "(min_limb_frequency is read by \"stiffness\": \"physical\" alone), got 2");
+  EXPECT_EQ(
+      input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "min_limb_frequency": 2}})")); }),
+      "s.json: /hsm/min_limb_frequency: expected no min_limb_frequency where stiffness is \"per_step\" "
+      "(min_limb_frequency is read by \"stiffness\": \"physical\" alone), got 2");
   for (const std::string mode : {"physical", "per_step"})
     for (const std::string key : {"k_d", "global_scale", "max_frequency", "max_limb_frequency"}) {
       const bool physical_key = key != "k_d";
       if (physical_key == (mode == "physical")) continue;
-      const std::string error = error_of([&] {
-        read_hsm(Json::parse(R"({"hsm": {"stiffness": ")" + mode + R"(", ")" + key + R"(": 0.5}})"));
-      });
+      const std::string error = input_error_of(
+          [&] { read_hsm(Json::parse(R"({"hsm": {"stiffness": ")" + mode + R"(", ")" + key + R"(": 0.5}})")); });
       EXPECT_NE(error.find("/hsm/" + key + ": expected no " + key), std::string::npos) << error;
     }
   // null takes the default, as anywhere; the resolved scene holds its own mode's keys alone, so
@@ -115,11 +114,13 @@ TEST(HsmOptions, ReadsPerStepStiffness) {
 }
 
 TEST(HsmOptions, RejectsOutOfRangeAndUnknownKeys) {
-  EXPECT_EQ(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 1.5}})")); }),
+  EXPECT_EQ(input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "per_step", "alpha": 1.5}})")); }),
             "s.json: /hsm/alpha: expected a number in [0, 1], got 1.5");
-  EXPECT_NE(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stifness": "physical"}})")); }).find("did you mean /hsm/stiffness"),
+  EXPECT_NE(input_error_of([] {
+              read_hsm(Json::parse(R"({"hsm": {"stifness": "physical"}})"));
+            }).find("did you mean /hsm/stiffness"),
             std::string::npos);
-  EXPECT_NE(error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "soft"}})")); }).find("\"per_step\""),
+  EXPECT_NE(input_error_of([] { read_hsm(Json::parse(R"({"hsm": {"stiffness": "soft"}})")); }).find("\"per_step\""),
             std::string::npos);
 }
 
@@ -135,11 +136,11 @@ TEST(WindOptions, ReadsKeysAndNormalisesDirections) {
 }
 
 TEST(WindOptions, RejectsBadKeys) {
-  EXPECT_EQ(error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"time": 1}, {"time": 1}]}})")); }),
+  EXPECT_EQ(input_error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"time": 1}, {"time": 1}]}})")); }),
             "s.json: /wind/keys/1/time: time 1 must be greater than the previous key's time 1");
-  EXPECT_EQ(error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"direction": [0, 0, 0]}]}})")); }),
+  EXPECT_EQ(input_error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"direction": [0, 0, 0]}]}})")); }),
             "s.json: /wind/keys/0/direction: expected a non-zero vector");
-  EXPECT_EQ(error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"speed": -1}]}})")); }),
+  EXPECT_EQ(input_error_of([] { read_wind(Json::parse(R"({"wind": {"keys": [{"speed": -1}]}})")); }),
             "s.json: /wind/keys/0/speed: expected a number in [0, 113], got -1");
 }
 
@@ -153,23 +154,25 @@ TEST(WindOptions, ReadsCsvFileRelativeToTheScene) {
   EXPECT_EQ(o.keys[1].speed, 12);
   EXPECT_EQ(o.keys[1].direction, Eigen::Vector3d(0, 0, 1));
   EXPECT_EQ(o.keys[1].gust, 3);
-  EXPECT_NE(error_of([&] { read_wind(Json::parse(R"({"wind": {"file": "missing.csv"}})"), dir); }).find("cannot open wind file"),
+  EXPECT_NE(input_error_of([&] {
+              read_wind(Json::parse(R"({"wind": {"file": "missing.csv"}})"), dir);
+            }).find("cannot open wind file"),
             std::string::npos);
   std::filesystem::remove_all(dir);
 }
 
 TEST(WindCsv, ErrorsNameFileAndLine) {
-  EXPECT_EQ(error_of([] { parse_wind_csv("t,speed,dx,dy,dz\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("t,speed,dx,dy,dz\n", "w.csv"); }),
             "w.csv:1: expected the header 'time,speed,dx,dy,dz' or 'time,speed,dx,dy,dz,gust', got 't,speed,dx,dy,dz'");
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,1,0,0\n1,x,1,0,0\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,1,0,0\n1,x,1,0,0\n", "w.csv"); }),
             "w.csv:3: column 'speed': expected a finite number, got 'x'");
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,1,0\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,1,0\n", "w.csv"); }),
             "w.csv:2: expected 5 comma-separated values, got 4");
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,0,0,0\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1,0,0,0\n", "w.csv"); }),
             "w.csv:2: columns 'dx,dy,dz': the direction must not be zero");
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n2,1,1,0,0\n\n1,1,1,0,0\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n2,1,1,0,0\n\n1,1,1,0,0\n", "w.csv"); }),
             "w.csv:4: time 1 must be greater than the previous key's time 2");
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n", "w.csv"); }),
             "w.csv:1: expected at least one data line after the header");
 }
 
@@ -182,7 +185,7 @@ TEST(WindCsv, DirectionsAndNumbersAtTheEndsOfTheDoubles) {
   EXPECT_TRUE(keys[0].direction.isApprox(Eigen::Vector3d(1, 1, 0).normalized()));
   EXPECT_EQ(keys[1].direction, Eigen::Vector3d(0, 1, 0));
   EXPECT_EQ(keys[1].speed, 4e-320);
-  EXPECT_EQ(error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1e999,1,0,0\n", "w.csv"); }),
+  EXPECT_EQ(input_error_of([] { parse_wind_csv("time,speed,dx,dy,dz\n0,1e999,1,0,0\n", "w.csv"); }),
             "w.csv:2: column 'speed': expected a finite number, got '1e999'");
 }
 

@@ -12,7 +12,7 @@
 namespace treeanim {
 namespace {
 
-Scene load(const std::string& text) { return load_scene_text(text, "s.json", "/scenes", {}); }
+Scene load_species(const std::string& text) { return load_scene_text(text, "s.json", "/scenes", {}); }
 
 const Species& named(const std::string& name) {
   for (const Species& s : species_library())
@@ -38,7 +38,7 @@ TEST(SpeciesLibrary, HoldsTenNamedSpeciesEachWithItsGrammarAndRange) {
 
 TEST(SpeciesScene, APresetGivesGrammarTreeAndWood) {
   const Species& oak = named("english_oak");
-  const Scene scene = load(R"({"species": "english_oak"})");
+  const Scene scene = load_species(R"({"species": "english_oak"})");
   ASSERT_TRUE(scene.lsystem.library_grammar);
   EXPECT_EQ(scene.lsystem.library_grammar->name, oak.grammar.name);
   EXPECT_EQ(scene.tree.wood_density, oak.tree.wood_density);
@@ -49,7 +49,7 @@ TEST(SpeciesScene, APresetGivesGrammarTreeAndWood) {
 }
 
 TEST(SpeciesScene, EveryKeyOfTheSceneStillApplies) {
-  const Scene scene = load(R"({"species": "english_oak", "tree": {"leaf": {"size": 0.5}, "ring_sides": 5},
+  const Scene scene = load_species(R"({"species": "english_oak", "tree": {"leaf": {"size": 0.5}, "ring_sides": 5},
                                "hsm": {"youngs_modulus": 3e9, "precision": "float"}})");
   EXPECT_EQ(scene.tree.leaf.size, 0.5);
   EXPECT_EQ(scene.tree.ring_sides, 5);
@@ -57,7 +57,7 @@ TEST(SpeciesScene, EveryKeyOfTheSceneStillApplies) {
   EXPECT_EQ(scene.hsm.youngs_modulus, 3e9);
   EXPECT_EQ(scene.hsm.precision, Precision::kFloat);
   // A grammar of the scene's own replaces the species'.
-  const Scene own = load(R"({"species": "english_oak", "lsystem": {"axiom": "F", "iterations": 0}})");
+  const Scene own = load_species(R"({"species": "english_oak", "lsystem": {"axiom": "F", "iterations": 0}})");
   EXPECT_FALSE(own.lsystem.library_grammar);
   EXPECT_EQ(own.tree.wood_density, named("english_oak").tree.wood_density);
 }
@@ -65,12 +65,12 @@ TEST(SpeciesScene, EveryKeyOfTheSceneStillApplies) {
 TEST(SpeciesScene, HeightGrowsEveryLengthAndTheResolvedSceneBakesTheSameTree) {
   const Species& oak = named("english_oak");
   const double height = 0.5 * (oak.min_height + oak.max_height);
-  const Scene scene = load(R"({"species": {"name": "english_oak", "height": )" + std::to_string(height) + "}}");
+  const Scene scene = load_species(R"({"species": {"name": "english_oak", "height": )" + std::to_string(height) + "}}");
   const double factor = height / oak.default_height;
   EXPECT_DOUBLE_EQ(scene.tree.scale, oak.tree.scale * factor);
   EXPECT_DOUBLE_EQ(scene.tree.leaf.size, oak.tree.leaf.size * factor);
   EXPECT_DOUBLE_EQ(scene.tree.trunk_radius, oak.tree.trunk_radius * factor);
-  const Scene again = load(scene.resolved.dump());
+  const Scene again = load_species(scene.resolved.dump());
   EXPECT_EQ(again.tree.scale, scene.tree.scale);
   EXPECT_EQ(again.tree.leaf.size, scene.tree.leaf.size);
   EXPECT_EQ(again.hsm.youngs_modulus, scene.hsm.youngs_modulus);
@@ -85,11 +85,11 @@ TEST(SpeciesScene, AScaleWithoutAHeightGrowsTheWholePreset) {
   ASSERT_EQ(oak.tree.scale, 1.0);
   const double factor = 1.25;  // 22.5 m, within the oak's 10-28
   for (const std::string species : {R"("english_oak")", R"({"name": "english_oak"})"}) {
-    const Scene scene = load(R"({"species": )" + species + R"(, "tree": {"scale": 1.25}})");
+    const Scene scene = load_species(R"({"species": )" + species + R"(, "tree": {"scale": 1.25}})");
     EXPECT_EQ(scene.tree.scale, 1.25) << species;
     EXPECT_DOUBLE_EQ(scene.tree.leaf.size, oak.tree.leaf.size * factor) << species;
     EXPECT_DOUBLE_EQ(scene.tree.trunk_radius, oak.tree.trunk_radius * factor) << species;
-    const Scene again = load(scene.resolved.dump());
+    const Scene again = load_species(scene.resolved.dump());
     EXPECT_EQ(again.tree.scale, scene.tree.scale) << species;
     EXPECT_EQ(again.tree.leaf.size, scene.tree.leaf.size) << species;
     EXPECT_EQ(again.tree.trunk_radius, scene.tree.trunk_radius) << species;
@@ -98,12 +98,13 @@ TEST(SpeciesScene, AScaleWithoutAHeightGrowsTheWholePreset) {
   std::ostringstream range;
   range << "/tree/scale: English oak (english_oak) grows from " << oak.min_height << " to " << oak.max_height
         << " m, got ";
-  EXPECT_NE(input_error_of([&] { load(R"({"species": "english_oak", "tree": {"scale": 100}})"); }).find(range.str()),
-            std::string::npos);
+  EXPECT_NE(
+      input_error_of([&] { load_species(R"({"species": "english_oak", "tree": {"scale": 100}})"); }).find(range.str()),
+      std::string::npos);
 }
 
 TEST(SpeciesScene, ForestVariantsOfSeveralSpeciesEachKeepTheirWood) {
-  const Scene forest = load(R"({"hsm": {"precision": "float"}, "forest": {
+  const Scene forest = load_species(R"({"hsm": {"precision": "float"}, "forest": {
       "variants": [{"name": "oak", "species": "english_oak"},
                    {"name": "spruce", "species": {"name": "norway_spruce", "height": 12}, "hsm": {"damping_ratio": 0.3}}],
       "trees": [{"variant": "oak"}, {"variant": "spruce", "position": [10, 0, 0]}]},
@@ -119,7 +120,7 @@ TEST(SpeciesScene, ForestVariantsOfSeveralSpeciesEachKeepTheirWood) {
     EXPECT_EQ(tree.hsm.precision, Precision::kFloat) << "the scene's /hsm stays under the species'";
     EXPECT_EQ(tree.tree.wood_density, species.tree.wood_density);
     // Its own resolved scene bakes it again alike.
-    const Scene again = tree_scene(load(tree.resolved.dump()), 0);
+    const Scene again = tree_scene(load_species(tree.resolved.dump()), 0);
     EXPECT_EQ(again.hsm.youngs_modulus, tree.hsm.youngs_modulus);
     EXPECT_EQ(again.hsm.damping_ratio, tree.hsm.damping_ratio);
     EXPECT_EQ(again.tree.scale, tree.tree.scale);
@@ -130,35 +131,43 @@ TEST(SpeciesScene, ForestVariantsOfSeveralSpeciesEachKeepTheirWood) {
 
 TEST(SpeciesScene, BadChoicesNameThePointerAndWhatIsExpected) {
   const Species& oak = named("english_oak");
-  const std::string unknown = input_error_of([] { load(R"({"species": "oak"})"); });
+  const std::string unknown = input_error_of([] { load_species(R"({"species": "oak"})"); });
   EXPECT_NE(unknown.find("s.json: /species: no species \"oak\" (did you mean english_oak?)"), std::string::npos)
       << unknown;
   for (const Species& s : species_library()) EXPECT_NE(unknown.find(s.name), std::string::npos) << unknown;
-  EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "nroway_spruce"}})"); })
-                .find("/species/name: no species \"nroway_spruce\" (did you mean norway_spruce?)"),
+  EXPECT_NE(input_error_of([] {
+              load_species(R"({"species": {"name": "nroway_spruce"}})");
+            }).find("/species/name: no species \"nroway_spruce\" (did you mean norway_spruce?)"),
             std::string::npos);
   std::ostringstream range;
   range << "/species/height: English oak (english_oak) grows from " << oak.min_height << " to " << oak.max_height
         << " m, got " << oak.max_height + 1;
-  EXPECT_NE(input_error_of([&] {
-              load(R"({"species": {"name": "english_oak", "height": )" + std::to_string(oak.max_height + 1) + "}}");
-            }).find(range.str()),
+  EXPECT_NE(
+      input_error_of([&] {
+        load_species(R"({"species": {"name": "english_oak", "height": )" + std::to_string(oak.max_height + 1) + "}}");
+      }).find(range.str()),
+      std::string::npos);
+  EXPECT_NE(input_error_of([] {
+              load_species(R"({"species": 5})");
+            }).find("/species: expected a species' name, or {\"name\": NAME, \"height\": METRES}, got 5"),
             std::string::npos);
-  EXPECT_NE(input_error_of([] { load(R"({"species": 5})"); })
-                .find("/species: expected a species' name, or {\"name\": NAME, \"height\": METRES}, got 5"),
+  EXPECT_NE(input_error_of([] {
+              load_species(R"({"species": {"height": 12}})");
+            }).find("/species/name: expected a species' name"),
             std::string::npos);
-  EXPECT_NE(input_error_of([] { load(R"({"species": {"height": 12}})"); }).find("/species/name: expected a species' name"),
-            std::string::npos);
-  EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "english_oak", "height": 15}, "tree": {"scale": 2}})"); })
-                .find("/tree/scale: the species' height of 15 m grows it at a scale of "),
+  EXPECT_NE(input_error_of([] {
+              load_species(R"({"species": {"name": "english_oak", "height": 15}, "tree": {"scale": 2}})");
+            }).find("/tree/scale: the species' height of 15 m grows it at a scale of "),
             std::string::npos);
   // Productions beside a species and no axiom would be left unread: the species' grammar grows.
-  EXPECT_NE(input_error_of([] { load(R"({"species": "english_oak", "lsystem": {"productions": ["F --> FF"]}})"); })
-                .find("/lsystem/productions: inline productions go with /lsystem/axiom; the species' grammar has its "
-                      "own (give an axiom to grow an inline grammar instead)"),
-            std::string::npos);
-  EXPECT_NE(input_error_of([] { load(R"({"species": {"name": "english_oak", "heigth": 15}})"); })
-                .find("/species/heigth: unknown key (did you mean /species/height?)"),
+  EXPECT_NE(
+      input_error_of([] { load_species(R"({"species": "english_oak", "lsystem": {"productions": ["F --> FF"]}})"); })
+          .find("/lsystem/productions: inline productions go with /lsystem/axiom; the species' grammar has its "
+                "own (give an axiom to grow an inline grammar instead)"),
+      std::string::npos);
+  EXPECT_NE(input_error_of([] {
+              load_species(R"({"species": {"name": "english_oak", "heigth": 15}})");
+            }).find("/species/heigth: unknown key (did you mean /species/height?)"),
             std::string::npos);
 }
 

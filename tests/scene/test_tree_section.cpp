@@ -37,7 +37,7 @@ TEST(TreeOptions, ValuesAndRelativeMeshPath) {
 }
 
 // read_tree_options on `text` => the InputError message.
-std::string error_of(const std::string& text) {
+std::string tree_error_of(const std::string& text) {
   Json document = Json::parse(text);
   try {
     SceneReader reader(document, "/scenes", "s.json");
@@ -50,10 +50,11 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(TreeOptions, BadValuesNameThePointer) {
-  EXPECT_EQ(error_of(R"({"tree": {"ring_sides": 2}})"),
+  EXPECT_EQ(tree_error_of(R"({"tree": {"ring_sides": 2}})"),
             "s.json: /tree/ring_sides: expected an integer in [3, 256], got 2");
-  EXPECT_EQ(error_of(R"({"tree": {"leaf": {"size": 0}}})"), "s.json: /tree/leaf/size: expected a number in (0, 25], got 0");
-  EXPECT_EQ(error_of(R"({"tree": {"cluster": {"segment_per_cluster": 2}}})"),
+  EXPECT_EQ(tree_error_of(R"({"tree": {"leaf": {"size": 0}}})"),
+            "s.json: /tree/leaf/size: expected a number in (0, 25], got 0");
+  EXPECT_EQ(tree_error_of(R"({"tree": {"cluster": {"segment_per_cluster": 2}}})"),
             "s.json: /tree/cluster/segment_per_cluster: unknown key (did you mean "
             "/tree/cluster/segments_per_cluster?)");
 }
@@ -66,11 +67,11 @@ TEST(TreeOptions, ColoursAreSrgbTriplesInTheUnitRange) {
   EXPECT_EQ(o.leaf_color, TreeOptions{}.leaf_color);
   EXPECT_EQ(o.leaf_color_variation, 0);
   EXPECT_EQ(document["tree"]["leaf_color"], Json::parse("[0.3, 0.47, 0.16]"));
-  EXPECT_EQ(error_of(R"({"tree": {"leaf_color": [0.2, 1.5, 0.1]}})"),
+  EXPECT_EQ(tree_error_of(R"({"tree": {"leaf_color": [0.2, 1.5, 0.1]}})"),
             "s.json: /tree/leaf_color: expected an sRGB colour: an array of 3 numbers in [0, 1], got [0.2,1.5,0.1]");
-  EXPECT_EQ(error_of(R"({"tree": {"bark_color": [0.2, 0.1]}})"),
+  EXPECT_EQ(tree_error_of(R"({"tree": {"bark_color": [0.2, 0.1]}})"),
             "s.json: /tree/bark_color: expected an array of 3 finite numbers, got [0.2,0.1]");
-  EXPECT_EQ(error_of(R"({"tree": {"leaf_color_variation": -0.1}})"),
+  EXPECT_EQ(tree_error_of(R"({"tree": {"leaf_color_variation": -0.1}})"),
             "s.json: /tree/leaf_color_variation: expected a number in [0, 1], got -0.1");
 }
 

@@ -24,7 +24,7 @@ using testing::grown_tree;
 using testing::same_bytes;
 
 constexpr size_t kSmallBlocks = 512;  // memberships: a dozen blocks on the test trees
-constexpr int kFrames = 72;
+constexpr int kBlockFrames = 72;
 
 TEST(CacheBlocks, PartitionTheClustersAndVerticesAsTheStepNeeds) {
   const TreeModel tree = grown_tree(6, 2, 2);
@@ -141,7 +141,7 @@ TEST(CacheBlocks, BakeHasTheBytesOfTheSeparatePasses) {
         SimState expected = passes.initial_state(0), actual = blocks.initial_state(0);
         bool slept = false;
         SimState saved;
-        for (int f = 1; f <= kFrames; ++f) {
+        for (int f = 1; f <= kBlockFrames; ++f) {
           passes.advance_frame(expected, f);
           blocks.advance_frame(actual, f);
           expect_same_state(expected, actual, f);
@@ -154,8 +154,8 @@ TEST(CacheBlocks, BakeHasTheBytesOfTheSeparatePasses) {
         }
         EXPECT_TRUE(slept || !beam);  // the beam's damping puts the tree to sleep in the calm
         Simulator fresh(tree, options, wind, 1.0 / 24, 3, kSmallBlocks);
-        for (int f = 21; f <= kFrames; ++f) fresh.advance_frame(saved, f);
-        expect_same_state(expected, saved, kFrames);
+        for (int f = 21; f <= kBlockFrames; ++f) fresh.advance_frame(saved, f);
+        expect_same_state(expected, saved, kBlockFrames);
       }
   omp_set_num_threads(saved_threads);
 }

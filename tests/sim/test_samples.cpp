@@ -22,7 +22,7 @@ using testing::grown_tree;
 using testing::gust_then_calm;
 using testing::same_bytes;
 
-constexpr double kFrameDt = 1.0 / 24;
+constexpr double kSampleFrameDt = 1.0 / 24;
 
 struct Moments {
   double mass = 0;
@@ -115,7 +115,7 @@ TEST(SampleSkin, PlacesTheRestMeshExactlyAndARigidMotionExactly) {
   const TreeModel mesh = grown_tree(4, 1, 4);
   const TreeModel samples = sample_tree_model(mesh);
   const SampleSkin skin(mesh, samples);
-  Simulator simulator(samples, HsmOptions{}, WindOptions{}, kFrameDt, 2);
+  Simulator simulator(samples, HsmOptions{}, WindOptions{}, kSampleFrameDt, 2);
   SimState state = simulator.initial_state(0);
   ClusterFrames frames;
   SimState out;
@@ -153,8 +153,8 @@ TEST(Samples, MoveTheTreeAsTheVerticesDo) {
   const SampleSkin skin(mesh, samples);
   const WindOptions wind = gust_then_calm(9, 1.5, 2.0);
   HsmOptions options;
-  Simulator vertices(mesh, options, wind, kFrameDt, 4);
-  Simulator sampled(samples, options, wind, kFrameDt, 4);
+  Simulator vertices(mesh, options, wind, kSampleFrameDt, 4);
+  Simulator sampled(samples, options, wind, kSampleFrameDt, 4);
   SimState a = vertices.initial_state(0), b = sampled.initial_state(0), skinned;
   ClusterFrames frames;
   double diff2 = 0, disp2 = 0, largest = 0, largest_disp = 0;
@@ -189,13 +189,13 @@ Eigen::Matrix3Xd sampled_bake(int threads, int resume_at) {
   options.leaf_detach_force = 0.02;
   options.precision = Precision::kFloat;
   const WindOptions wind = gust_then_calm(16, 0.5, 0.7);
-  Simulator simulator(samples, options, wind, kFrameDt, 3);
+  Simulator simulator(samples, options, wind, kSampleFrameDt, 3);
   SimState state = simulator.initial_state(0), skinned;
   ClusterFrames frames;
   Eigen::Matrix3Xd all(3, 0);
   for (int frame = 1; frame <= 60; ++frame) {
     if (frame == resume_at) {
-      Simulator fresh(samples, options, wind, kFrameDt, 3);
+      Simulator fresh(samples, options, wind, kSampleFrameDt, 3);
       SimState copy = state;
       fresh.advance_frame(copy, frame);
       simulator.advance_frame(state, frame);

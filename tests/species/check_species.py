@@ -10,8 +10,8 @@ A species passes when, as its table entry (grammars/species/species.json, "check
   attachment (weeping and birch twigs), the stem unbranched below the crown (palms), several
   stems from the ground (shrubs), every blade from one point (grasses); two seeds differ;
 - bakes: 240 frames of configs/demo.json's gusting wind at its smallest and largest height,
-  seeds 1 and 2, exit 0, finite and bounded, and converged against 64 substeps as the stress
-  rule asks (tests/stress/README.md);
+  seeds 1 and 2, exit 0, finite and bounded; the smallest with seed 1 and the largest with
+  seed 2 also converged against 64 substeps as the stress rule asks (tests/stress/README.md);
 - sway: plucked at the two heights, its first frequency (at the top of its leader) lies in
   the field band: between Jackson et al.'s broadleaves - 0.2 Hz and Moore & Maguire's conifers
   + 0.07 Hz at its DBH and height (scripts/bench-accuracy), or the entry's own band where a
@@ -211,7 +211,9 @@ def check_species(binary, name, tmp):
             scene = species_scene(name, height, seed, wind=GUSTS, time={"fps": 24, "frames": 240})
             code, err, _ = bake(binary, scene, folder)
             passed, text = run_stress.judge(code, err, folder, "out.h5")
-            if passed:
+            # A 64-substep reference costs some 30 bakes at the default step: one per height and
+            # per seed, on the diagonal, holds both heights and both trees to the rule.
+            if passed and (height, seed) in ((heights[0], 1), (heights[1], 2)):
                 passed, more = run_stress.exaggeration(binary, os.path.join(folder, "scene.json"), folder)
                 text += "; " + more
             print(f"  240 frames of gusts at {height} m, seed {seed}: {'ok' if passed else 'FAIL'}: {text}")

@@ -3,6 +3,7 @@
 // and plays it with three.js. Bundled by esbuild at build time; the page needs no network.
 // page.html#t=SECONDS shows that time, stops, and sets document.title to "ready" once drawn;
 // &tree=K shows the K-th tree alone (from 0; none past the last), framed as the whole page.
+// The page follows its address: a new #t= or &tree= is shown without loading it again.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
@@ -426,18 +427,25 @@ function tick(now) {
   requestAnimationFrame(tick);
 }
 
-// #t=SECONDS: that time, stopped; the title says "ready" once the frame is on the canvas.
-const requested = /(?:^#|&)t=([0-9.eE+-]+)/.exec(window.location.hash);
-const alone = /(?:^#|&)tree=([0-9]+)/.exec(window.location.hash);
-if (alone) trees.forEach((tree, k) => { tree.mesh.visible = k === Number(alone[1]); });
-resize();
-if (requested) {
+// The address's #t=SECONDS: that time, stopped, and the title says "ready" once the frame is on
+// the canvas; &tree=K: that tree alone. => whether it asked for a time.
+const pageTitle = document.title;
+function follow(hash) {
+  const requested = /(?:^#|&)t=([0-9.eE+-]+)/.exec(hash);
+  const alone = /(?:^#|&)tree=([0-9]+)/.exec(hash);
+  trees.forEach((tree, k) => { tree.mesh.visible = !alone || k === Number(alone[1]); });
+  if (!requested) return false;
   playing = false;
   playButton.textContent = 'Play';
   show(Math.min(Math.max(Number(requested[1]), times[0]), times[samples - 1]));
   renderer.render(scene, camera);
   requestAnimationFrame(() => { document.title = 'ready'; });
-} else {
-  show(times[0]);
+  return true;
 }
+resize();
+if (!follow(window.location.hash)) show(times[0]);
+window.addEventListener('hashchange', () => {
+  document.title = pageTitle;
+  follow(window.location.hash);
+});
 requestAnimationFrame(tick);
