@@ -7,6 +7,7 @@
 #include "bake/bake_plan.h"
 #include "bake/bake_start.h"
 #include "bake/bake_tree.h"
+#include "bake/checkpoint.h"
 #include "bake/forest_manifest.h"
 #include "bake/signals.h"
 #include "bake/thread_governor.h"
@@ -39,6 +40,7 @@ void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifes
     if (plan.checkpoints.every > 0) {
       const std::string checkpoints = "the checkpoints of tree " + id;
       targets.add_folder(plan.checkpoints.dir, checkpoints);
+      check_checkpoint_folder(plan.checkpoints.dir);
       if (writes) targets.add_file(journal_path(plan.checkpoints.dir, plan.written.first), checkpoints);
     }
   }
@@ -77,7 +79,7 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
 
 void check_forest_writers(const Scene& scene) {
   OutputTargets targets;
-  add_forest_files(scene, BakeConfig{}, false, [](size_t, const Scene&) { return false; }, targets);
+  add_forest_files(scene, BakeConfig{}, true, [](size_t, const Scene&) { return true; }, targets);
 }
 
 ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,

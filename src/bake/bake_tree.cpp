@@ -252,6 +252,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   PreparedTree tree = prepare_tree(scene, give_up_mesh ? MeshSurface::kOmitted : MeshSurface::kBuilt, log.grown_step);
   tree.skeleton = Skeleton();  // the model is built from it; nothing in a bake reads it again
   log.prepared(tree);
+  if (plan.checkpoints.every > 0) check_checkpoint_folder(plan.checkpoints.dir);  // every input noted by now
   // From the outputs' locks on, a signal waits for the frame loop, which removes what they made.
   const DeferredInterrupts deferred;
   BakeFrames frames(scene, config, plan, tree.model, placement);

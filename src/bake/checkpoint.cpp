@@ -10,6 +10,7 @@
 
 #include "bake/scene_hash.h"
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "files/io_failure.h"
 #include "files/staged_files.h"
 #include "formats/hdf5_support.h"
@@ -169,6 +170,16 @@ void read_prediction(const CheckpointFile& file, hid_t group, const StepPredicti
                   p.damping_compliance.data());
 }
 
+// A file's name => whether a bake takes it for one of its own in its checkpoints' folder: a
+// checkpoint, a frame journal or the temporary of either.
+bool bake_file_name(const std::string& name) {
+  auto between = [&](const std::string& prefix, const std::string& suffix) {
+    return name.size() > prefix.size() + suffix.size() && name.starts_with(prefix) && name.ends_with(suffix);
+  };
+  return between("checkpoint-", ".h5") || between("frames-from-", ".journal") ||
+         ((name.starts_with(".checkpoint-") || name.starts_with(".frames-from-")) && name.find(".tmp-") != std::string::npos);
+}
+
 }  // namespace
 
 double estimated_checkpoint_bytes(size_t vertices, size_t clusters, size_t leaves) {
@@ -182,20 +193,24 @@ fs::path checkpoint_path(const fs::path& dir, long long frame) {
   return dir / ("checkpoint-" + std::to_string(frame) + ".h5");
 }
 
+void check_checkpoint_folder(const fs::path& dir) {
+  std::error_code error;
+  for (fs::directory_iterator entry(dir, error), end; !error && entry != end; entry.increment(error)) {
+    if (!bake_file_name(entry->path().filename().string())) continue;
+    if (const std::string input = input_file_at(entry->path()); !input.empty())
+      throw InputError(entry->path().string() + " is " + (input == entry->path().string() ? "" : input + ", ") +
+                       "an input of this bake, in the checkpoints' folder under a name the bake replaces and "
+                       "removes as its own; expected another name for it, or another --checkpoint-dir");
+  }
+}
+
 void remove_spent_checkpoints(const fs::path& dir) noexcept {
   std::error_code error;
   if (!fs::is_directory(fs::symlink_status(dir, error))) return;
-  auto spent = [](const std::string& name) {
-    auto between = [&](const std::string& prefix, const std::string& suffix) {
-      return name.size() > prefix.size() + suffix.size() && name.starts_with(prefix) && name.ends_with(suffix);
-    };
-    return between("checkpoint-", ".h5") || between("frames-from-", ".journal") ||
-           ((name.starts_with(".checkpoint-") || name.starts_with(".frames-from-")) &&
-            name.find(".tmp-") != std::string::npos);
-  };
   std::vector<fs::path> removed;
   for (fs::directory_iterator entry(dir, error), end; !error && entry != end; entry.increment(error))
-    if (spent(entry->path().filename().string()) && entry->is_regular_file(error)) removed.push_back(entry->path());
+    if (bake_file_name(entry->path().filename().string()) && entry->is_regular_file(error))
+      removed.push_back(entry->path());
   for (const fs::path& path : removed) fs::remove(path, error);
   ::rmdir(dir.c_str());  // fails, harmlessly, on a folder that holds anything else
 }

@@ -25,6 +25,11 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& dir, long lon
 // none when dir does not exist.
 std::vector<std::pair<long long, std::filesystem::path>> list_checkpoints(const std::filesystem::path& dir);
 
+// A bake's checkpoint folder => InputError when one of this process's inputs (common/input_files.h)
+// is there under a name the bake takes for its own checkpoints and journals, which it would
+// replace or remove; nothing when the folder does not exist.
+void check_checkpoint_folder(const std::filesystem::path& dir);
+
 // A finished bake's checkpoint folder => its checkpoints, frame journals and their temporaries
 // removed, then the folder when that empties it. Nothing else is touched: no other file in it,
 // nor what stands at `dir` when it is not a folder (a link, a file). Never throws.

@@ -12,8 +12,8 @@
 namespace treeanim {
 
 int farm_plan_command(const FarmRequest& request) {
-  if (!request.json.empty()) check_text_output_target(request.json);
   const Scene scene = load_scene(request.scene, request.overrides);
+  if (!request.json.empty()) check_text_output_target(request.json);  // after the scene noted its inputs
   if (!scene.forest)
     throw InputError(request.scene.string() + ": no /forest: farm plan splits a forest's trees into tasks");
   const Forest& forest = *scene.forest;

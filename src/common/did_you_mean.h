@@ -6,9 +6,9 @@
 
 namespace treeanim {
 
-// Levenshtein edit distance.
+// Edit distance: insertions, deletions, substitutions and swaps of neighbouring letters.
 size_t edit_distance(const std::string& a, const std::string& b);
-// The closest candidate to `word`, or "" when none is close enough to suggest.
+// The closest candidate to `word` (ignoring case first), or "" when none is close enough to suggest.
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
 
 }  // namespace treeanim

@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "files/io_failure.h"
 #include "files/output_file.h"
 #include "files/staged_files.h"
@@ -15,12 +16,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// path => "" when a file can be written there, else what stands in the way.
+// path => "" when a file can be written there, else what stands in the way: something other
+// than a regular file, or a file this process reads its inputs from.
 std::string text_target_problem(const fs::path& path) {
   const OutputTarget target = resolve_output_target(path);
-  if (target.kind.empty()) return "";
-  return path.string() + (target.file == path ? " is " : " links to " + target.file.string() + ", ") + target.kind +
-         ", left untouched; expected a regular file or a new one";
+  if (!target.kind.empty())
+    return path.string() + (target.file == path ? " is " : " links to " + target.file.string() + ", ") + target.kind +
+           ", left untouched; expected a regular file or a new one";
+  if (const std::string input = input_file_at(target.file); !input.empty())
+    return path.string() + " is " + (input == path.string() ? "" : input + ", ") +
+           "an input of this command, left untouched; expected a file it does not read";
+  return "";
 }
 
 }  // namespace

@@ -125,8 +125,10 @@ namespace {
 
 // A file system's longest name (NAME_MAX of ext4, XFS, tmpfs, NFS), and what an output's own
 // name may take of it: its lock ".NAME.lock" and temporaries ".NAME.tmp-PID" (and a USD
-// layer's scratch beside them) add up to 32 bytes.
-constexpr size_t kMostFolderNameBytes = 255, kMostFileNameBytes = 255 - 32;
+// layer's scratch beside them) add up to 32 bytes. A path the system takes is shorter than
+// PATH_MAX with its terminating zero.
+constexpr size_t kLockAndTemporaryBytes = 32, kMostPathBytes = 4096;
+constexpr size_t kMostFolderNameBytes = 255, kMostFileNameBytes = 255 - kLockAndTemporaryBytes;
 
 std::vector<OutputFiles> output_files(const std::vector<OutputOptions>& outputs, const fs::path& out_dir,
                                       long long frame_start, long long frame_count) {
@@ -179,6 +181,10 @@ void OutputTargets::add(const fs::path& target, const std::string& writer, const
     if (file) break;
     start = slash + 1;
   }
+  if (written && text.size() + kLockAndTemporaryBytes >= kMostPathBytes)
+    throw InputError(refused + "a path of " + std::to_string(text.size()) + " bytes: at most " +
+                     std::to_string(kMostPathBytes - kLockAndTemporaryBytes - 1) +
+                     ", the system's 4096 less the room of its lock and temporary files");
   OutputTarget resolved;
   try {
     resolved = resolve_output_target(target);

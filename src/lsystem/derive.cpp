@@ -474,6 +474,8 @@ class Deriver {
   // start where the next one does).
   void expand_all(RuleSet Lsystem::*section, const ModuleString& word, Purpose purpose, ModuleString* out,
                   std::vector<uint32_t>* at = nullptr) {
+    expanding_ = purpose;
+    modules_begun_ = 0;
     out->clear();
     out->symbols.reserve(word.size());
     out->param_offsets.reserve(word.size() + 1);
@@ -581,6 +583,7 @@ class Deriver {
   // applies, else its rule's frame pushed. => the modules its rule replaces (1 when none).
   size_t begin_module(const RuleSet& set, char symbol, std::span<const double> params, size_t index, int depth,
                       RandomStream& random, ModuleString* out) {
+    if (++modules_begun_ > kModulesBegunPerModule * settings_.max_modules) fail_expansion_work();
     double slots[kMaxSlots];
     const Rule* rule = depth < set.max_depth ? select(set, symbol, params, index, slots, random) : nullptr;
     if (!rule) {
@@ -604,6 +607,20 @@ class Deriver {
       }
     }
     return rule->length();
+  }
+
+  // Rules that recurse to their 'maximum depth:' without growing the word (A(n) --> A(n-1)A(n-1)
+  // ending in an erasure) take time the module cap never sees: a pass that begins more modules
+  // than this many per module of the cap stops (a pass begins each module it writes once, and
+  // each rule it applies once more).
+  static constexpr size_t kModulesBegunPerModule = 8;
+  [[noreturn]] void fail_expansion_work() const {
+    const std::string section = expanding_ == kHomomorphism ? "homomorphism" : "decomposition";
+    throw InputError(g_.sources.at(0) + ": the " + section + (expanding_ == kHomomorphism ? "" : " of derivation step " + std::to_string(step_)) +
+                     " applied more than " + std::to_string(kModulesBegunPerModule) + " x lsystem.max_modules = " +
+                     std::to_string(kModulesBegunPerModule * settings_.max_modules) +
+                     " rules and modules (its rules recurse too far: lower its 'maximum depth:', or raise "
+                     "lsystem.max_modules)");
   }
 
   // '%' removes itself and the rest of its branch (up to, not including, the closing ']').
@@ -630,6 +647,8 @@ class Deriver {
   const DerivationSettings& settings_;
   const TurtleSettings turtle_;         // answers the query modules
   int step_ = 0;
+  Purpose expanding_ = kDecomposition;  // the section expand_all applies
+  size_t modules_begun_ = 0;            // by expand_all's pass so far (kModulesBegunPerModule)
   const Rule* rule_ = nullptr;          // the rule being evaluated, for error messages
   const ModuleString* word_ = nullptr;  // the word being rewritten (contexts)
   bool derived_ = false;                // the module being expanded comes from a successor: its contexts are its origin's

@@ -45,8 +45,7 @@ int arity_of(Op op) {
     case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: case Op::kFclose: case Op::kFscan: return 1;
     case Op::kStoreElem: return 2;
     case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem:
-    case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe:
-    case Op::kAnd: case Op::kOr: return 2;
+    case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe: return 2;
     default: break;
   }
   for (const Function& f : kFunctions)
@@ -217,13 +216,14 @@ class Compiler {
     for (const size_t skip : skips_else) land(skip);
   }
 
+  // a || b and a && b, 1 or 0, as in C and cpfg: b runs only when a leaves the answer open
+  // (x != 0 && 1 / x > 0 divides by nothing), compiled as a ? 1 : b != 0 and a ? b != 0 : 0.
   void parse_or() {
     parse_and();
     for (;;) {
       const size_t where = (skip_space(), pos_);
       if (!accept("||")) return;
-      parse_and();
-      emit(Op::kOr, 0, where);
+      logic_operand(where, true);
     }
   }
   void parse_and() {
@@ -231,8 +231,31 @@ class Compiler {
     for (;;) {
       const size_t where = (skip_space(), pos_);
       if (!accept("&&")) return;
+      logic_operand(where, false);
+    }
+  }
+  // The left operand on the stack => the right one parsed (parse_and's for ||, parse_comparison's
+  // for &&) and run only when needed; the result 1 or 0 on the stack.
+  void logic_operand(size_t where, bool is_or) {
+    const size_t to_right = emit_jump(Op::kJumpIfZero, where);
+    if (is_or) {  // a true: 1
+      emit_constant(1, where);
+      const size_t past = emit_jump(Op::kJump, where);
+      --depth_;  // one of the two sides is on the stack
+      land(to_right);
+      parse_and();
+      emit_constant(0, where);
+      emit(Op::kNe, 0, where);
+      land(past);
+    } else {  // a false: 0
       parse_comparison();
-      emit(Op::kAnd, 0, where);
+      emit_constant(0, where);
+      emit(Op::kNe, 0, where);
+      const size_t past = emit_jump(Op::kJump, where);
+      --depth_;
+      land(to_right);
+      emit_constant(0, where);
+      land(past);
     }
   }
   void parse_comparison() {
@@ -827,8 +850,6 @@ namespace {
       case Op::kGe: a = a >= b ? 1.0 : 0.0; --top; break;
       case Op::kEq: a = a == b ? 1.0 : 0.0; --top; break;
       case Op::kNe: a = a != b ? 1.0 : 0.0; --top; break;
-      case Op::kAnd: a = (a != 0.0 && b != 0.0) ? 1.0 : 0.0; --top; break;
-      case Op::kOr: a = (a != 0.0 || b != 0.0) ? 1.0 : 0.0; --top; break;
       case Op::kSin: stack[top] = std::sin(b * kDegree); break;
       case Op::kCos: stack[top] = std::cos(b * kDegree); break;
       case Op::kTan: stack[top] = std::tan(b * kDegree); break;

@@ -53,7 +53,7 @@ enum class Op : uint8_t {
   kConst, kParam,                                  // push constants[arg] / formals[arg]
   kAdd, kSub, kMul, kDiv, kPow,                    // binary arithmetic
   kNeg, kNot,                                      // unary
-  kLt, kLe, kGt, kGe, kEq, kNe, kAnd, kOr,         // comparisons and logic: 1 or 0
+  kLt, kLe, kGt, kGe, kEq, kNe,                    // comparisons: 1 or 0 (&& and || are jumps)
   kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2,   // degrees
   kSqrt, kExp, kLog, kAbs, kMin, kMax, kFloor, kCeil,
   kRem, kTrunc, kSign,                             // C's fmod, trunc; sign: -1, 0, 1

@@ -23,7 +23,7 @@ struct OutputOptions {
   bool skinned = false;            // usd: UsdSkel joints and keys instead of points per frame
   size_t max_page_bytes = 64 << 20;  // html: the page's size limit (key max_mib)
   std::string pointer;             // "/outputs/N", for messages about this element
-  std::string source;              // the scene's name ("" when unknown), before the pointer in messages
+  std::string source;              // the scene's name, or the override that set the path ("" when unknown), before the pointer in messages
 
   // "scene.json: /outputs/N": what a message about this element begins with, as the scene's own.
   std::string where() const { return source.empty() ? pointer : source + ": " + pointer; }

@@ -39,7 +39,8 @@ std::vector<std::pair<std::string, double>> read_defines(SceneObject& section) {
   SceneObject defines = section.object("defines");
   for (const std::string& name : names) {
     if (!is_name(name)) defines.fail(name, "expected a name of letters, digits and '_' (not starting with a digit)");
-    out.emplace_back(name, *defines.optional_number(name));
+    // null takes the default, as for any key: the grammar's own #define, or none
+    if (const std::optional<double> number = defines.optional_number(name)) out.emplace_back(name, *number);
   }
   return out;
 }

@@ -44,7 +44,7 @@ void read_format_key(SceneObject& element, const OutputKey& key, OutputOptions& 
 OutputOptions read_output_options(SceneObject element) {
   OutputOptions options;
   options.pointer = element.pointer();
-  options.source = element.source_name();
+  options.source = element.source_of("path");  // most messages about an output are about its file
   std::vector<std::string> formats;
   for (const OutputFormatRow& row : output_formats()) formats.emplace_back(row.name);
   if (!element.raw("format")) {  // null is absent (docs/scene.md), as everywhere

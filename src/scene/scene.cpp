@@ -103,7 +103,7 @@ std::string override_name(const std::string& assignment) { return "--set '" + ex
 
 }  // namespace
 
-std::string apply_override(Json& document, const std::string& assignment) {
+AppliedOverride apply_override(Json& document, const std::string& assignment) {
   const std::string shown = override_name(assignment);
   // The file's strings were checked by the JSON parser; command-line bytes were not, and the
   // resolved scene (written into every output) must stay valid JSON text.
@@ -138,8 +138,13 @@ std::string apply_override(Json& document, const std::string& assignment) {
   }
 
   Json* node = &document;
-  std::string pointer;
+  std::string pointer, made;
   for (const std::string& token : tokens) {
+    // A value not there yet: an array when the path indexes it (outputs.0.path), else an object.
+    if (node->is_null()) {
+      *node = is_index(token) ? Json::array() : Json::object();
+      if (made.empty()) made = pointer;
+    }
     pointer += "/" + escape_pointer_token(token);
     if (node->is_array()) {
       if (!is_index(token) || std::stoul(token) > node->size())
@@ -147,18 +152,21 @@ std::string apply_override(Json& document, const std::string& assignment) {
                          std::to_string(node->size()) + " elements (0 ... " + std::to_string(node->size()) + ", " +
                          std::to_string(node->size()) + " appending one)");
       const size_t index = std::stoul(token);
-      if (index == node->size()) node->push_back(Json::object());
+      if (index == node->size()) {
+        node->push_back(Json::object());
+        if (made.empty()) made = pointer;
+      }
       node = &(*node)[index];
     } else {
-      if (node->is_null()) *node = Json::object();
       if (!node->is_object())
         throw InputError(shown + ": " + pointer.substr(0, pointer.rfind('/')) +
                          " is " + describe_json(*node) + ", not an object");
+      if (!node->contains(token) && made.empty()) made = pointer;
       node = &(*node)[token];
     }
   }
   *node = std::move(value);
-  return target;
+  return {target, made.empty() ? target : made};
 }
 
 Scene load_scene_text(const std::string& text, const std::string& name,
@@ -169,13 +177,16 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   SceneReader reader(scene.resolved, base_dir, name);
   std::map<std::string, std::string> set_by;  // pointer => the override that set it
   for (const std::string& assignment : overrides) {
-    const std::string target = apply_override(scene.resolved, assignment);
-    // As a key given twice in the file: which one was meant is no one's guess to make.
-    const auto [earlier, first] = set_by.emplace(target, override_name(assignment));
-    if (!first)
-      throw InputError(override_name(assignment) + ": " + target + " is set already by " + earlier->second +
-                       ": expected each path once");
-    reader.note_override(target, override_name(assignment));
+    const auto [target, made] = apply_override(scene.resolved, assignment);
+    // As a key given twice in the file: which one was meant is no one's guess to make. A value
+    // set whole after a part of it was set would drop that part unsaid (a part set after the
+    // whole changes it, as asked).
+    for (const auto& [earlier, by] : set_by)
+      if (earlier == target || earlier.starts_with(target + "/"))
+        throw InputError(override_name(assignment) + ": " + target + (earlier == target ? " is" : " holds " + earlier + ",") +
+                         " set already by " + by + ": expected each path once, and a whole value before its parts");
+    set_by.emplace(target, override_name(assignment));
+    reader.note_override(made, override_name(assignment));  // what it made is its own
   }
 
   SceneObject root = reader.root();

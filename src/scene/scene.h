@@ -46,11 +46,16 @@ struct Scene {
   std::vector<std::filesystem::path> volume_frames;
 };
 
+// Where one override put its value: the JSON pointer it set, and the outermost value it made
+// (an object or array the document did not have on the way there; else the pointer it set).
+struct AppliedOverride {
+  std::string target, made;
+};
 // Applies one "--set a.b.c=VALUE" override to a scene document (VALUE parsed as JSON, else a
 // string; JSON nested too deep, with a repeated key or an out-of-range number is refused). Missing
-// intermediate objects are created. => the JSON pointer it set. Throws InputError on a malformed
-// override.
-std::string apply_override(Json& document, const std::string& assignment);
+// intermediate objects (arrays where the path indexes them) are created. Throws InputError on a
+// malformed override.
+AppliedOverride apply_override(Json& document, const std::string& assignment);
 
 // Loads, overrides, validates. Errors: InputError "file: /pointer: message" (exit 2).
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);

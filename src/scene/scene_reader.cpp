@@ -246,15 +246,48 @@ SceneReader::SceneReader(Json& root, std::filesystem::path scene_dir, std::strin
   if (!root_.is_object()) fail("", "expected a JSON object at the top level, got " + describe_json(root_));
 }
 
+std::string SceneReader::misspelling_of(const std::string& pointer) const {
+  try {
+    // From the value at fault up: while it is absent or empty, a key beside it that no reader
+    // asked for and that is near its name is what was meant ("lsytem" for a missing "lsystem").
+    for (std::string at = pointer; !at.empty();) {
+      const size_t slash = at.rfind('/');
+      const std::string parent = at.substr(0, slash);
+      const Json::json_pointer place(at);
+      if (root_.contains(place) && !root_.at(place).empty()) return "";
+      const Json& holder = root_.at(Json::json_pointer(parent));
+      const auto known = valid_keys_.find(parent);
+      if (!holder.is_object() || known == valid_keys_.end()) return "";
+      const std::string name = Json::json_pointer(at).back();
+      std::vector<std::string> unknown;
+      for (auto it = holder.begin(); it != holder.end(); ++it)
+        if (it.key() != name && std::find(known->second.begin(), known->second.end(), it.key()) == known->second.end())
+          unknown.push_back(it.key());
+      if (const std::string near = closest_match(name, unknown); !near.empty())
+        return " (" + printable_text(parent + "/" + escape_pointer_token(near)) + " is not a key: did you mean " + at + "?)";
+      at = parent;
+    }
+  } catch (const std::exception&) {  // a message must never throw
+  }
+  return "";
+}
+
+const std::string& SceneReader::source_of(const std::string& pointer) const {
+  const std::string* source = &source_name_;
+  for (const auto& [target, argument] : overrides_)
+    if (pointer == target || pointer.starts_with(target + "/")) source = &argument;
+  return *source;
+}
+
 void SceneReader::fail(const std::string& pointer, const std::string& message) const {
   const std::string where = pointer.empty() ? std::string("/") : pointer;
-  std::string source = source_name_;
-  for (const auto& [target, argument] : overrides_)
-    if (pointer == target || pointer.starts_with(target + "/")) source = argument;
-  throw InputError((source.empty() ? "" : source + ": ") + where + ": " + message);
+  const std::string& source = source_of(pointer);
+  throw InputError((source.empty() ? "" : source + ": ") + where + ": " + message + misspelling_of(pointer));
 }
 
 const std::string& SceneObject::source_name() const { return reader_->source_name(); }
+
+const std::string& SceneObject::source_of(const std::string& key) const { return reader_->source_of(pointer_of(key)); }
 
 SceneObject SceneReader::root() { return SceneObject(this, &root_, ""); }
 

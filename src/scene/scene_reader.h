@@ -79,6 +79,8 @@ class SceneObject {
   const std::string& pointer() const { return pointer_; }
   // The scene file's name as messages give it ("" when none).
   const std::string& source_name() const;
+  // What messages about `key` name as its source: the override that set it, else source_name().
+  const std::string& source_of(const std::string& key) const;
   // The object as read so far (defaults of the keys read are filled in).
   const Json& json() const { return *node_; }
   // Throws InputError "<pointer>/<key>: <message>".
@@ -105,8 +107,10 @@ class SceneReader {
   SceneObject root();
   const std::filesystem::path& scene_dir() const { return scene_dir_; }
   const std::string& source_name() const { return source_name_; }
-  // Throws InputError "<source>: <pointer>: <message>".
+  // Throws InputError "<source>: <pointer>: <message>", the source as source_of(pointer).
   [[noreturn]] void fail(const std::string& pointer, const std::string& message) const;
+  // The value at `pointer` => the override that set it ("--set 'time.fps=5000'"), else source_name().
+  const std::string& source_of(const std::string& pointer) const;
   // Throws InputError for the first key (in document order) no reader declared.
   void check_unknown_keys() const;
   // Called by SceneObject: marks key valid for the object at pointer.
@@ -123,6 +127,9 @@ class SceneReader {
 
  private:
   void check_object(const Json& node, const std::string& pointer) const;
+  // The value at `pointer` is at fault => " (/lsytem is not a key: did you mean /lsystem?)" when
+  // it, or an object it lies in, is absent or empty beside a near key no reader asked for; else "".
+  std::string misspelling_of(const std::string& pointer) const;
   Json& root_;
   std::filesystem::path scene_dir_;
   std::string source_name_;

@@ -98,8 +98,9 @@ const Species& closest_species(const std::string& word) {
 [[noreturn]] void fail_unknown(SceneObject& section, const std::string& key, const std::string& name) {
   std::string names;
   for (const Species& s : species_library()) names += (names.empty() ? "" : ", ") + s.name;
-  section.fail(key, "no species \"" + name + "\" (did you mean " + closest_species(name).name + "?); the library has " +
-                        names + " (treeanim species lists them)");
+  const std::string near = name.empty() ? "" : " (did you mean " + closest_species(name).name + "?)";
+  section.fail(key, "no species \"" + name + "\"" + near + "; the library has " + names +
+                        " (treeanim species lists them)");
 }
 
 const Species* find_species(const std::string& name) {

@@ -13,6 +13,7 @@
 #include "bake/frame_journal.h"
 #include "bake/scene_hash.h"
 #include "common/errors.h"
+#include "common/input_files.h"
 #include "sim/simulator.h"
 #include "../sim/grown_tree.h"
 
@@ -170,6 +171,23 @@ TEST(Checkpoint, RefusesAStateThatNoLongerMatchesItsDigest) {
               path.string() + ": not a readable checkpoint: its state does not match the digest it was written "
                               "with (damaged on disk; delete it to resume from the one before)");
   }
+}
+
+// An input in the checkpoints' folder under a name the bake replaces and removes as its own is
+// refused before the bake; an input under another name, and such a name that is no input, are not.
+TEST(Checkpoint, AnInputNamedAsTheBakesOwnFilesIsRefused) {
+  ScratchDir dir("input-named-as-a-journal");
+  std::ofstream(dir.path / "frames-from-0.journal") << "0,3\n";
+  std::ofstream(dir.path / "wind.csv") << "0,3\n";
+  std::ofstream(dir.path / "checkpoint-5.h5") << "x";
+  note_input_file(dir.path / "wind.csv");
+  EXPECT_EQ(input_error([&] { check_checkpoint_folder(dir.path); }), "");
+  note_input_file(dir.path / "frames-from-0.journal");
+  EXPECT_EQ(input_error([&] { check_checkpoint_folder(dir.path); }),
+            (dir.path / "frames-from-0.journal").string() +
+                " is an input of this bake, in the checkpoints' folder under a name the bake replaces and removes as "
+                "its own; expected another name for it, or another --checkpoint-dir");
+  EXPECT_EQ(input_error([&] { check_checkpoint_folder(dir.path / "none"); }), "");
 }
 
 TEST(FrameJournal, KeepsWholeRecordsAndTruncatesToTheCheckpoint) {

@@ -257,6 +257,14 @@ TEST(Cpfg, ParametersAndExpandedTextAreBounded) {
   EXPECT_EQ(input_error_of([&] { derive(g, {10, 1, 10000}); }),
             "plant.l: derivation step 9 of 10 reached 40100 parameters, more than 4 x lsystem.max_modules = 10000 "
             "(lower lsystem.iterations or raise lsystem.max_modules)");
+  // Rules that recurse to their maximum depth and erase what they made grow nothing the module
+  // cap sees: 2^40 rule applications, stopped after 8 x max_modules modules begun.
+  const Grammar recursing = parse_plant(
+      "derivation length: 1\naxiom: F A(40)\nhomomorphism\nmaximum depth: 100\n"
+      "A(n) : n > 0 --> A(n-1)A(n-1)\nA(n) : n == 0 --> *\n");
+  EXPECT_EQ(input_error_of([&] { apply_homomorphism(recursing, derive(recursing, {1, 1, 1000}), {1, 1, 1000}); }),
+            "plant.l: the homomorphism applied more than 8 x lsystem.max_modules = 8000 rules and modules (its rules "
+            "recurse too far: lower its 'maximum depth:', or raise lsystem.max_modules)");
   // 16 macros each twice the one before, each use a line of half a megabyte.
   std::string doubling = "#define M0 FFFFFFFFFFFFFFFF\n";
   for (int k = 1; k < 16; ++k)

@@ -58,6 +58,14 @@ TEST(Expression, ComparisonsAndLogic) {
   EXPECT_EQ(eval("!(x == 2)"), 0.0);
   EXPECT_EQ(eval("!0 + !5"), 1.0);
   EXPECT_EQ(eval("1 + 2 < 4"), 1.0);  // arithmetic before comparison
+  // The right operand runs only when the left leaves the answer open, as in C and cpfg.
+  EXPECT_EQ(eval("x != 0 && 1 / x > 0", 0.0), 0.0);
+  EXPECT_EQ(eval("x == 0 || 1 / x > 0", 0.0), 1.0);
+  EXPECT_EQ(eval("x != 0 && 1 / x > 0", 4.0), 1.0);
+  EXPECT_EQ(eval("x && y && 0 || y"), 1.0);  // && before ||
+  EXPECT_EQ(eval("x && 7"), 1.0);            // 1 or 0, whatever the operands
+  EXPECT_EQ(eval("0 || 0 || x - 2"), 0.0);
+  EXPECT_EQ(eval("(x || y) + (0 && y) + (3 && 0.5)"), 2.0);
 }
 
 TEST(Expression, FunctionsInDegrees) {

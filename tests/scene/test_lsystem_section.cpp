@@ -25,6 +25,9 @@ TEST(LsystemOptions, FileGrammarWithDefaultsFilledIn) {
   const LsystemOptions o = read(scene);
   EXPECT_EQ(*o.grammar, std::filesystem::path("/grammars/tree.lsys"));
   EXPECT_EQ(o.defines, (std::vector<std::pair<std::string, double>>{{"r1", 0.8}}));
+  // null takes the default, the grammar's own value: no define is replaced.
+  Json unset = Json::parse(R"({"lsystem": {"grammar": "../grammars/tree.lsys", "defines": {"r1": null}}})");
+  EXPECT_TRUE(read(unset).defines.empty());
   EXPECT_FALSE(o.iterations);
   EXPECT_EQ(o.seed, 77u);  // the scene's top-level seed
   EXPECT_EQ(o.step, 1.0);

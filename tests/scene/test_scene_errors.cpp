@@ -122,7 +122,19 @@ TEST(SceneErrors, OverrideValueIsValidated) {
 
 TEST(SceneErrors, OverrideOfOnePathTwice) {
   EXPECT_EQ(scene_error_of(kValid, {"time.fps=30", "time.frames=4", "time.fps=24"}),
-            "--set 'time.fps=24': /time/fps is set already by --set 'time.fps=30': expected each path once");
+            "--set 'time.fps=24': /time/fps is set already by --set 'time.fps=30': expected each path once, and "
+            "a whole value before its parts");
+  // The whole after a part would drop the part; a part after the whole changes it.
+  EXPECT_EQ(scene_error_of(kValid, {"time.fps=30", "time={\"frames\": 5}"}),
+            "--set 'time={\"frames\": 5}': /time holds /time/fps, set already by --set 'time.fps=30': expected each "
+            "path once, and a whole value before its parts");
+  EXPECT_EQ(load_scene_text(kValid, "s.json", ".", {"time={\"frames\": 5}", "time.fps=30"}).time.fps, 30);
+}
+
+TEST(SceneErrors, OverrideIndexStartsAnArray) {
+  const Scene scene = load_scene_text(kValid, "s.json", ".", {"outputs.0.format=hdf5", "outputs.0.path=a.h5"});
+  ASSERT_EQ(scene.outputs.size(), 1u);
+  EXPECT_EQ(scene.outputs[0].format->name, "hdf5");
 }
 
 TEST(SceneErrors, MissingFileNamesTheResolvedPath) {

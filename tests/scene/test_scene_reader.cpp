@@ -139,6 +139,13 @@ TEST(SceneReader, ClosestMatch) {
   EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
   EXPECT_EQ(closest_match("substep", {"substeps", "fps"}), "substeps");
   EXPECT_EQ(closest_match("xyz", {"substeps", "fps"}), "");
+  // Neighbours swapped are one edit; case is ignored before the letters are compared.
+  EXPECT_EQ(edit_distance("fromat", "format"), 1u);
+  EXPECT_EQ(edit_distance("axoim", "axiom"), 1u);
+  EXPECT_EQ(closest_match("Z", {"x", "y", "z"}), "z");
+  EXPECT_EQ(closest_match("GLB", {"hdf5", "glb", "obj"}), "glb");
+  // A short word is not turned into another by two edits.
+  EXPECT_EQ(closest_match("fbx", {"hdf5", "glb", "obj"}), "");
 }
 
 }  // namespace
