@@ -13,6 +13,7 @@
 #include "common/errors.h"
 #include "common/message_text.h"
 #include "sim/kernel_isa.h"
+#include "sim/simulator.h"
 #include "sim/volume_grids.h"
 #include "sim/wind_volume.h"
 #include "treeanim_version.h"
@@ -58,13 +59,14 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
                       "Folder that relative output paths are resolved against (created if needed)")
       ->check(non_empty_path);
   run_app->add_option("--frames", args.run.frames,
-                      "Write only frames START:END (inclusive); the simulation still starts at "
-                      "time.start");
+                      "Write only frames START:END (inclusive); the simulation starts at time.start, or "
+                      "at the newest checkpoint at or before START (docs/checkpoint.md)");
   run_app->add_option("--threads", args.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
       ->check(CLI::Range(1, kMaxThreads));
   run_app->add_option("--set", args.run.overrides,
                       "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
-                      "JSON or a plain string; repeatable");
+                      "JSON or a plain string; repeatable, one PATH=VALUE each")
+      ->allow_extra_args(false);
   run_app->add_option("--checkpoint-every", args.run.checkpoint_every,
                       "Write the complete simulation state every N frames (docs/checkpoint.md)")
       ->check(CLI::Range(1LL, 1'000'000'000LL));
@@ -96,7 +98,8 @@ CLI::App* add_validate(CLI::App& app, Arguments& args) {
   CLI::App* validate_app =
       app.add_subcommand("validate", "Load the scene, derive the tree and build the model; no simulation");
   validate_app->add_option("scene", args.validate_scene, "Scene file (JSON)")->required();
-  validate_app->add_option("--set", args.validate_overrides, "Override a scene value: PATH=VALUE");
+  validate_app->add_option("--set", args.validate_overrides, "Override a scene value: PATH=VALUE")
+      ->allow_extra_args(false);
   validate_app->footer(
       "Examples:\n"
       "  treeanim validate configs/demo.json\n"
@@ -107,7 +110,8 @@ CLI::App* add_validate(CLI::App& app, Arguments& args) {
 CLI::App* add_info(CLI::App& app, Arguments& args) {
   CLI::App* info_app = app.add_subcommand("info", "Print counts (modules, segments, vertices, clusters) and estimates");
   info_app->add_option("scene", args.info_scene, "Scene file (JSON)")->required();
-  info_app->add_option("--set", args.info_overrides, "Override a scene value: PATH=VALUE");
+  info_app->add_option("--set", args.info_overrides, "Override a scene value: PATH=VALUE")
+      ->allow_extra_args(false);
   CLI::Option* json_flag = info_app->add_flag("--json", args.info_json, "Print one JSON object");
   info_app->add_flag("--resolved-scene", args.info_resolved,
                      "Print the scene with every default filled in (what outputs record)")
@@ -161,7 +165,8 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
   commands.gather = farm_app->add_subcommand("gather", "Check every tree of a forest is baked and write OUT/forest.json");
   for (CLI::App* sub : {commands.plan, commands.submit, commands.gather}) {
     sub->add_option("scene", farm.scene, "Scene file (JSON) with a /forest")->required();
-    sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE");
+    sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE")
+      ->allow_extra_args(false);
   }
   commands.plan->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(CLI::Range(1, 1'000'000));
   commands.plan->add_option("--json", farm.json, "Also write the plan as JSON to this file")->check(non_empty_path);
@@ -212,6 +217,7 @@ std::string omp_threads_error(const Arguments& args) {
 int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   try {
     if (const std::string isa = asked_isa_error(); !isa.empty()) throw InputError(isa);
+    if (const std::string blocks = asked_blocks_error(); !blocks.empty()) throw InputError(blocks);
     if (const std::string threads = omp_threads_error(args); !threads.empty()) throw InputError(threads);
     return dispatch(commands, args);
   } catch (const InputError& error) {

@@ -3,11 +3,15 @@
 #include "sim/simulator.h"
 
 #include <Eigen/Geometry>
+#include <cctype>
+#include <cerrno>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "sim/solver_step.h"
 
 namespace treeanim {
@@ -121,21 +125,38 @@ void Solver<Real>::advance_frame(SimState& state, long long frame) {
   state.predicted = complete;
 }
 
-}  // namespace
-
 // A block's vertex, membership and cluster data (about 400 bytes a membership in float, 6.5 MB)
 // stays in the cache between its passes, two threads' blocks at once in a 32 MiB L3
 // (docs/solver.md, "Cache blocks", which measured 8,192 and 32,768 too).
 constexpr size_t kBlockMemberships = 16384;
 
+// Memberships a cache block may be asked for: more than any tree holds (a tree's memberships are
+// 32-bit counts).
+constexpr unsigned long long kMostBlockMemberships = 0xffffffffull;
+
+// TREEANIM_BLOCKS => its count when it is one in 0 ... kMostBlockMemberships, else none.
+std::optional<size_t> asked_blocks() {
+  const char* asked = std::getenv("TREEANIM_BLOCKS");
+  if (!asked || !std::isdigit(static_cast<unsigned char>(*asked))) return std::nullopt;
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long n = std::strtoull(asked, &end, 10);
+  if (*end != 0 || errno != 0 || n > kMostBlockMemberships) return std::nullopt;
+  return size_t(n);
+}
+
+}  // namespace
+
 size_t cache_block_memberships() {
-  static const size_t memberships = [] {
-    const char* asked = std::getenv("TREEANIM_BLOCKS");
-    char* end = nullptr;
-    const unsigned long long n = asked ? std::strtoull(asked, &end, 10) : 0;
-    return asked && *asked && *end == 0 ? size_t(n) : kBlockMemberships;
-  }();
+  static const size_t memberships = asked_blocks().value_or(kBlockMemberships);
   return memberships;
+}
+
+std::string asked_blocks_error() {
+  const char* asked = std::getenv("TREEANIM_BLOCKS");
+  if (!asked || asked_blocks()) return "";
+  return "TREEANIM_BLOCKS: expected a count of memberships, 0 ... " + std::to_string(kMostBlockMemberships) +
+         " (0: no cache blocks; or none: " + std::to_string(kBlockMemberships) + "), got '" + excerpt(asked) + "'";
 }
 
 Simulator::Simulator(const TreeModel& model, const HsmOptions& options, const WindOptions& wind,

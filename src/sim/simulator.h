@@ -13,6 +13,8 @@ namespace treeanim {
 // environment's TREEANIM_BLOCKS (a count; 0: no blocks, the separate passes) for tests and
 // benchmarks. Every value gives the same bytes. Read on the first call.
 size_t cache_block_memberships();
+// TREEANIM_BLOCKS set to anything but such a count => what is wrong with it; else "".
+std::string asked_blocks_error();
 
 class Simulator {
  public:
