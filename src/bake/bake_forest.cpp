@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <system_error>
 
 #include "bake/bake_plan.h"
@@ -102,6 +103,12 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     throw;
   }
   ForestBakeResult result;
+  // A whole forest that rewrites a tree first removes the manifest of the one before: killed
+  // halfway, it left a manifest that called old and new trees one complete forest.
+  if (!config.shard && std::find(complete.begin(), complete.end(), false) != complete.end()) {
+    const DeferredInterrupts deferred;
+    remove_forest_files(config.out_dir);
+  }
   // One team for the forest: what other work leaves it carries from tree to tree.
   if (config.threads > 0) omp_set_num_threads(config.threads);
   ThreadGovernor governor(omp_get_max_threads(), log.team_resized);

@@ -166,6 +166,15 @@ void add_forest_targets(const Scene& scene, const fs::path& out_dir, OutputTarge
   if (first_output(scene, "html")) targets.add_file(forest_page_path(out_dir), "the forest's page", written);
 }
 
+bool remove_forest_files(const fs::path& out_dir) {
+  bool removed = false;
+  for (const fs::path& file : {forest_manifest_path(out_dir), forest_stage_path(out_dir), forest_page_path(out_dir)}) {
+    std::error_code error;
+    if (fs::is_regular_file(fs::symlink_status(file, error))) removed = fs::remove(file, error) || removed;
+  }
+  return removed;
+}
+
 GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const std::string& generator,
                            const fs::path& checkpoints) {
   GatherReport report;
@@ -181,7 +190,10 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
       trees.push_back(std::move(*part));
     }
   }
-  if (!report.missing.empty()) return report;
+  if (!report.missing.empty()) {
+    report.removed_stale = remove_forest_files(out_dir);
+    return report;
+  }
   // Before the manifest, which says the forest is complete.
   if (const auto stage = usd_stage_trees(trees); !stage.empty()) {
     const long long start = trees[0].at("frame_start").get<long long>();

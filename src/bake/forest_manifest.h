@@ -35,15 +35,21 @@ std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, con
 void add_forest_targets(const Scene& scene, const std::filesystem::path& out_dir, OutputTargets& targets,
                         bool written = true);
 
+// The forest's own files in out_dir (the manifest, and its stage and page), each removed where it
+// is a regular file: they say the trees beside them are one complete forest, which a bake that
+// rewrites a tree, or a gather that finds one missing, makes untrue. => whether one was there.
+bool remove_forest_files(const std::filesystem::path& out_dir);
+
 struct GatherReport {
   std::vector<size_t> missing;       // trees whose bake is not complete, ascending
   std::vector<std::string> reasons;  // (missing) why
+  bool removed_stale = false;        // trees missing: an earlier manifest, stage or page was removed
 };
 
 // Every tree complete (its part of this generator's key) => writes OUT/forest.json, removes
 // the folder of the trees' checkpoints (`checkpoints`, "" for none) when their bakes left it
-// empty, and returns no missing trees; else writes nothing and returns them. Throws
-// OutputError when the manifest cannot be written.
+// empty, and returns no missing trees; else removes the forest's files (remove_forest_files)
+// and returns them. Throws OutputError when the manifest cannot be written.
 GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir, const std::string& generator,
                            const std::filesystem::path& checkpoints);
 

@@ -33,8 +33,9 @@ int farm_gather_command(const FarmRequest& request) {
       for (size_t t : tasks[k]) task_of[t] = k;
   }
   for (size_t m = 0; m < report.missing.size(); ++m) by_task[task_of[report.missing[m]]].push_back(m);
-  std::fprintf(stderr, "treeanim: %zu of %zu trees are not complete; %s not written\n", report.missing.size(),
-               forest.trees.size(), printable_text(forest_manifest_path(request.out_dir).string()).c_str());
+  std::fprintf(stderr, "treeanim: %zu of %zu trees are not complete; %s not written%s\n", report.missing.size(),
+               forest.trees.size(), printable_text(forest_manifest_path(request.out_dir).string()).c_str(),
+               report.removed_stale ? " (the earlier one, which no longer describes the trees, removed)" : "");
   for (const auto& [task, missing] : by_task) {
     if (request.tasks > 0) {
       std::fprintf(stderr, "  task %zu of %zu", task, request.tasks);
