@@ -87,6 +87,23 @@ def case_shards(treeanim, tmp):
         lo, hi = tree["bounds"]["min"], tree["bounds"]["max"]
         if not (lo[0] <= x <= hi[0] and lo[2] <= z <= hi[2]):
             raise Failed("tree %s at %s lies outside its world bounds %s" % (tree["id"], tree["position"], tree["bounds"]))
+    # A whole forest baked again with another scene removes the manifest before it rewrites the
+    # first tree: killed then, it leaves no manifest that calls old and new trees one forest.
+    parts = os.path.join(one, "forest.parts")
+    before = {name: os.stat(os.path.join(parts, name)).st_mtime_ns for name in os.listdir(parts)}
+    process = subprocess.Popen([treeanim, "run", SCENE, "-o", one, "-q", "--set", "wind.turbulence_length=5"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if any(os.stat(os.path.join(parts, n)).st_mtime_ns != t for n, t in before.items() if os.path.exists(os.path.join(parts, n))):
+            process.send_signal(signal.SIGKILL)
+            break
+        time.sleep(0.0005)
+    process.wait()
+    if process.returncode != -signal.SIGKILL:
+        raise Failed("expected the rebake to be killed after its first tree, got exit %s" % process.returncode)
+    if os.path.exists(os.path.join(one, "forest.json")):
+        raise Failed("a rebake killed after its first tree left the manifest of the bake before")
     # A removed file makes the gather fail, naming the tree and what to do: the command that bakes
     # it again, with the --set the forest was gathered with (this one leaves the scene as it is).
     os.remove(os.path.join(shards, trees[3]["outputs"][0]["files"][0]))
@@ -94,6 +111,9 @@ def case_shards(treeanim, tmp):
     rerun = "treeanim run '%s' --shard I/3 -o '%s' --set 'time.frames=24' --resume" % (SCENE, shards)
     if done.returncode != 4 or trees[3]["id"] not in done.stderr or rerun not in done.stderr:
         raise Failed("gather with a missing file: exit %d, %s" % (done.returncode, done.stderr))
+    # The manifest the first gather wrote no longer describes the folder: removed, and said so.
+    if os.path.exists(os.path.join(shards, "forest.json")) or "the earlier one" not in done.stderr:
+        raise Failed("a gather that found a tree missing left the manifest before it: %s" % done.stderr)
     # A part copied from another tree is named as that tree's, not as another scene's.
     parts = os.path.join(shards, "forest.parts")
     shutil.copy(os.path.join(parts, trees[1]["id"] + ".json"), os.path.join(parts, trees[2]["id"] + ".json"))
