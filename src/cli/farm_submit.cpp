@@ -39,6 +39,12 @@ struct FarmJob {
 };
 
 // The command of task `index` (a shell expression, e.g. "$SLURM_ARRAY_TASK_ID").
+// The job's scripts: for Slurm its array's and its gather's, else the plain one.
+std::vector<fs::path> script_paths(const FarmJob& job, bool slurm) {
+  if (slurm) return {job.farm / (job.name + ".sbatch"), job.farm / (job.name + "-gather.sbatch")};
+  return {job.farm / (job.name + ".sh")};
+}
+
 std::string task_command(const FarmJob& job, const std::string& index) {
   return shell_word(job.treeanim.string()) + " run " + shell_word(job.scene.string()) + " --shard \"" + index + "/" +
          std::to_string(job.tasks) + "\" -o " + shell_word(job.out.string()) + " --checkpoint-every " +
@@ -129,7 +135,8 @@ int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
   if (sbatch.empty())
     throw InputError("--engine slurm: no sbatch on PATH: run farm submit on a Slurm login node (or install Slurm's "
                      "client commands), or write a plain script with --engine script; nothing was submitted");
-  const fs::path array = job.farm / (job.name + ".sbatch"), gather = job.farm / (job.name + "-gather.sbatch");
+  const std::vector<fs::path> scripts = script_paths(job, true);
+  const fs::path &array = scripts[0], &gather = scripts[1];
   MadeFolders folders;
   std::error_code made;
   folders.make(job.logs, made);
@@ -206,6 +213,20 @@ void refuse_control_characters(const std::string& text, const std::string& what)
                    "scripts name it on comment and #SBATCH lines, which it would break; rename it");
 }
 
+// What the job writes under OUT/farm => InputError, before anything is written, where a file
+// stands in the place of its folders or a folder in the place of a script (the tasks failed one
+// by one on a file named logs, and the gather after them).
+void check_job_targets(const FarmJob& job, const std::vector<fs::path>& scripts) {
+  for (const fs::path& folder : {job.out, job.farm, job.logs}) {
+    std::error_code error;
+    const fs::file_status status = fs::status(folder, error);
+    if (fs::exists(status) && !fs::is_directory(status))
+      throw InputError(folder.string() + " is not a folder, left untouched; expected the folder of the job's " +
+                       (folder == job.logs ? "logs" : "files") + ", or nothing there");
+  }
+  for (const fs::path& script : scripts) check_text_output_target(script);
+}
+
 }  // namespace
 
 int farm_submit_command(const FarmRequest& request) {
@@ -234,11 +255,12 @@ int farm_submit_command(const FarmRequest& request) {
   if (job.space_check)
     check_free_space({{job.out / "forest.json", forest_bytes(scene, estimate, job.checkpoint_every)}});
 
+  check_job_targets(job, script_paths(job, request.engine == "slurm"));
   if (request.engine == "slurm") return submit_to_slurm(job, request);
   if (request.wait) throw InputError("--wait: only with --engine slurm (run the script itself to wait for it)");
   if (!request.sbatch_args.empty())
     throw InputError("--sbatch-arg: only with --engine slurm (a plain script has no #SBATCH lines)");
-  const fs::path script = job.farm / (job.name + ".sh");
+  const fs::path script = script_paths(job, false).front();
   write_text_output(script, plain_script(job), true);
   // The commands as shell words, to copy as they are (a ' or $( in the path stays text).
   const std::string shown = printable_text(script.string()), word = printable_text(shell_word(script.string()));

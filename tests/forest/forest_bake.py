@@ -227,6 +227,14 @@ sys.exit(status if "--wait" in sys.argv else 0)
 
 
 def case_submit(treeanim, tmp):
+    # A file where the tasks' logs go is refused before anything is written (each task failed on it).
+    blocked = os.path.join(tmp, "blocked")
+    os.makedirs(os.path.join(blocked, "farm"))
+    open(os.path.join(blocked, "farm", "logs"), "w").close()
+    done = run(treeanim, "farm", "submit", SCENE, "--engine", "script", "--tasks", "2", "-o", blocked, check=False)
+    if done.returncode != 2 or "logs is not a folder, left untouched" not in done.stderr \
+            or os.listdir(os.path.join(blocked, "farm")) != ["logs"]:
+        raise Failed("a file where the logs go: exit %d, %s" % (done.returncode, done.stderr))
     reference = os.path.join(tmp, "reference")
     run(treeanim, "run", SCENE, "-o", reference, "-q")
     bin_dir = os.path.join(tmp, "bin")
