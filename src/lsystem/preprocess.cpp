@@ -101,6 +101,8 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
   for (size_t start = 0; start <= clean.size();) {
     size_t stop = clean.find('\n', start);
     if (stop == std::string::npos) stop = clean.size();
+    // Before its columns (12 bytes a character) are made: a 100 MB line took 2.9 GB.
+    if (stop - start > kMaxLineLength) fail({source, single_line ? 0 : number, 1}, "a line longer than 1 MiB");
     SourceLine line = make_line(std::string_view(clean).substr(start, stop - start), {source, single_line ? 0 : number, 1});
     const size_t hash = skip_spaces(line.text, 0);
     // A line continues on the next one after a trailing backslash, as in cpp; cpfg files also
@@ -111,6 +113,7 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
       stop = clean.find('\n', start);
       if (stop == std::string::npos) stop = clean.size();
       ++number;
+      if (line.text.size() + (stop - start) > kMaxLineLength) fail({source, number, 1}, "a line longer than 1 MiB");
       const SourceLine more = make_line(std::string_view(clean).substr(start, stop - start), {source, number, 1});
       line.text += more.text;
       line.columns.insert(line.columns.end(), more.columns.begin(), more.columns.end());
@@ -183,6 +186,8 @@ void Preprocessor::directive(const std::string& name, const SourceLine& line, si
     --include_depth_;
     return;
   }
+  if (name == "ignore" || name == "consider")  // ABOP's listings print the statement so (Fig. 1.31)
+    fail(at, "'#" + name + ":' is ABOP's way of printing the statement; write '" + name + ":' without the '#'");
   fail(at, "unsupported preprocessor directive '#" + name + "' (supported: #define, #include, #ifdef, #ifndef, #else, #endif; '# ' starts a comment)");
 }
 
@@ -290,6 +295,8 @@ SourceLine Preprocessor::expand_within(const SourceLine& line, std::vector<const
           const auto p = std::find(macro->parameters.begin(), macro->parameters.end(), b.substr(q, e - q));
           if (p != macro->parameters.end()) {
             append(substituted, args[static_cast<size_t>(p - macro->parameters.begin())], at);
+            // Checked as it grows: each use of an argument copies it (5,000 uses took 1.9 GB).
+            if (substituted.text.size() > kMaxLineLength) fail(at, "a line grows past 1 MiB when its macros are expanded");
             q = e;
             continue;
           }

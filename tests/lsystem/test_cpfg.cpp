@@ -112,6 +112,8 @@ std::string plant_error_of(const std::string& text, int steps = 1) {
 TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(plant_error_of("axiom: A(1)\nA(x) : {while (1) {x = x;}} --> A(x)\n", 0), "no error");
   EXPECT_EQ(plant_error_of("#define F(x) x\naxiom: F(1,2)\n"), "plant.l:2:8: macro 'F' expects 1 arguments, got 2");
+  EXPECT_EQ(plant_error_of("#ignore: +-F\naxiom: A\n"),
+            "plant.l:1:1: '#ignore:' is ABOP's way of printing the statement; write 'ignore:' without the '#'");
   EXPECT_EQ(plant_error_of("axiom: A\nA --> B ?(3, 0.5) C $\n"),
             "plant.l:2:9: '?(3, ...)' calls L-system 3, but the file has no 'lsystem: 3' (it has 0)");
   EXPECT_EQ(plant_error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
@@ -265,6 +267,12 @@ TEST(Cpfg, ParametersAndExpandedTextAreBounded) {
   EXPECT_EQ(input_error_of([&] { apply_homomorphism(recursing, derive(recursing, {1, 1, 1000}), {1, 1, 1000}); }),
             "plant.l: the homomorphism applied more than 8 x lsystem.max_modules = 8000 rules and modules (its rules "
             "recurse too far: lower its 'maximum depth:', or raise lsystem.max_modules)");
+  // A macro argument used 5,000 times is stopped as the line grows, not after (it took 1.9 GB).
+  std::string uses_of_x = "#define D(x)";
+  for (int k = 0; k < 5000; ++k) uses_of_x += " x";
+  EXPECT_NE(plant_error_of(uses_of_x + "\naxiom: F(1) A(D(D(1)))\n", 0).find("a line grows past 1 MiB"), std::string::npos);
+  EXPECT_NE(plant_error_of("axiom: F" + std::string(size_t(1) << 21, 'F') + "\n", 0).find("plant.l:1:1: a line longer than 1 MiB"),
+            std::string::npos);
   // 16 macros each twice the one before, each use a line of half a megabyte.
   std::string doubling = "#define M0 FFFFFFFFFFFFFFFF\n";
   for (int k = 1; k < 16; ++k)
