@@ -50,8 +50,9 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
 void BakePrinter::print_summary(const TreeBakeResult& result) const {
   const std::string samples = result.samples ? " simulated as " + std::to_string(result.samples) + " samples" : "";
   // The bake's own time to the millisecond: scripts/bench-frame divides it by the frames of a short bake.
-  std::printf("baked %lld frames: %zu vertices%s, %zu clusters, %lld substeps in %.2f s (simulation + writing %.3f s)\n",
-              result.written.count(), result.vertices, samples.c_str(), result.clusters, result.substeps,
+  std::printf("baked %lld frame%s: %zu vertices%s, %zu clusters, %lld substeps in %.2f s (simulation + writing %.3f s)\n",
+              result.written.count(), result.written.count() == 1 ? "" : "s", result.vertices, samples.c_str(),
+              result.clusters, result.substeps,
               result.seconds, result.run_seconds);
   for (const auto& path : result.final_paths) std::printf("  wrote %s\n", printable_text(path.string()).c_str());
   for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", printable_text(path.string()).c_str(), line.c_str());

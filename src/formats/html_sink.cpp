@@ -133,7 +133,9 @@ class HtmlSink final : public FrameSink {
     plan_ = plan_preview_page(html_page_shape(options, model, info), max_page_bytes_);
     if (!plan_.fits)
       throw InputError(options.where() + "/max_mib: the page needs " + std::to_string(mebibytes(plan_.bytes)) +
-                       " MiB at least for this tree (viewer, mesh and two frames)");
+                       " MiB at least for this tree (viewer, mesh and two frames), more than max_mib = " +
+                       std::to_string(max_page_bytes_ >> 20) +
+                       ": raise max_mib where its range allows, or leave the html output out");
   }
 
   std::vector<fs::path> summary_paths() const override { return {path_}; }
