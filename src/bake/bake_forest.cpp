@@ -80,7 +80,9 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
 
 void check_forest_writers(const Scene& scene) {
   OutputTargets targets;
-  add_forest_files(scene, BakeConfig{}, true, [](size_t, const Scene&) { return true; }, targets);
+  // The manifest goes where -o puts it, which validate and info are not given (a scene named
+  // forest.json is its own folder's manifest path): it only keeps its name from the trees.
+  add_forest_files(scene, BakeConfig{}, false, [](size_t, const Scene&) { return true; }, targets);
 }
 
 ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,

@@ -18,8 +18,8 @@ struct ForestBakeResult {
 };
 
 // Every file the forest would write has one writer (the manifest, each tree's outputs and
-// part), wherever it bakes, and each is absent or a regular file that is none of the inputs:
-// InputError as a whole forest's bake reports it. Writes nothing.
+// part), wherever it bakes, and each tree's is absent or a regular file that is none of the
+// inputs: InputError as a whole forest's bake reports it. Writes nothing.
 void check_forest_writers(const Scene& scene);
 
 // Bakes `trees` (shard_trees()) of the forest. With --resume a tree whose part says it is

@@ -237,6 +237,24 @@ class Compiler {
   // The left operand on the stack => the right one parsed (parse_and's for ||, parse_comparison's
   // for &&) and run only when needed; the result 1 or 0 on the stack.
   void logic_operand(size_t where, bool is_or) {
+    const size_t n = program_.code.size();
+    if (n > barrier_ && program_.code[n - 1].op == Op::kConst) {
+      // A constant left side decides now, so that `#define B (A && 1)` stays a constant: the
+      // right side is parsed (its errors reported) and kept only where it decides, as right != 0.
+      const double left = program_.constants[program_.code[n - 1].arg];
+      program_.code.pop_back(), program_.code_pos.pop_back(), --depth_;
+      const size_t right = program_.code.size(), barrier = barrier_;
+      is_or ? parse_and() : parse_comparison();
+      if (is_or ? left != 0 : left == 0) {
+        program_.code.resize(right), program_.code_pos.resize(right), --depth_;
+        barrier_ = barrier;
+        emit_constant(is_or ? 1 : 0, where);
+      } else {
+        emit_constant(0, where);
+        emit(Op::kNe, 0, where);
+      }
+      return;
+    }
     const size_t to_right = emit_jump(Op::kJumpIfZero, where);
     if (is_or) {  // a true: 1
       emit_constant(1, where);

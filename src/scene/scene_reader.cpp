@@ -259,6 +259,8 @@ std::string SceneReader::misspelling_of(const std::string& pointer) const {
       const auto known = valid_keys_.find(parent);
       if (!holder.is_object() || known == valid_keys_.end()) return "";
       const std::string name = Json::json_pointer(at).back();
+      // Only a key some reader asked for is one a near unknown key may have meant.
+      if (std::find(known->second.begin(), known->second.end(), name) == known->second.end()) return "";
       std::vector<std::string> unknown;
       for (auto it = holder.begin(); it != holder.end(); ++it)
         if (it.key() != name && std::find(known->second.begin(), known->second.end(), it.key()) == known->second.end())

@@ -318,6 +318,19 @@ def case_locked(treeanim, tmp):
 
 
 def case_targets(treeanim, tmp):
+    # validate and info have no -o: a scene named forest.json, checked in its own folder, is not
+    # taken for the manifest a bake writes (where -o puts it).
+    named = os.path.join(tmp, "named")
+    os.makedirs(named)
+    with open(SCENE) as f:
+        text = f.read().replace('"../grammars/', '"%s/' % os.path.realpath(os.path.join(HERE, "..", "..", "grammars")))
+    with open(os.path.join(named, "forest.json"), "w") as f:
+        f.write(text)
+    for command in [["validate", "forest.json"], ["info", "forest.json"]]:
+        done = subprocess.run([treeanim, *command], cwd=named, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise Failed("%s of a scene named forest.json in its folder: exit %d, %s"
+                         % (command[0], done.returncode, done.stderr))
     out = os.path.join(tmp, "out")
     # The first tree's files from an earlier bake, which a refused forest must not replace.
     for name in ["trees/hero.h5", "trees/hero.html", "caches/hero.pc2", "caches/hero.rest.obj"]:

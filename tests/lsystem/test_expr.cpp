@@ -66,6 +66,25 @@ TEST(Expression, ComparisonsAndLogic) {
   EXPECT_EQ(eval("x && 7"), 1.0);            // 1 or 0, whatever the operands
   EXPECT_EQ(eval("0 || 0 || x - 2"), 0.0);
   EXPECT_EQ(eval("(x || y) + (0 && y) + (3 && 0.5)"), 2.0);
+  EXPECT_EQ(eval("x > 1 ? 0 && y : 5 && y"), 0.0);  // a constant left side where a jump lands
+  EXPECT_EQ(eval("x > 3 ? 0 && y : 5 && y - 3"), 0.0);
+  EXPECT_EQ(eval("x > 3 ? 0 : 5 && y"), 1.0);
+}
+
+// A constant left side decides at compile time: such an expression is still a constant.
+TEST(Expression, LogicOfConstantsIsFolded) {
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, double>>{
+           {"1 && 2 || 0", 1.0}, {"0 && k", 0.0}, {"k || 0", 1.0}, {"0 || k > 20", 0.0}, {"!(0 || 0) && 3", 1.0}}) {
+    const Compiled c = compile(text);
+    double value = -1;
+    EXPECT_TRUE(c.program.is_constant(c.expr, &value)) << text;
+    EXPECT_EQ(value, expected) << text;
+  }
+  const Compiled c = compile("1 && x");  // the right side decides: x != 0 at run time
+  double value = 0;
+  EXPECT_FALSE(c.program.is_constant(c.expr, &value));
+  EXPECT_EQ(eval("1 && x", 0.0), 0.0);
+  EXPECT_EQ(eval("0 || x", 4.0), 1.0);
 }
 
 TEST(Expression, FunctionsInDegrees) {
