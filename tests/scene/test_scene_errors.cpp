@@ -134,7 +134,7 @@ TEST(SceneErrors, OverrideOfOnePathTwice) {
 TEST(SceneErrors, OverrideIndexStartsAnArray) {
   const Scene scene = load_scene_text(kValid, "s.json", ".", {"outputs.0.format=hdf5", "outputs.0.path=a.h5"});
   ASSERT_EQ(scene.outputs.size(), 1u);
-  EXPECT_EQ(scene.outputs[0].format->name, "hdf5");
+  EXPECT_STREQ(scene.outputs[0].format->name, "hdf5");
 }
 
 TEST(SceneErrors, MissingFileNamesTheResolvedPath) {
