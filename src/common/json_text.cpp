@@ -145,6 +145,10 @@ Json parse_json_text(const std::string& text, const std::string& name, const std
   return document;
 }
 
+bool pointer_within(const std::string& pointer, const std::string& target) {
+  return pointer == target || (pointer.starts_with(target) && pointer[target.size()] == '/');
+}
+
 std::string escape_pointer_token(const std::string& token) {
   std::string out;
   for (char c : token) {

@@ -36,4 +36,7 @@ std::string line_column(const std::string& text, size_t offset);
 // JSON-pointer escaping of one reference token ("~" => "~0", "/" => "~1").
 std::string escape_pointer_token(const std::string& token);
 
+// Does `pointer` name `target` or a value below it ("/a/b" is within "/a", "/ab" is not)?
+bool pointer_within(const std::string& pointer, const std::string& target);
+
 }  // namespace treeanim

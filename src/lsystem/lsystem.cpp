@@ -5,6 +5,7 @@
 
 #include "common/direction.h"
 #include "common/errors.h"
+#include "common/json_text.h"
 #include "common/read_text_file.h"
 
 namespace treeanim {
@@ -26,7 +27,7 @@ void check_overrides(const LsystemOptions& options, const Grammar& grammar, cons
       continue;
     std::string known;
     for (const std::string& d : grammar.file_defines) known += (known.empty() ? "" : ", ") + d;
-    throw InputError(options.inline_name() + "/defines/" + name + ": the grammar " + source + " has no '#define " +
+    throw InputError(options.inline_name("/defines/" + name) + ": the grammar " + source + " has no '#define " +
                      name + "' (it defines: " +
                      (known.empty() ? "nothing" : known) + ")");
   }
@@ -83,6 +84,14 @@ ViewSettings load_view(const LsystemOptions& options) {
   return options.view ? read_view_file(*options.view) : ViewSettings{};
 }
 
+std::string LsystemOptions::inline_name(const std::string& suffix) const {
+  const std::string at = pointer + suffix;
+  const std::string* source = &scene_name;
+  for (const auto& [target, argument] : set_by)
+    if (pointer_within(at, target)) source = &argument;
+  return source->empty() ? at : *source + ": " + at;
+}
+
 std::string grammar_name(const LsystemOptions& options) {
   return options.grammar ? options.grammar->string()
                          : options.library_grammar ? options.library_grammar->name : options.inline_name();
@@ -98,8 +107,8 @@ Grammar load_grammar(const LsystemOptions& options, const ViewSettings& view) {
   }
   std::vector<GrammarText> texts;
   for (size_t i = 0; i < options.productions.size(); ++i)
-    texts.push_back({options.inline_name() + "/productions/" + std::to_string(i), options.productions[i], true});
-  return parse_grammar(texts, options.defines, GrammarText{options.inline_name() + "/axiom", options.axiom, true});
+    texts.push_back({options.inline_name("/productions/" + std::to_string(i)), options.productions[i], true});
+  return parse_grammar(texts, options.defines, GrammarText{options.inline_name("/axiom"), options.axiom, true});
 }
 
 std::vector<std::filesystem::path> grammar_input_files(const LsystemOptions& options) {

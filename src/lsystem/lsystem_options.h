@@ -39,8 +39,10 @@ struct LsystemOptions {
   std::optional<int> surface_precision;          // quads per patch along s and t of every view-file surface (1 ... 10)
   std::string scene_name;                        // the scene file that holds the section ("" when none)
   std::string pointer = "/lsystem";              // the section's JSON pointer in it
-  // What messages call the section's inline rules: "scene.json: /lsystem" (+ "/axiom", "/productions/3").
-  std::string inline_name() const { return scene_name.empty() ? pointer : scene_name + ": " + pointer; }
+  std::vector<std::pair<std::string, std::string>> set_by;  // pointer => the --set argument that gave it
+  // What messages call the section's value at `suffix` ("", "/axiom", "/productions/3"): "scene.json:
+  // /lsystem/axiom", or "--set 'lsystem.axiom=F': /lsystem/axiom" for a value given on the command line.
+  std::string inline_name(const std::string& suffix = "") const;
 };
 
 }  // namespace treeanim

@@ -21,8 +21,9 @@ std::vector<std::string> read_productions(SceneObject& section) {
   const Json* value = section.raw("productions");
   if (!value) return out;
   if (!value->is_array()) section.fail_expected("productions", "an array of strings (one production each)");
-  for (const Json& element : *value) {
-    if (!element.is_string()) section.fail_expected("productions", "an array of strings (one production each)");
+  for (size_t i = 0; i < value->size(); ++i) {
+    const Json& element = value->at(i);
+    if (!element.is_string()) section.fail_element("productions", i, "a string (one production)");
     out.push_back(element.get<std::string>());
   }
   return out;
@@ -51,6 +52,7 @@ LsystemOptions read_lsystem_options(SceneObject section, uint64_t scene_seed, co
   LsystemOptions options;
   options.scene_name = section.source_name();
   options.pointer = section.pointer();
+  options.set_by = section.overrides();
   options.grammar = section.optional_path("grammar");
   const std::optional<std::string> axiom = section.optional_string("axiom");
   options.productions = read_productions(section);

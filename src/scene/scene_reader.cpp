@@ -61,6 +61,11 @@ void SceneObject::fail_expected(const std::string& key, const std::string& expec
   fail(key, "expected " + expected + ", got " + (value ? describe_json(*value) : "nothing"));
 }
 
+void SceneObject::fail_element(const std::string& key, size_t index, const std::string& expected) const {
+  reader_->fail(pointer_of(key) + "/" + std::to_string(index),
+                "expected " + expected + ", got " + describe_json(find(key)->at(index)));
+}
+
 const Json* SceneObject::find(const std::string& key) const {
   auto it = node_->find(key);
   return it == node_->end() ? nullptr : &*it;
@@ -227,10 +232,8 @@ std::vector<SceneObject> SceneObject::array_of_objects(const std::string& key) {
   std::vector<SceneObject> out;
   for (size_t i = 0; i < value->size(); ++i) {
     Json& element = (*value)[i];
-    const std::string element_pointer = pointer_of(key) + "/" + std::to_string(i);
-    if (!element.is_object())
-      reader_->fail(element_pointer, "expected an object, got " + describe_json(element));
-    out.emplace_back(reader_, &element, element_pointer);
+    if (!element.is_object()) fail_element(key, i, "an object");
+    out.emplace_back(reader_, &element, pointer_of(key) + "/" + std::to_string(i));
   }
   return out;
 }
@@ -277,7 +280,7 @@ std::string SceneReader::misspelling_of(const std::string& pointer) const {
 const std::string& SceneReader::source_of(const std::string& pointer) const {
   const std::string* source = &source_name_;
   for (const auto& [target, argument] : overrides_)
-    if (pointer == target || pointer.starts_with(target + "/")) source = &argument;
+    if (pointer_within(pointer, target)) source = &argument;
   return *source;
 }
 
@@ -290,6 +293,8 @@ void SceneReader::fail(const std::string& pointer, const std::string& message) c
 const std::string& SceneObject::source_name() const { return reader_->source_name(); }
 
 const std::string& SceneObject::source_of(const std::string& key) const { return reader_->source_of(pointer_of(key)); }
+
+const std::vector<std::pair<std::string, std::string>>& SceneObject::overrides() const { return reader_->overrides(); }
 
 SceneObject SceneReader::root() { return SceneObject(this, &root_, ""); }
 

@@ -81,12 +81,16 @@ class SceneObject {
   const std::string& source_name() const;
   // What messages about `key` name as its source: the override that set it, else source_name().
   const std::string& source_of(const std::string& key) const;
+  // (pointer, "--set '...'") of each value the command line gave, in the order given.
+  const std::vector<std::pair<std::string, std::string>>& overrides() const;
   // The object as read so far (defaults of the keys read are filled in).
   const Json& json() const { return *node_; }
   // Throws InputError "<pointer>/<key>: <message>".
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   // Throws InputError "<pointer>/<key>: expected <expected>, got <value>".
   [[noreturn]] void fail_expected(const std::string& key, const std::string& expected) const;
+  // Throws InputError "<pointer>/<key>/<index>: expected <expected>, got <element>".
+  [[noreturn]] void fail_element(const std::string& key, size_t index, const std::string& expected) const;
 
  private:
   const Json* find(const std::string& key) const;
@@ -124,6 +128,7 @@ class SceneReader {
     overrides_.emplace_back(std::move(pointer), std::move(argument));
   }
   const std::vector<std::filesystem::path>& paths() const { return paths_; }
+  const std::vector<std::pair<std::string, std::string>>& overrides() const { return overrides_; }
 
  private:
   void check_object(const Json& node, const std::string& pointer) const;

@@ -75,8 +75,10 @@ TEST(LsystemOptions, ErrorsAreJsonPointers) {
             "scene.json: /lsystem/productions: inline productions go with /lsystem/axiom, not with a grammar "
             "file (/lsystem/grammar)");
   EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "productions": ["F --> FF", 3]}})"),
+            "scene.json: /lsystem/productions/1: expected a string (one production), got 3");
+  EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "productions": "F --> FF"}})"),
             "scene.json: /lsystem/productions: expected an array of strings (one production each), got "
-            "[\"F --> FF\",3]");
+            "\"F --> FF\"");
   EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "defines": {"k": "x"}}})"),
             "scene.json: /lsystem/defines/k: expected a finite number, got \"x\"");
   EXPECT_EQ(lsystem_error_of(R"({"lsystem": {"axiom": "F", "defines": {"2k": 1}}})"),
