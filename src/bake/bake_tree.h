@@ -67,7 +67,7 @@ struct TreeBakeResult {
   long long substeps = 0;                                 // simulated by this process
   double seconds = 0;                                     // s, the whole bake
   double run_seconds = 0;                                 // s, the frame loop and the outputs' finish
-  std::vector<std::filesystem::path> final_paths;         // an output's file, or its sequence's first
+  std::vector<SummaryFile> final_paths;                   // each output's files, a sequence by its first and last
   std::vector<std::pair<std::filesystem::path, std::string>> reports;  // (path, what its output says)
   std::vector<std::vector<std::filesystem::path>> files;  // (outputs) every file of each output
   std::optional<LoopSummary> loop;                        // a loop baked whole

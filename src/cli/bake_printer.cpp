@@ -54,7 +54,11 @@ void BakePrinter::print_summary(const TreeBakeResult& result) const {
               result.written.count(), result.written.count() == 1 ? "" : "s", result.vertices, samples.c_str(),
               result.clusters, result.substeps,
               result.seconds, result.run_seconds);
-  for (const auto& path : result.final_paths) std::printf("  wrote %s\n", printable_text(path.string()).c_str());
+  for (const SummaryFile& file : result.final_paths) {
+    if (file.files == 1) std::printf("  wrote %s\n", printable_text(file.path.string()).c_str());
+    else std::printf("  wrote %s ... %s (%lld files)\n", printable_text(file.path.string()).c_str(),
+                     printable_text(file.last.filename().string()).c_str(), file.files);
+  }
   for (const auto& [path, line] : result.reports) std::printf("  %s: %s\n", printable_text(path.string()).c_str(), line.c_str());
   if (!result.loop) return;
   const LoopSummary& loop = *result.loop;

@@ -29,8 +29,8 @@ struct FrameSelection {
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  // The files named in the run's summary (a sequence's first frame stands for the rest).
-  virtual std::vector<std::filesystem::path> summary_paths() const = 0;
+  // The files named in the run's summary (a sequence by its first and last frame).
+  virtual std::vector<SummaryFile> summary_paths() const = 0;
   // Opens the temporaries and writes what does not change over frames.
   virtual void begin() = 0;
   // Appends one selected frame. Throws OutputError naming the path.

@@ -292,7 +292,7 @@ class GlbSink final : public FrameSink {
                                      size_t(selection_.written()),
                                      target_names(selection_))) {}
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override {
     reserved_json_ = render_json(content_).size();

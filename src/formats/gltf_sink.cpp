@@ -22,9 +22,9 @@ class GltfSink final : public FrameSink {
       : pattern_(sequence_pattern(path, ".glb", options.where())), model_(model), info_(info),
         normals_(options.normals), selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  std::vector<fs::path> summary_paths() const override {
+  std::vector<SummaryFile> summary_paths() const override {
     if (selection_.written() == 0) return {};
-    return {pattern_.frame(selection_.start)};
+    return {sequence_summary(pattern_, selection_)};
   }
 
   // The rest mesh; write() replaces its positions and normals in the buffer frame by frame.

@@ -28,7 +28,7 @@ class Hdf5Sink final : public FrameSink {
   Hdf5Sink(const OutputOptions& options, fs::path path, const TreeModel& model, const BakeInfo& info)
       : options_(options), path_(std::move(path)), model_(model), info_(info) {}
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override {
     const auto lock = hdf5_lock();

@@ -138,7 +138,7 @@ class HtmlSink final : public FrameSink {
                        ": raise max_mib where its range allows, or leave the html output out");
   }
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override { temporary_ = staged_.stage(path_); }
 

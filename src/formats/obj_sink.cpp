@@ -29,9 +29,9 @@ class ObjSink final : public FrameSink {
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals),
         mtl_(mtl_path(pattern_)) {}
 
-  std::vector<fs::path> summary_paths() const override {
-    if (selection_.written() == 0) return {pattern_.rest()};
-    return {pattern_.rest(), pattern_.frame(selection_.start)};
+  std::vector<SummaryFile> summary_paths() const override {
+    if (selection_.written() == 0) return {{pattern_.rest()}};
+    return {{pattern_.rest()}, sequence_summary(pattern_, selection_)};
   }
 
   void begin() override {

@@ -273,7 +273,7 @@ OutputSet::OutputSet(const std::vector<OutputOptions>& outputs, const fs::path& 
     worker->sink = find_sink_factory(options.format->name)(options, output.path, model, info);  // the row OutputFiles found
     worker->selection = output.selection;
     const auto summary = worker->sink->summary_paths();
-    worker->first_path = summary.empty() ? output.path : summary.front();
+    worker->first_path = summary.empty() ? output.path : summary.front().path;
     worker->estimated_bytes = estimated_output_bytes(options, model.vertex_count(), model.triangle_count(),
                                                      model.cluster_count(), info.frame_count);
     impl_->velocities = impl_->velocities || options.velocities;
@@ -407,10 +407,10 @@ std::vector<fs::path> OutputSet::files(size_t k) const {
   return files;
 }
 
-std::vector<fs::path> OutputSet::final_paths() const {
-  std::vector<fs::path> paths;
+std::vector<SummaryFile> OutputSet::final_paths() const {
+  std::vector<SummaryFile> paths;
   for (const auto& worker : impl_->workers)
-    for (const fs::path& path : worker->sink->summary_paths()) paths.push_back(path);
+    for (const SummaryFile& file : worker->sink->summary_paths()) paths.push_back(file);
   return paths;
 }
 

@@ -114,6 +114,14 @@ class OutputTargets {
   std::vector<std::filesystem::path> probes_;            // the first file of each folder
 };
 
+// A line of the run's summary: one file, or a sequence of `files` frames' files from `path` to
+// `last` (a sequence of one frame is one file).
+struct SummaryFile {
+  std::filesystem::path path;
+  long long files = 1;
+  std::filesystem::path last = {};
+};
+
 class OutputSet {
  public:
   // Resolves relative paths against out_dir (when not empty), checks every target (folder
@@ -146,8 +154,8 @@ class OutputSet {
   bool finish(const std::function<bool()>& stop = [] { return false; });
   // Stops the writer and removes every temporary. Never throws.
   void abort() noexcept;
-  // Final paths (files, or the first file of a sequence pattern) for the summary line.
-  std::vector<std::filesystem::path> final_paths() const;
+  // What the run's summary names: each file, or each sequence's first and last.
+  std::vector<SummaryFile> final_paths() const;
   // Every file of output k, in the order of its sink (a sequence: each frame's file and the rest mesh).
   std::vector<std::filesystem::path> files(size_t k) const;
   // Each output's first file and the bytes of the frames it will write (estimated_output_bytes).

@@ -49,7 +49,7 @@ class PointCacheSink final : public FrameSink {
       : format_(format), files_(point_cache_files(format, path)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step} {}
 
-  std::vector<fs::path> summary_paths() const override { return {files_.cache, files_.rest}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{files_.cache}, {files_.rest}}; }
 
   void begin() override {
     write_mtl_file(staged_.stage(files_.mtl), files_.mtl, info_.generator + ", materials", info_.materials);

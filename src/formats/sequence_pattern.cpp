@@ -5,6 +5,7 @@
 #include "common/errors.h"
 #include "common/frame_field.h"
 #include "common/message_text.h"
+#include "formats/frame_sink.h"
 
 namespace treeanim {
 
@@ -36,6 +37,11 @@ SequencePattern sequence_pattern(const fs::path& path, const std::string& extens
     throw InputError(pointer + "/path: expected a file name that ends in " + extension + " after its frame field (e.g. \"" +
                      excerpt(name.substr(0, field.begin + field.length)) + extension + "\"), got \"" + excerpt(text) + "\"");
   return pattern;
+}
+
+SummaryFile sequence_summary(const SequencePattern& pattern, const FrameSelection& selection) {
+  const long long files = selection.written();
+  return {pattern.frame(selection.start), files, pattern.frame(selection.start + (files - 1) * selection.step)};
 }
 
 }  // namespace treeanim

@@ -21,4 +21,9 @@ struct SequencePattern {
 SequencePattern sequence_pattern(const std::filesystem::path& path, const std::string& extension,
                                  const std::string& pointer);
 
+struct FrameSelection;
+struct SummaryFile;
+// The frames' files of `selection` by this pattern, as the run's summary names them.
+SummaryFile sequence_summary(const SequencePattern& pattern, const FrameSelection& selection);
+
 }  // namespace treeanim

@@ -38,7 +38,7 @@ class SkinnedGlbSink final : public FrameSink {
                         " frames); lower max_joints, raise frame_step or shorten the bake");
   }
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override {
     temporary_ = staged_.stage(path_);

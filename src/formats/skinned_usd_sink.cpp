@@ -30,7 +30,7 @@ class SkinnedUsdSink final : public FrameSink {
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals),
         skin_(build_skin(model, options.max_joints > 0 ? options.max_joints : model.cluster_count())) {}
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override { file_.emplace(staged_.stage(path_), path_); }
 

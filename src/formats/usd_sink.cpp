@@ -31,7 +31,7 @@ class UsdSink final : public FrameSink {
       : path_(std::move(path)), model_(model), info_(info),
         selection_{info.frame_start, info.frame_count, options.frame_step}, normals_(options.normals) {}
 
-  std::vector<fs::path> summary_paths() const override { return {path_}; }
+  std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }
 
   void begin() override {
     temporary_ = staged_.stage(path_);

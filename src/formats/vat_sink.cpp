@@ -139,8 +139,8 @@ class VatSink final : public FrameSink {
                        " (raise frame_step or shorten the bake)");
   }
 
-  std::vector<fs::path> summary_paths() const override {
-    return {stem_ + ".positions.exr", stem_ + ".normals.exr", stem_ + ".glb", stem_ + ".json"};
+  std::vector<SummaryFile> summary_paths() const override {
+    return {{stem_ + ".positions.exr"}, {stem_ + ".normals.exr"}, {stem_ + ".glb"}, {stem_ + ".json"}};
   }
 
   void begin() override {

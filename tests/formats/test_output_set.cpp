@@ -108,10 +108,28 @@ TEST_F(OutputSetTest, FinishRenamesEveryTemporary) {
                                                  "tree.pc2", "tree.rest.mtl", "tree.rest.obj"}));
   const auto paths = set.final_paths();
   ASSERT_EQ(paths.size(), 7u);
-  EXPECT_EQ(paths[0], dir_ / "bake.h5");
-  EXPECT_EQ(paths[1], dir_ / "obj/tree.rest.obj");
-  EXPECT_EQ(paths[2], dir_ / "obj/tree.0000.obj");
-  EXPECT_EQ(paths[3], dir_ / "gltf/tree.0000.glb");
+  EXPECT_EQ(paths[0].path, dir_ / "bake.h5");
+  EXPECT_EQ(paths[1].path, dir_ / "obj/tree.rest.obj");
+  EXPECT_EQ(paths[2].path, dir_ / "obj/tree.0000.obj");
+  EXPECT_EQ(paths[3].path, dir_ / "gltf/tree.0000.glb");
+  for (const SummaryFile& file : paths) EXPECT_EQ(file.files, 1);
+}
+
+// A sequence is named by its first and last frame's files and how many there are.
+TEST_F(OutputSetTest, SummaryNamesASequenceByItsFirstAndLastFile) {
+  const TreeModel m = small_model();
+  std::vector<OutputOptions> outputs = every_format();
+  for (OutputOptions& o : outputs) o.frame_step = 2;
+  OutputSet set(outputs, dir_, m, small_info(5, 3));
+  const auto paths = set.final_paths();
+  ASSERT_EQ(paths.size(), 7u);
+  EXPECT_EQ(paths[0].files, 1);
+  EXPECT_EQ(paths[2].path, dir_ / "obj/tree.0003.obj");
+  EXPECT_EQ(paths[2].last, dir_ / "obj/tree.0007.obj");
+  EXPECT_EQ(paths[2].files, 3);
+  EXPECT_EQ(paths[3].path, dir_ / "gltf/tree.0003.glb");
+  EXPECT_EQ(paths[3].last, dir_ / "gltf/tree.0007.glb");
+  EXPECT_EQ(paths[3].files, 3);
 }
 
 TEST_F(OutputSetTest, AFrameEveryWriterIsDoneWithComesBackToBeFilledAgain) {
