@@ -44,7 +44,7 @@ int arity_of(Op op) {
     case Op::kNeg: case Op::kNot: case Op::kStoreVar: case Op::kStoreParam: case Op::kPop:
     case Op::kJumpIfZero: case Op::kIndex: case Op::kLoadElem: case Op::kFclose: case Op::kFscan: return 1;
     case Op::kStoreElem: return 2;
-    case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem:
+    case Op::kAdd: case Op::kSub: case Op::kMul: case Op::kDiv: case Op::kPow: case Op::kRem: case Op::kIntRem:
     case Op::kLt: case Op::kLe: case Op::kGt: case Op::kGe: case Op::kEq: case Op::kNe: return 2;
     default: break;
   }
@@ -89,8 +89,9 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   return near;
 }
 
-// Recursive-descent compiler of one expression into program.code (precedence, lowest first:
-// || && comparisons +- */ unary ^).
+// Recursive-descent compiler of one expression into program.code. Precedence, lowest first, is
+// cpfg's (its parser, lsys_input.y): ?: || && (== !=) (< <= > >=) (+ -) (* / %) ^ unary, each
+// binary level grouping to the left, so -2^2 = 4 and 2^3^2 = 64 as cpfg computes them.
 class Compiler {
  public:
   Compiler(ExprProgram& program, std::string_view text, size_t pos, const TextOrigin& line,
@@ -276,7 +277,21 @@ class Compiler {
       land(past);
     }
   }
-  void parse_comparison() {
+  void parse_comparison() {  // == and != bind less tightly than < <= > >=, as in C and cpfg
+    parse_relation();
+    for (;;) {
+      skip_space();
+      const size_t where = pos_;
+      Op op;
+      if (accept("==")) op = Op::kEq;
+      else if (accept("!=")) op = Op::kNe;
+      else if (peek() == '=') fail(pos_, "expected '==' to compare, got '='");
+      else return;
+      parse_relation();
+      emit(op, 0, where);
+    }
+  }
+  void parse_relation() {
     parse_sum();
     for (;;) {
       skip_space();
@@ -284,9 +299,6 @@ class Compiler {
       Op op;
       if (accept("<=")) op = Op::kLe;
       else if (accept(">=")) op = Op::kGe;
-      else if (accept("==")) op = Op::kEq;
-      else if (accept("!=")) op = Op::kNe;
-      else if (peek() == '=') fail(pos_, "expected '==' to compare, got '='");
       else if (accept("<")) op = Op::kLt;
       else if (accept(">")) op = Op::kGt;
       else return;
@@ -305,14 +317,24 @@ class Compiler {
     }
   }
   void parse_product() {
+    parse_power();
+    for (;;) {
+      skip_space();
+      const size_t where = pos_;
+      if (accept("*")) { parse_power(); emit(Op::kMul, 0, where); }
+      else if (accept("/")) { parse_power(); emit(Op::kDiv, 0, where); }
+      else if (accept("%")) { parse_power(); emit(Op::kIntRem, 0, where); }
+      else return;
+    }
+  }
+  void parse_power() {
     parse_unary();
     for (;;) {
       skip_space();
       const size_t where = pos_;
-      if (accept("*")) { parse_unary(); emit(Op::kMul, 0, where); }
-      else if (accept("/")) { parse_unary(); emit(Op::kDiv, 0, where); }
-      else if (accept("%")) { parse_unary(); emit(Op::kRem, 0, where); }
-      else return;
+      if (!accept("^")) return;
+      parse_unary();
+      emit(Op::kPow, 0, where);
     }
   }
   // Every parenthesis, call and unary operator nests the recursion one level deeper.
@@ -323,18 +345,8 @@ class Compiler {
     if (accept("-")) { parse_unary(); emit(Op::kNeg, 0, where); }
     else if (accept("+")) parse_unary();
     else if (peek() == '!' && peek(1) != '=') { ++pos_; parse_unary(); emit(Op::kNot, 0, where); }
-    else parse_power();
+    else parse_primary();
     --nesting_;
-  }
-  // '^' binds tighter than unary minus (-2^2 = -4) and groups to the right (2^3^2 = 2^9).
-  void parse_power() {
-    parse_primary();
-    skip_space();
-    const size_t where = pos_;
-    if (accept("^")) {
-      parse_unary();
-      emit(Op::kPow, 0, where);
-    }
   }
   void parse_primary() {
     skip_space();
@@ -859,6 +871,9 @@ namespace {
       case Op::kRem:
         if (b == 0.0) eval_fail(program, k, "division by zero");
         a = std::fmod(a, b); --top; break;
+      case Op::kIntRem:  // cpfg's (int)a % (int)b, without C's overflow past int
+        if (std::trunc(b) == 0.0) eval_fail(program, k, "division by zero ('%' takes whole numbers: its divisor truncates to 0)");
+        a = std::fmod(std::trunc(a), std::trunc(b)); --top; break;
       case Op::kPow: a = std::pow(a, b); --top; break;
       case Op::kNeg: stack[top] = -b; break;
       case Op::kNot: stack[top] = b == 0.0 ? 1.0 : 0.0; break;

@@ -56,7 +56,7 @@ enum class Op : uint8_t {
   kLt, kLe, kGt, kGe, kEq, kNe,                    // comparisons: 1 or 0 (&& and || are jumps)
   kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2,   // degrees
   kSqrt, kExp, kLog, kAbs, kMin, kMax, kFloor, kCeil,
-  kRem, kTrunc, kSign,                             // C's fmod, trunc; sign: -1, 0, 1
+  kRem, kIntRem, kTrunc, kSign,                    // C's fmod, cpfg's % (of the truncated operands), trunc; sign: -1, 0, 1
   kFunc,                                           // view-file function functions[arg] at x
   kCurve, kCurveLength,                            // curves[arg / 3] coordinate arg % 3 at t; curves[arg] length
   kRan, kNran, kBran, kBiran, kSrand,              // random: never folded

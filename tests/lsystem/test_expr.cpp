@@ -36,13 +36,29 @@ double eval(const std::string& text, double x = 2.0, double y = 3.0) {
 TEST(Expression, ArithmeticPrecedence) {
   EXPECT_EQ(eval("1+2*3"), 7.0);
   EXPECT_EQ(eval("(1+2)*3"), 9.0);
-  EXPECT_EQ(eval("2^3^2"), 512.0);       // right-associative
-  EXPECT_EQ(eval("-2^2"), -4.0);         // ^ binds tighter than unary minus
+  // cpfg's precedence (lsys_input.y): ^ groups to the left, unary minus binds tighter.
+  EXPECT_EQ(eval("2^3^2"), 64.0);
+  EXPECT_EQ(eval("-2^2"), 4.0);
+  EXPECT_EQ(eval("-x^2"), 4.0);
   EXPECT_EQ(eval("2^-1"), 0.5);
+  EXPECT_EQ(eval("2*3^2"), 18.0);        // ^ before * /
+  EXPECT_EQ(eval("!0^2"), 1.0);
   EXPECT_EQ(eval("7-2-1"), 4.0);         // left-associative
   EXPECT_EQ(eval("8/2/2"), 2.0);
   EXPECT_EQ(eval("1/3"), 1.0 / 3.0);
   EXPECT_EQ(eval(".5e1 + 1E-1"), 5.1);
+}
+
+// '%' is cpfg's: the remainder of the operands truncated to whole numbers, with the dividend's
+// sign as in C; fmod() is C's, of the reals.
+TEST(Expression, RemainderTakesWholeNumbersAsCpfg) {
+  EXPECT_EQ(eval("7.5 % 2"), 1.0);
+  EXPECT_EQ(eval("7 % 2.9"), 1.0);
+  EXPECT_EQ(eval("-7 % 3"), -1.0);
+  EXPECT_EQ(eval("7 % -3"), 1.0);
+  EXPECT_EQ(eval("fmod(7.5, 2)"), 1.5);
+  EXPECT_EQ(eval("1e300 % 7"), std::fmod(1e300, 7.0));  // no int to overflow
+  EXPECT_EQ(eval("2 * 7 % 4"), 2.0);                     // left to right with * and /
 }
 
 TEST(Expression, NamesFormalsShadowDefines) {
@@ -58,6 +74,9 @@ TEST(Expression, ComparisonsAndLogic) {
   EXPECT_EQ(eval("!(x == 2)"), 0.0);
   EXPECT_EQ(eval("!0 + !5"), 1.0);
   EXPECT_EQ(eval("1 + 2 < 4"), 1.0);  // arithmetic before comparison
+  EXPECT_EQ(eval("0 == 0 < 5"), 0.0);  // < before ==, as in C and cpfg: 0 == (0 < 5)
+  EXPECT_EQ(eval("1 < 2 == 1"), 1.0);
+  EXPECT_EQ(eval("3 != 2 > 1"), 1.0);
   // The right operand runs only when the left leaves the answer open, as in C and cpfg.
   EXPECT_EQ(eval("x != 0 && 1 / x > 0", 0.0), 0.0);
   EXPECT_EQ(eval("x == 0 || 1 / x > 0", 0.0), 1.0);
@@ -178,6 +197,7 @@ TEST(Expression, CompileErrors) {
   EXPECT_EQ(compile_error("sinh(1)"), "1: unknown function 'sinh' (did you mean 'sin'?)");
   EXPECT_EQ(compile_error("x = 1"), "3: expected '==' to compare, got '='");
   EXPECT_EQ(compile_error("1/(2-2)"), "2: division by zero");
+  EXPECT_EQ(compile_error("5 % 0.5"), "3: division by zero ('%' takes whole numbers: its divisor truncates to 0)");
   EXPECT_EQ(compile_error("x, 1"), "no error, stopped at 1");  // ',' ends an actual parameter
   EXPECT_EQ(compile_error(std::string(300, '(') + "1" + std::string(300, ')')), "257: expression too deeply nested");
   EXPECT_EQ(compile_error(std::string(17, '1') + "e999"), "1: number out of range");
