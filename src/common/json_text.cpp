@@ -5,6 +5,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/message_text.h"
+
 namespace treeanim {
 
 namespace {
@@ -99,7 +101,10 @@ std::string line_column(const std::string& text, size_t offset) {
   const size_t end = std::min(offset, text.size());
   const size_t line = 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + static_cast<long>(end), '\n'));
   const size_t line_start = text.rfind('\n', end == 0 ? 0 : end - 1);
-  const size_t column = line_start == std::string::npos || end == 0 ? end + 1 : end - line_start;
+  const size_t first = line_start == std::string::npos || end == 0 ? 0 : line_start + 1;
+  const size_t column = 1 + static_cast<size_t>(std::count_if(text.begin() + static_cast<long>(first),
+                                                              text.begin() + static_cast<long>(end),
+                                                              [](char c) { return !continues_character(c); }));
   return std::to_string(line) + ":" + std::to_string(column);
 }
 

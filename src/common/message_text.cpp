@@ -66,8 +66,8 @@ std::string printable_text(std::string_view text) {
 std::string shown_message(std::string_view text, size_t most) {
   if (text.size() <= most) return printable_text(text);
   size_t head = most * 3 / 4, tail = text.size() - most / 4;
-  while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
-  while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
+  while (head > 0 && continues_character(text[head])) --head;
+  while (tail < text.size() && continues_character(text[tail])) ++tail;
   return printable_text(text.substr(0, head)) + " [... " + std::to_string(tail - head) + " bytes left out ...] " +
          printable_text(text.substr(tail));
 }
@@ -75,7 +75,7 @@ std::string shown_message(std::string_view text, size_t most) {
 std::string excerpt(std::string_view text, size_t most) {
   if (text.size() <= most) return printable_text(text);
   size_t cut = most >= 3 ? most - 3 : 0;
-  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+  while (cut > 0 && continues_character(text[cut])) --cut;
   return printable_text(text.substr(0, cut)) + "...";
 }
 

@@ -22,6 +22,10 @@ std::string shown_message(std::string_view text, size_t most = 2000);
 // its first NUL).
 std::string excerpt(std::string_view text, size_t most = 60);
 
+// A byte that continues a UTF-8 character (10xxxxxx): messages count a line's columns in
+// characters, as an editor shows them, so such a byte takes its character's column.
+inline bool continues_character(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+
 // A number in a message, as a stream writes it: six significant digits ("0.02", "1e-09", "inf").
 std::string number_text(double value);
 

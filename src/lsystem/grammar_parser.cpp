@@ -199,26 +199,29 @@ class Parser {
     };
   }
 
-  // Whether the pending statement has parentheses open, or braces before its arrow (blocks of a
-  // rule's head, Start: blocks): then it goes on to the next line. An axiom has no head: its
-  // braces are polygons ("F{.+F.A", closed by a rule), which never join the next line. Read as
-  // lines join the statement, each character once (a rule of a million lines was read again
-  // for each).
+  // Whether the pending statement has parentheses open, or braces between a ':' and its arrow
+  // (blocks of a rule's head, which follow its ':', and Start: blocks): then it goes on to the
+  // next line. Any other brace is a polygon's, which never joins the next line: an axiom's
+  // ("F{.+F.A", closed by a rule), an ignore: or consider: list's, a predecessor's ("{ --> {"
+  // rewrites one). Read as lines join the statement, each character once (a rule of a million
+  // lines was read again for each).
   bool pending_open() {
     PendingNesting& n = nesting_;
     const std::string& t = pending_.text;
     if (n.scanned == 0 && !t.empty()) {
       size_t b = 0, e = t.size(), value = 0;
       trim(t, &b, &e);
-      n.axiom = match_keyword(t, b, e, "axiom", true, &value);
+      n.symbols = match_keyword(t, b, e, "axiom", true, &value) || match_keyword(t, b, e, "ignore", true, &value) ||
+                  match_keyword(t, b, e, "consider", true, &value);
     }
     for (; n.scanned < t.size(); ++n.scanned) {
       const size_t k = n.scanned;
       if (t[k] == '(') ++n.parens;
       else if (t[k] == ')') --n.parens;
       else if (t[k] == '>' && k > 0 && t[k - 1] == '-') n.past_arrow = true;
-      else if (!n.axiom && !n.past_arrow && t[k] == '{') ++n.braces;
-      else if (!n.axiom && !n.past_arrow && t[k] == '}') --n.braces;
+      else if (t[k] == ':' && n.parens == 0) n.past_colon = true;
+      else if (!n.symbols && n.past_colon && !n.past_arrow && t[k] == '{') ++n.braces;
+      else if (!n.symbols && n.past_colon && !n.past_arrow && t[k] == '}') --n.braces;
     }
     return n.parens > 0 || n.braces > 0;
   }
@@ -969,7 +972,7 @@ class Parser {
   struct PendingNesting {
     size_t scanned = 0;  // characters of pending_ read
     int parens = 0, braces = 0;
-    bool axiom = false, past_arrow = false;
+    bool symbols = false, past_colon = false, past_arrow = false;  // symbols: axiom:, ignore:, consider:
   } nesting_;            // of pending_, as pending_open() read it
   std::optional<Preprocessor> preprocessor_;  // one for all texts: an inline grammar's lines share its #defines
 };

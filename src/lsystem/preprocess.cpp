@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include "common/message_text.h"
+
 namespace treeanim {
 
 namespace {
@@ -24,40 +26,38 @@ bool in_name(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c =
 
 [[noreturn]] void fail(SourcePos at, const std::string& message) { throw GrammarError{at, message}; }
 
-// text => the same text with comments blanked (newlines kept, so lines and columns stay).
+// text => the same text with each character of a comment blanked to one space (newlines kept,
+// so lines and columns, counted in characters, stay).
 std::string strip_comments(const std::string& text, int32_t source, bool single_line) {
-  std::string out = text;
-  int32_t line = 1, column = 1;
-  for (size_t k = 0; k < out.size(); ++k, ++column) {
-    if (out[k] == '\n') {
-      ++line;
-      column = 0;
-      continue;
-    }
-    if (out[k] != '/' || k + 1 >= out.size()) continue;
+  std::string out;
+  out.reserve(text.size());
+  int32_t line = 1, column = 1;  // where text[k] stands
+  for (size_t k = 0; k < text.size();) {
     // "//" starts a comment, as cpp (which cpfg runs) reads it, after a module too ("FF// x");
     // a run of three or more '/' is roll modules (ABOP's "/////").
-    const bool line_comment = out[k + 1] == '/' && (k == 0 || out[k - 1] != '/') &&
-                              (k + 2 >= out.size() || out[k + 2] != '/');
+    const bool slash = text[k] == '/' && k + 1 < text.size();
+    const bool line_comment = slash && text[k + 1] == '/' && (out.empty() || out.back() != '/') &&
+                              (k + 2 >= text.size() || text[k + 2] != '/');
+    size_t end = k + 1;  // past the comment, or past this byte
     if (line_comment) {
-      while (k < out.size() && out[k] != '\n') out[k++] = ' ';
-      --k;
-      --column;
-    } else if (out[k + 1] == '*') {
-      const SourcePos open{source, single_line ? 0 : line, column};
-      const size_t close = out.find("*/", k + 2);
-      if (close == std::string::npos) fail(open, "'/*' comment is never closed (expected '*/')");
-      for (size_t j = k; j < close + 2; ++j) {
-        if (out[j] == '\n') {
-          ++line;
-          column = 0;
-        } else {
-          out[j] = ' ';
-          ++column;
-        }
+      end = std::min(text.find('\n', k), text.size());
+    } else if (slash && text[k + 1] == '*') {
+      const size_t close = text.find("*/", k + 2);
+      if (close == std::string::npos)
+        fail({source, single_line ? 0 : line, column}, "'/*' comment is never closed (expected '*/')");
+      end = close + 2;
+    }
+    const bool comment = end > k + 1;
+    for (; k < end; ++k) {
+      const char c = text[k];
+      if (c == '\n') {
+        ++line;
+        column = 1;
+      } else if (!continues_character(c)) {
+        ++column;
       }
-      k = close + 1;
-      --column;
+      if (!comment || c == '\n') out += c;
+      else if (!continues_character(c)) out += ' ';
     }
   }
   return out;
@@ -68,7 +68,8 @@ SourceLine make_line(std::string_view text, SourcePos start) {
   line.text = std::string(text);
   line.start = start;
   line.columns.reserve(text.size());
-  for (size_t k = 0; k < text.size(); ++k) line.columns.push_back({start.source, start.line, start.column + static_cast<int32_t>(k)});
+  int32_t column = start.column - 1;  // a byte that continues a character takes its column
+  for (const char c : text) line.columns.push_back({start.source, start.line, continues_character(c) ? column : ++column});
   return line;
 }
 

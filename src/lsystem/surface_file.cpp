@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 #include "common/read_text_file.h"
 
 namespace treeanim {
@@ -69,7 +70,7 @@ class SurfaceReader {
         tokens_.back().text = std::string_view(text).substr(start, k - start);
         start = std::string::npos;
       }
-      ++column;
+      if (!continues_character(c)) ++column;
       if (c == '\n') {
         ++line;
         column = 1;
@@ -85,9 +86,11 @@ class SurfaceReader {
     // The end of the file is reported just after its last token.
     const Token* last = tokens_.empty() ? nullptr : &tokens_.back();
     const int line = t ? t->line : last ? last->line : 1;
-    const int column = t ? t->column : last ? last->column + static_cast<int>(last->text.size()) : 1;
-    std::string got = t ? "'" + std::string(t->text.substr(0, 24)) + (t->text.size() > 24 ? "...'" : "'")
-                        : "the end of the file";
+    const auto characters = [](std::string_view text) {
+      return static_cast<int>(std::count_if(text.begin(), text.end(), [](char c) { return !continues_character(c); }));
+    };
+    const int column = t ? t->column : last ? last->column + characters(last->text) : 1;
+    std::string got = t ? "'" + excerpt(t->text, 27) + "'" : "the end of the file";
     throw InputError(name_ + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message + ", got " + got);
   }
 

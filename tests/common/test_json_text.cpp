@@ -85,5 +85,13 @@ TEST(JsonText, LineColumnCountsFromOne) {
   EXPECT_EQ(line_column("ab\ncd", 4), "2:2");
 }
 
+// Columns count characters, as an editor shows them, not the bytes of their UTF-8.
+TEST(JsonText, LineColumnCountsCharacters) {
+  EXPECT_EQ(line_column("\"\xC3\xA9t\xC3\xA9\" x", 8), "1:7");
+  EXPECT_EQ(line_column("a\n\xE2\x86\x92\xF0\x9F\x8C\xB3 x", 10), "2:4");
+  EXPECT_EQ(error_of("{\"name\": \"\xC3\xA9t\xC3\xA9\", }"), "s.json:1:17: JSON syntax error: syntax error while parsing "
+            "object key - unexpected '}'; expected string literal");
+}
+
 }  // namespace
 }  // namespace treeanim

@@ -80,6 +80,14 @@ TEST(Cpfg, BlocksVariablesAndControlBlocks) {
             "A(0)B(1)B(2)");  // step 1: m = 2, count 10; step 2: m = 4 -> 0, count 11
 }
 
+// A block after a rule's ':' continues over lines until its braces close; any other brace is a
+// polygon's and never takes in the next line: a predecessor's, an axiom's, an ignore: list's.
+TEST(Cpfg, OnlyABlockTakesInTheNextLine) {
+  EXPECT_EQ(derive_text("axiom: A(1)\nA(n) : {m = n;\nm = m + 1;} m > 0 --> A(m)\n", 2), "A(3)");
+  EXPECT_EQ(derive_text("axiom: A{.F}\n{ --> {\nA --> FA\n", 1), "FA{.F}");
+  EXPECT_EQ(derive_text("ignore: {}\naxiom: A{B}\nA < B --> C\n", 1), "A{C}");
+}
+
 // The homomorphism reads the globals as the derivation's End block leaves them.
 TEST(Cpfg, HomomorphismReadsTheGlobalsTheDerivationLeaves) {
   const Grammar g = parse_plant(
@@ -395,6 +403,14 @@ TEST(Cpfg, LabelsTakeAStringAndDrawNothing) {
   EXPECT_EQ(k.segment_end.size(), 2u);
   EXPECT_TRUE(k.leaf_segment.empty());
   EXPECT_EQ(plant_error_of("axiom: @L(\"open)\n"), "plant.l:1:11: the string is never closed (expected '\"')");
+}
+
+// A column counts characters, so a comment or label in UTF-8 before the fault moves it by its
+// characters, not by their bytes.
+TEST(Cpfg, ColumnsCountCharacters) {
+  EXPECT_EQ(plant_error_of("axiom: /* \xC3\xA9t\xC3\xA9 */ F(1/)\n"), "plant.l:1:22: expected a number, a name or '(', got ')'");
+  EXPECT_EQ(plant_error_of("axiom: @L(\"\xE2\x86\x92\") F(1/)\n"), "plant.l:1:20: expected a number, a name or '(', got ')'");
+  EXPECT_EQ(plant_error_of("/* \xC3\xA9\n\xC3\xA9 */ axiom: F(1/)\n"), "plant.l:2:17: expected a number, a name or '(', got ')'");
 }
 
 // curveX/curveY/curveZ/curveGAL (CPFG manual 5.5) read the view file's curves by arc length.
