@@ -16,8 +16,14 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
   plan.use_checkpoints = config.checkpoints.resume || config.frames.has_value();
   plan.checkpoints = config.checkpoints;
   plan.key = {bake_key(scene, config.generator), config.generator, scene.hsm.precision == Precision::kFloat};
-  plan.reads_mesh = !scene.outputs.empty() || plan.checkpoints.every > 0 || plan.closes_loop;
+  plan.reads_mesh = !scene.outputs.empty() || plan.written.first < last_checkpoint(plan) || plan.closes_loop;
   return plan;
+}
+
+long long last_checkpoint(const BakePlan& plan) {
+  const long long every = plan.checkpoints.every;
+  if (every <= 0 || plan.written.last <= plan.first) return plan.first;
+  return plan.first + (plan.written.last - plan.first) / every * every;
 }
 
 double frame_time(const BakePlan& plan, long long frame) { return static_cast<double>(frame) * plan.frame_dt; }

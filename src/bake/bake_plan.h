@@ -20,7 +20,7 @@ struct BakePlan {
   bool use_checkpoints = false;  // --resume or --frames: look for a checkpoint at all
   CheckpointPolicy checkpoints;
   CheckpointKey key;
-  // Something reads each frame's mesh: an output, the checkpoints' journal or a loop's seam.
+  // Something reads each frame's mesh: an output, the frame journal or a loop's seam.
   bool reads_mesh = false;
 };
 
@@ -28,6 +28,12 @@ struct BakePlan {
 // time.start (or at a checkpoint of this bake), so frame k of a split bake is bit-identical to
 // frame k of the whole bake.
 BakePlan plan_bake(const Scene& scene, const BakeConfig& config);
+
+// The frame of the last checkpoint a bake of `plan` writes (a multiple of checkpoints.every
+// after time.start, up to the last written frame), plan.first when it writes none. The frame
+// journal holds the written frames before it, the ones a resume from a checkpoint replays:
+// none when the bake writes no checkpoint (--checkpoint-every past its frames).
+long long last_checkpoint(const BakePlan& plan);
 
 // The simulation time of `frame` (s).
 double frame_time(const BakePlan& plan, long long frame);

@@ -112,7 +112,7 @@ void open_bake_journal(const BakePlan& plan, const JournalLayout& layout, BakeSt
   remove_foreign_checkpoints(plan, start.frame, start.state, notes);
   if (start.journal)
     start.journal->truncate(start.frame - plan.written.first);  // the frames before the checkpoint's
-  else
+  else if (std::max(start.frame, plan.written.first) < last_checkpoint(plan))  // a checkpoint to come needs it
     start.journal = FrameJournal::create(journal_path(plan.checkpoints.dir, plan.written.first), layout);
 }
 

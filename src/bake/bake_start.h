@@ -35,7 +35,8 @@ BakeStart start_bake(const BakePlan& plan, const JournalLayout& layout, const Si
 void remove_foreign_checkpoints(const BakePlan& plan, long long start, const SimState& shape, std::FILE* notes);
 
 // A bake that writes checkpoints (else nothing): foreign checkpoints removed, and start.journal
-// this bake's, cut to the frames before start.frame or created empty.
+// this bake's, cut to the frames before start.frame, or created empty when a checkpoint to come
+// needs frames in it (last_checkpoint), else left null.
 void open_bake_journal(const BakePlan& plan, const JournalLayout& layout, BakeStart& start, std::FILE* notes);
 
 }  // namespace treeanim

@@ -65,7 +65,7 @@ void add_cluster_motions(const ClusterFrames& frames, const Eigen::Matrix3Xd& re
 }
 
 // The mesh of frame `frame` of `state` (placed from the samples when the bake has a skin),
-// converted, journalled when the bake writes checkpoints, pushed.
+// converted, journalled when a checkpoint after it needs it, pushed.
 void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, const SimState& state, long long frame,
                  const TreePlacement* placement) {
   const bool velocities = frames.outputs.wants_velocities();
@@ -86,7 +86,7 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
   }
   if (frames.cluster_motions) add_cluster_motions(frames.skin_frames, frames.skin->rest_centres(), placement, data);
   else data.cluster_motions.clear();
-  if (plan.checkpoints.every > 0) start.journal->append(data);
+  if (frame < last_checkpoint(plan)) start.journal->append(data);
   frames.push(std::move(data));
 }
 
@@ -152,7 +152,7 @@ void check_room(const BakePlan& plan, const BakeStart& start, const TreeModel& s
   if (plan.checkpoints.every > 0) {
     const long long every = plan.checkpoints.every;
     const long long checkpoints = (plan.written.last - plan.first) / every - (start.frame - plan.first) / every;
-    const long long records = plan.written.last - std::max(start.frame, plan.written.first) + 1;
+    const long long records = std::max(0LL, last_checkpoint(plan) - std::max(start.frame, plan.written.first));
     needs.push_back({journal_path(plan.checkpoints.dir, plan.written.first),
                      double(checkpoints) * estimated_checkpoint_bytes(simulated.vertex_count(), simulated.cluster_count(),
                                                                       simulated.leaf_count()) +
@@ -201,7 +201,7 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
     // The journal reaches the disk before the checkpoint that names its frames as written.
     if (plan.checkpoints.every > 0 && frame > start.frame && (frame - plan.first) % plan.checkpoints.every == 0) {
       if (thread) thread->finish();
-      start.journal->sync();
+      if (start.journal) start.journal->sync();  // none when the written frames start after the last checkpoint
       write_checkpoint(checkpoint_path(plan.checkpoints.dir, frame), start.state, frame, plan.key);
     }
     log.frame_done(frame - start.frame + 1);

@@ -405,7 +405,7 @@ std::unique_ptr<FrameSink> make_glb_sink(const OutputOptions& options, const fs:
     const uint64_t fits = bound.frames_within(kGlbMaxBytes);  // written frames
     char size[32];
     std::snprintf(size, sizeof size, "%.2f GiB", double(bytes) / double(1ull << 30));
-    throw OutputError(path.string() + ": the animated GLB would be " + size + " (" +
+    throw InputError(options.where() + ": the animated GLB " + path.string() + " would be " + size + " (" +
                       std::to_string(model.vertex_count()) + " vertices x " + std::to_string(selection.written()) +
                       " frames), over glTF's 4 GiB GLB limit; at most " + std::to_string(fits * uint64_t(options.frame_step)) +
                       " frames of this bake fit at frame_step " + std::to_string(options.frame_step) +

@@ -33,7 +33,7 @@ class SkinnedGlbSink final : public FrameSink {
         skin_(build_skin(model, options.max_joints > 0 ? options.max_joints : model.cluster_count())) {
     const uint64_t bytes = skinned_glb_bytes(model, skin_.joint_count(), uint64_t(selection_.written()));
     if (bytes > kGlbMaxBytes)
-      throw OutputError(path_.string() + ": the skinned GLB would pass glTF's 4 GiB GLB limit (" +
+      throw InputError(options.where() + ": the skinned GLB " + path_.string() + " would pass glTF's 4 GiB GLB limit (" +
                         std::to_string(skin_.joint_count()) + " joints x " + std::to_string(selection_.written()) +
                         " frames); lower max_joints, raise frame_step or shorten the bake");
   }

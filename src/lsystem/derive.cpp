@@ -283,21 +283,26 @@ class Deriver {
   // contexts of `index` and only rules of one module),
   // its formal parameters bound in slots; nullptr when none applies. The first applicable rule
   // wins; when it has a probability, one of all applicable rules with a probability is drawn
-  // with weights proportional to them.
+  // with weights proportional to them. In a stochastic set (cpfg's, with 'seed:') every
+  // applicable rule is drawn from, one without a probability weighing 1, and when every weight
+  // is 0 the first applies, as cpfg's SelectProd does.
   const Rule* select(const RuleSet& set, char symbol, std::span<const double> params, size_t index,
                      double* slots, RandomStream& random) {
     const auto s = static_cast<unsigned char>(symbol);
     double total = 0;
     size_t candidates = 0;
+    bool weighed = false;  // some candidate has a probability: the choice draws a number
     for (uint32_t k = set.first_rule[s]; k < set.first_rule[s + 1]; ++k) {
       const Rule& rule = set.rules[set.rule_order[k]];
       if (!applies(set, rule, params, index, slots, random)) continue;
-      if (!rule.probability.present()) {
+      if (!rule.probability.present() && !set.stochastic) {
         if (candidates == 0) return &rule;
         continue;
       }
       rule_ = &rule;
-      const double weight = evaluate(g_.program, rule.probability, slots, random, variables_.data());
+      weighed = weighed || rule.probability.present();
+      const double weight =
+          rule.probability.present() ? evaluate(g_.program, rule.probability, slots, random, variables_.data()) : 1.0;
       if (weight < 0)
         throw EvalError{rule.probability.pos, "expected a probability >= 0, got " + number_text(weight)};
       weights_.resize(candidates + 1);
@@ -309,11 +314,13 @@ class Deriver {
       ++candidates;
       total += weight;
     }
-    if (candidates == 0 || total <= 0) return nullptr;
-    const double draw = random.uniform() * total;
+    if (candidates == 0 || (total <= 0 && !set.stochastic)) return nullptr;
+    // A lone rule without a probability applies without a draw, as outside a stochastic set.
+    const bool draws = total > 0 && (weighed || candidates > 1);
+    const double draw = draws ? random.uniform() * total : 0.0;
     double sum = 0;
-    size_t pick = candidates - 1;
-    for (size_t c = 0; c < candidates; ++c) {
+    size_t pick = draws ? candidates - 1 : 0;
+    for (size_t c = 0; c < candidates && draws; ++c) {
       sum += weights_[c];
       if (draw < sum && weights_[c] > 0) {
         pick = c;

@@ -66,6 +66,9 @@ struct RuleSet {
   int max_depth = 1;                           // decomposition / homomorphism recursion depth
   bool any_context = false;                    // some rule has a left or right context
   bool any_cut = false;                        // some successor contains '%'
+  // The productions of an L-system with 'seed:' (cpfg's stochastic L-system): every applicable
+  // rule is a candidate of the draw, one without a probability weighing 1.
+  bool stochastic = false;
   // Some rule's strict predecessor has several modules: the recursion of a decomposition or
   // homomorphism evaluates a successor's parameters when it applies the rule, so that such a
   // predecessor can match within it (CPFG manual 4.3.1, as cpfg rewrites its successor buffer).

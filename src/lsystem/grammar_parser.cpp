@@ -412,8 +412,12 @@ class Parser {
           fail(line, begin, "a decomposition draws with the productions' random numbers: 'seed:' belongs before "
                             "'decomposition' (CPFG manual 4.4)");
         const auto seed = static_cast<uint64_t>(integer_value(text, vbegin, vend, line, 0, 1LL << 53));
-        if (first && section_ == Section::kHomomorphism) g_.homomorphism_seed = seed;
-        else if (first) g_.seed = seed;
+        if (section_ == Section::kHomomorphism) {
+          if (first) g_.homomorphism_seed = seed;
+        } else {
+          lsystem().productions.stochastic = true;
+          if (first) g_.seed = seed;
+        }
       } else if (keyword == "lsystem") lsystem_label(text, vbegin, vend, line);
       else if (keyword == "maximum depth") current().max_depth = static_cast<int>(integer_value(text, vbegin, vend, line, 1, kMaxDepth));
       else if (keyword == "tropism") parse_tropism(text, vbegin, vend, line);

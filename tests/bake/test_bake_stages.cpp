@@ -278,6 +278,34 @@ TEST_F(BakeStages, AResumedBakeWritesTheSameBytes) {
   EXPECT_EQ(slurp(dir_ / "out" / "bake.pc2"), whole);
 }
 
+// The journal holds the written frames a resume replays, those before the last checkpoint,
+// and a bake that writes no checkpoint (--checkpoint-every past its frames) writes none.
+TEST_F(BakeStages, TheJournalHoldsTheFramesBeforeTheLastCheckpoint) {
+  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"}])"});  // frames 10 to 14
+  const fs::path journal = journal_path(dir_ / "checkpoints", 10);
+  BakeConfig checkpointed = config();
+  checkpointed.checkpoints.every = 3;
+  ASSERT_EQ(bake_tree(line, checkpointed, nullptr, BakeLog{}).exit_code, 0);
+  const BakePlan plan = plan_bake(line, checkpointed);
+  EXPECT_EQ(last_checkpoint(plan), 13);
+  EXPECT_TRUE(fs::exists(checkpoint_path(dir_ / "checkpoints", 13)));
+  const PreparedTree tree = prepare_tree(line);
+  EXPECT_EQ(FrameJournal::open(journal, journal_layout(plan, tree.model, false)).size(), 3);  // frames 10 to 12
+  // --frames 14:14 starts after the last checkpoint: nothing to journal, the checkpoint still written.
+  fs::remove_all(dir_ / "checkpoints");
+  BakeConfig after = checkpointed;
+  after.frames = FrameRange{14, 14};
+  ASSERT_EQ(bake_tree(line, after, nullptr, BakeLog{}).exit_code, 0);
+  EXPECT_TRUE(fs::exists(checkpoint_path(dir_ / "checkpoints", 13)));
+  EXPECT_FALSE(fs::exists(journal_path(dir_ / "checkpoints", 14)));
+  fs::remove_all(dir_ / "checkpoints");
+  checkpointed.checkpoints.every = 5;
+  EXPECT_EQ(last_checkpoint(plan_bake(line, checkpointed)), 10);
+  ASSERT_EQ(bake_tree(line, checkpointed, nullptr, BakeLog{}).exit_code, 0);
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / "bake.pc2"));
+  EXPECT_FALSE(fs::exists(journal));
+}
+
 TEST_F(BakeStages, ASampledBakeResumedFromAnEarlierCheckpointWritesTheSameBytes) {
   // The skinned GLB's keys are the clusters' motions: the journal replays them too.
   const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"},

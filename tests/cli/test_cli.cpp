@@ -138,8 +138,10 @@ TEST_F(Cli, ValidateMeetsTheWritersLimits) {
        "least 2 (or 0: as wide as the vertices)"},
       {R"(--set 'outputs=[{"format": "html", "path": "p.html", "max_mib": 2}]' --set tree.ring_sides=64)", 2,
        "/outputs/0/max_mib: the page needs"},
-      {R"(--set time.frames=200000 --set 'outputs=[{"format": "glb", "path": "big.glb"}]')", 4,
-       "over glTF's 4 GiB GLB limit"},
+      {R"(--set time.frames=200000 --set 'outputs=[{"format": "glb", "path": "big.glb"}]')", 2,
+       "/outputs/0: the animated GLB "},
+      {R"(--set time.frames=200000 --set 'outputs=[{"format": "skinned_glb", "path": "big.glb"}]')", 2,
+       "/outputs/0: the skinned GLB "},
   };
   for (const auto& c : cases) {
     for (const std::string& command : {std::string("validate "), "run --no-space-check -o " + (dir_ / "out").string() + " "}) {

@@ -439,7 +439,7 @@ TEST_F(OutputSetTest, GlbOverFourGibIsRefusedWithTheFramesThatFit) {
   const std::string error = output_error({output("glb", "anim.glb")}, dir_, m, info);
   char size[32];
   std::snprintf(size, sizeof size, "%.2f GiB", double(animated_glb_bytes(m, info, 1)) / double(1ull << 30));
-  const std::string expected = (dir_ / "anim.glb").string() + ": the animated GLB would be " + size +
+  const std::string expected = "input: /outputs/0: the animated GLB " + (dir_ / "anim.glb").string() + " would be " + size +
                                " (100000 vertices x 4000 frames), over glTF's 4 GiB GLB limit; at most ";
   ASSERT_EQ(error.rfind(expected, 0), 0u) << error;
   const long long fits = std::stoll(error.substr(expected.size()));

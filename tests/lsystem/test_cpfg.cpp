@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -463,6 +464,24 @@ TEST(Cpfg, HomomorphismSeedKeysOnlyTheHomomorphism) {
   EXPECT_EQ(plant_error_of("axiom: A\ndecomposition\nseed: 5\n"),
             "plant.l:3:1: a decomposition draws with the productions' random numbers: 'seed:' belongs before "
             "'decomposition' (CPFG manual 4.4)");
+}
+
+// With "seed:" an L-system is stochastic as cpfg's (generate.c, FindApplProductions and
+// SelectProd): every applicable production is drawn from, one without a probability weighing
+// 1, and when every weight is 0 the first applies. Without it the first applicable rule without
+// a probability applies, unless one with a probability comes first.
+TEST(Cpfg, SeedMakesEveryApplicableProductionACandidate) {
+  const std::string rules = "axiom: " + std::string(100, 'A') + "\nA --> B : 1\nA --> C\n";
+  const std::string seeded = derive_text("seed: 3\n" + rules, 1);
+  const auto count = [](const std::string& word, char c) { return std::count(word.begin(), word.end(), c); };
+  EXPECT_EQ(count(seeded, 'B') + count(seeded, 'C'), 100);
+  EXPECT_GT(count(seeded, 'B'), 30);  // 50 expected; a seed gives under 30 with a chance of 4e-5
+  EXPECT_GT(count(seeded, 'C'), 30);
+  EXPECT_EQ(derive_text(rules, 1), std::string(100, 'B'));
+  // A lone applicable rule applies, with or without its probability.
+  EXPECT_EQ(derive_text("seed: 3\naxiom: A\nA --> C\n", 1), "C");
+  EXPECT_EQ(derive_text("seed: 3\naxiom: AA\nA --> B : 0\nA --> C : 0\n", 1), "BB");
+  EXPECT_EQ(derive_text("axiom: AA\nA --> B : 0\nA --> C : 0\n", 1), "AA");
 }
 
 // fopen(name, "r") and fscan (CPFG manual 5.4) read a data file beside the grammar, as C's
