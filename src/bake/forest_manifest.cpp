@@ -127,7 +127,7 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
 }
 
 std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::string& id, const std::string& key,
-                                       std::string& why) {
+                                       std::string& why, bool* foreign) {
   const fs::path path = tree_part_path(out_dir, id);
   std::string text, reason;
   if (!read_text_file(path, text, reason, kMaxTextFileBytes, TextFileRole::kOwnOutput)) {
@@ -141,6 +141,7 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
       const std::string of = part.at("id").get<std::string>();
       why = path.string() + (of != id ? " is the part of tree " + printable_text(of) + ", copied here"
                                       : " is of another scene or treeanim version");
+      if (foreign) *foreign = of == id;
       return std::nullopt;
     }
     for (const Json& output : part.at("outputs"))
@@ -179,10 +180,13 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
                            const fs::path& checkpoints) {
   GatherReport report;
   Json trees = Json::array();
+  size_t foreign_parts = 0;
   for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
     std::string why;
+    bool foreign = false;
     const Scene one = tree_scene(scene, t);
-    auto part = complete_tree_part(out_dir, scene.forest->trees[t].id, bake_key(one, generator), why);
+    auto part = complete_tree_part(out_dir, scene.forest->trees[t].id, bake_key(one, generator), why, &foreign);
+    foreign_parts += foreign ? 1 : 0;
     if (!part) {
       report.missing.push_back(t);
       report.reasons.push_back(why);
@@ -190,8 +194,11 @@ GatherReport gather_forest(const Scene& scene, const fs::path& out_dir, const st
       trees.push_back(std::move(*part));
     }
   }
+  // Every part another scene's: a gather given another scene or --set than the forest was baked
+  // with, whose manifest still describes the folder.
+  report.other_scene = foreign_parts == scene.forest->trees.size();
   if (!report.missing.empty()) {
-    report.removed_stale = remove_forest_files(out_dir);
+    if (!report.other_scene) report.removed_stale = remove_forest_files(out_dir);
     return report;
   }
   // Before the manifest, which says the forest is complete.

@@ -25,9 +25,10 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
                      const TreeBakeResult& result);
 
 // The tree's part when its bake is complete: the part is there, of this key, and every file it
-// lists exists; else nullopt, with the reason in `why`.
+// lists exists; else nullopt, with the reason in `why` and `*foreign` set when the part is the
+// tree's own of another key (another scene or treeanim version).
 std::optional<Json> complete_tree_part(const std::filesystem::path& out_dir, const std::string& id,
-                                       const std::string& key, std::string& why);
+                                       const std::string& key, std::string& why, bool* foreign = nullptr);
 
 // What gather_forest writes, added to `targets` (formats/outputs.h): the manifest, and beside
 // it the stage or the page when the scene has a usd or an html output. `written` false: a
@@ -44,12 +45,16 @@ struct GatherReport {
   std::vector<size_t> missing;       // trees whose bake is not complete, ascending
   std::vector<std::string> reasons;  // (missing) why
   bool removed_stale = false;        // trees missing: an earlier manifest, stage or page was removed
+  // Every tree's part is its own of another scene or treeanim version: the folder holds a
+  // forest, not this scene's, and its files were left as they are.
+  bool other_scene = false;
 };
 
 // Every tree complete (its part of this generator's key) => writes OUT/forest.json, removes
 // the folder of the trees' checkpoints (`checkpoints`, "" for none) when their bakes left it
 // empty, and returns no missing trees; else removes the forest's files (remove_forest_files)
-// and returns them. Throws OutputError when the manifest cannot be written.
+// and returns them, unless every part is of another scene (GatherReport::other_scene): then
+// the gather's scene is not the folder's, and its files stay. Throws OutputError when the manifest cannot be written.
 GatherReport gather_forest(const Scene& scene, const std::filesystem::path& out_dir, const std::string& generator,
                            const std::filesystem::path& checkpoints);
 

@@ -36,6 +36,10 @@ ForestEstimate estimate_forest(const Scene& scene) {
       variant_bytes[v] += estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
                                                  tree.model.cluster_count(), scene.time.frames);
   }
+  // A variant no tree uses is not grown, but its grammar and view file are read: a slip in
+  // them is bad input now, not when a later scene draws the variant.
+  for (size_t v = 0; v < forest.variants.size(); ++v)
+    if (!built[v]) load_grammar(forest.variants[v].lsystem, load_view(forest.variants[v].lsystem));
   ForestEstimate estimate;
   for (const ForestTree& tree : forest.trees) {
     estimate.tree_cost.push_back(variant_cost[tree.variant]);
@@ -90,9 +94,9 @@ void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees) {
 }  // namespace
 
 std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard) {
-  // Every variant grows here, with or without shards, and every tree whose seed shapes it: a
-  // later tree's bad grammar, view or leaf mesh is bad input before the first tree's files are
-  // written.
+  // Every variant a tree uses grows here, with or without shards, and every tree whose seed
+  // shapes it: a later tree's bad grammar, view or leaf mesh is bad input before the first tree's
+  // files are written. A variant no tree uses is read, not grown (estimate_forest).
   const ForestEstimate estimate = estimate_forest(scene);
   std::vector<size_t> trees(scene.forest->trees.size());
   std::iota(trees.begin(), trees.end(), size_t{0});

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "common/errors.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -26,9 +27,9 @@ FrameRange parse_frame_range(const std::string& text, long long first, long long
 }
 
 Shard parse_shard(const std::string& text) {
-  const std::string expected = "--shard '" + text +
-                               "': expected I/N with 0 <= I < N <= 1000000 (farm --tasks' range), the 0-based task "
-                               "of N (I may be 'auto', which reads $SLURM_ARRAY_TASK_ID)";
+  std::string expected = "--shard '" + text +
+                         "': expected I/N with 0 <= I < N <= 1000000 (farm --tasks' range), the 0-based task "
+                         "of N (I may be 'auto', which reads $SLURM_ARRAY_TASK_ID)";
   const size_t slash = text.find('/');
   if (slash == std::string::npos) throw InputError(expected);
   std::string index = text.substr(0, slash);
@@ -36,6 +37,7 @@ Shard parse_shard(const std::string& text) {
     const char* env = std::getenv("SLURM_ARRAY_TASK_ID");
     if (!env) throw InputError("--shard '" + text + "': SLURM_ARRAY_TASK_ID is not set (not a Slurm array task): give I/N");
     index = env;
+    expected += ", and $SLURM_ARRAY_TASK_ID is '" + excerpt(index) + "'";
   }
   const auto parse = [&](const std::string& digits) {
     if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)

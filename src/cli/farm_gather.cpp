@@ -25,6 +25,12 @@ int farm_gather_command(const FarmRequest& request) {
                 printable_text(forest_manifest_path(request.out_dir).string()).c_str());
     return 0;
   }
+  if (report.other_scene)
+    throw InputError(tree_part_path(request.out_dir, forest.trees[0].id).parent_path().string() +
+                     ": every tree's part is of another scene or treeanim version than " + request.scene.string() +
+                     (request.overrides.empty() ? "" : " with its --set") +
+                     ": gather with the scene and --set the forest was baked with (its files are left as they are), "
+                     "or bake this scene first");
   std::map<size_t, std::vector<size_t>> by_task;  // task => indices into report.missing
   std::vector<size_t> task_of(forest.trees.size(), 0);
   if (request.tasks > 0) {

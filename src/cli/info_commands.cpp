@@ -72,7 +72,7 @@ int validate_command(const std::filesystem::path& scene_file,
   const Scene scene = load_scene(scene_file, overrides);
   if (scene.forest) {
     check_forest_writers(scene);
-    shard_trees(scene, std::nullopt);  // grows one tree of each variant, and every tree a seed shapes
+    shard_trees(scene, std::nullopt);  // grows one tree of each variant used, and every tree a seed shapes
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
     print_counts(tree_summary(scene, prepare_checked_tree(scene)));
@@ -90,9 +90,13 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
     std::cout << scene.resolved.dump(2) << "\n";
     return 0;
   }
-  // A forest: the figures of its first tree. Outputs that run would refuse are refused here
-  // too: figures of a bake that cannot run would say it can.
-  if (scene.forest) check_forest_writers(scene);
+  // A forest: the figures of its first tree. Outputs and trees that run would refuse are
+  // refused here too (every variant in use grown, as validate does): figures of a bake that
+  // cannot run would say it can.
+  if (scene.forest) {
+    check_forest_writers(scene);
+    shard_trees(scene, std::nullopt);
+  }
   const Scene first = scene.forest ? tree_scene(scene, 0) : Scene();
   const Scene& one = scene.forest ? first : scene;
   const PreparedTree tree = scene.forest ? prepare_tree(one) : prepare_checked_tree(one);

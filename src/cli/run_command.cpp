@@ -1,4 +1,6 @@
 // treeanim run: one tree, or a forest's trees one after another (bake/bake_forest.h).
+#include <cstdio>
+
 #include "bake/bake_forest.h"
 #include "bake/bake_tree.h"
 #include "bake/forest_tasks.h"
@@ -6,6 +8,7 @@
 #include "cli/bake_arguments.h"
 #include "cli/bake_printer.h"
 #include "cli/commands.h"
+#include "common/message_text.h"
 
 namespace treeanim {
 
@@ -13,6 +16,10 @@ int run_command(const RunRequest& request) {
   install_interrupt_handlers();
   const Scene scene = load_scene(request.scene, request.overrides);
   const BakeConfig config = bake_config(request, scene);
+  if (!request.checkpoint_dir.empty() && request.checkpoint_every <= 0 && !request.resume && !request.frames)
+    std::fprintf(stderr, "treeanim: note: --checkpoint-dir %s is not used: only --checkpoint-every, --resume and "
+                         "--frames write or read checkpoints\n",
+                 printable_text(request.checkpoint_dir.string()).c_str());
   BakePrinter printer(scene, config, request.scene, request.verbosity);
   if (!scene.forest) return bake_tree(scene, config, nullptr, printer.log()).exit_code;
   const std::vector<size_t> trees = shard_trees(scene, config.shard);

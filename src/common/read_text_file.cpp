@@ -33,10 +33,11 @@ bool read_text_file(const std::filesystem::path& path, std::string& text, std::s
   }
   if (in.bad()) return fail("not a readable file");
   if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
-  if (text.find('\r') != std::string::npos) {
+  if (text.find('\r') != std::string::npos) {  // "\r\n" and a "\r" alone (old Mac text) end a line as "\n"
     size_t kept = 0;
     for (size_t i = 0; i < text.size(); ++i)
-      if (!(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) text[kept++] = text[i];
+      if (text[i] != '\r') text[kept++] = text[i];
+      else if (i + 1 == text.size() || text[i + 1] != '\n') text[kept++] = '\n';
     text.resize(kept);
   }
   if (role == TextFileRole::kInput) note_input_file(path);

@@ -13,9 +13,9 @@ constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t(256) << 20;
 // path => its whole content in `text`, true; or false with `reason` ("no such file", "not a
 // readable file", "larger than 256 MiB"). Reads at most max_bytes + 1 bytes, so a device or
 // pipe without end (/dev/zero) fails instead of filling memory; FIFOs and process
-// substitution still work. Text saved on Windows reads as on Linux: a UTF-8 byte-order mark at
-// the start is dropped and each CRLF line end becomes LF (lines are unchanged, and columns are
-// those an editor shows). A regular file read is noted as an input (common/input_files.h),
+// substitution still work. Text saved on Windows or an old Mac reads as on Linux: a UTF-8
+// byte-order mark at the start is dropped and each CRLF or lone CR line end becomes LF (lines
+// are those an editor shows, and so are columns). A regular file read is noted as an input (common/input_files.h),
 // unless it is one of a bake's own outputs read back (kOwnOutput: a forest's parts and pages),
 // which the bake may write again.
 enum class TextFileRole { kInput, kOwnOutput };

@@ -133,9 +133,11 @@ class HtmlSink final : public FrameSink {
     plan_ = plan_preview_page(html_page_shape(options, model, info), max_page_bytes_);
     if (!plan_.fits)
       throw InputError(options.where() + "/max_mib: the page needs " + std::to_string(mebibytes(plan_.bytes)) +
-                       " MiB at least for this tree (viewer, mesh and two frames), more than max_mib = " +
+                       " MiB at least for this tree (viewer, mesh, two frames and the plots of its " +
+                       std::to_string(selection_.written()) + " written frames), more than max_mib = " +
                        std::to_string(max_page_bytes_ >> 20) +
-                       ": raise max_mib where its range allows, or leave the html output out");
+                       ": raise max_mib where its range allows, raise frame_step or shorten the bake (the plots keep "
+                       "every written frame), or leave the html output out");
   }
 
   std::vector<SummaryFile> summary_paths() const override { return {{path_}}; }

@@ -22,8 +22,8 @@ std::string forest_usda(const std::vector<ForestStageTree>& trees, const ForestS
     if (!names.insert(name).second) names.insert(name += "_" + std::to_string(t));
     const bool relative = !std::filesystem::path(tree.layer).is_absolute();
     out += "    def \"" + name + "\" (\n        customData = {\n            string treeanim_id = " +
-           usd_quoted(tree.id) + "\n        }\n        prepend references = @" + (relative ? "./" : "") + tree.layer +
-           "@\n    )\n    {\n        double3 xformOp:translate = (";
+           usd_quoted(tree.id) + "\n        }\n        prepend references = " +
+           usd_asset_path((relative ? "./" : "") + tree.layer) + "\n    )\n    {\n        double3 xformOp:translate = (";
     for (int a = 0; a < 3; ++a) {
       if (a > 0) out += ", ";
       append_usd_number(out, tree.translation[a]);

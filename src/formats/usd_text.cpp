@@ -65,6 +65,16 @@ std::string usd_quoted(std::string_view text) {
   return out + '"';
 }
 
+std::string usd_asset_path(std::string_view path) {
+  if (path.find('@') == std::string_view::npos) return "@" + std::string(path) + "@";
+  std::string out = "@@@";
+  for (size_t k = 0; k < path.size(); ++k) {
+    if (path.substr(k, 3) == "@@@") out += '\\';
+    out += path[k];
+  }
+  return out + "@@@";
+}
+
 std::string usd_prim_name(std::string_view name) {
   std::string out;
   for (char c : name) {

@@ -26,6 +26,10 @@ void append_usd_matrix(std::string& out, const Eigen::Matrix3d& rotation, const 
 // A quoted USD string: '"' and '\' escaped.
 std::string usd_quoted(std::string_view text);
 
+// An asset path as USD's text reads it: @path@, or @@@path@@@ when the path holds an '@' (which
+// would end the first), an '@@@' in it escaped as \@@@.
+std::string usd_asset_path(std::string_view path);
+
 // Any name => a valid prim name: letters, digits and '_', not starting with a digit.
 std::string usd_prim_name(std::string_view name);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <sstream>
 #include <span>
 #include <string>
@@ -47,7 +48,7 @@ class Deriver {
       if (stepped) stepped(step_, word.size());
     }
     step_ = settings_.iterations;
-    run_block(g_.end_block);
+    if (settings_.iterations > 0) run_block(g_.end_block);  // cpfg runs End in its last step's Derive
     return word;
   }
 
@@ -112,13 +113,23 @@ class Deriver {
     execute(g_.program, block, no_slots, random, variables_.data());
   }
 
+  // A module parameter's expression => its value as the string keeps it (stored_parameter).
+  double parameter(const Expr& expr, const double* slots, RandomStream& random) {
+    const double value = evaluate(g_.program, expr, slots, random, variables_.data());
+    const double stored = stored_parameter(value);
+    if (!std::isfinite(stored))
+      throw EvalError{expr.pos, "the value " + number_text(value) + " is past a module parameter's range: a parameter "
+                                "is a 32-bit float, as in cpfg, at most 3.4e38 in magnitude"};
+    return stored;
+  }
+
   // The axiom's modules, their parameters evaluated with the axiom's random stream.
   void emit_axiom(ModuleString* out) {
     RandomStream random = RandomStream::keyed(seed(), kAxiom, 0, 0);
     for (const SuccessorModule& m : g_.axiom) {
       out->symbols.push_back(m.symbol);
       for (uint32_t p = 0; p < m.arity; ++p)
-        out->params.push_back(evaluate(g_.program, g_.axiom_params[m.first_param + p], nullptr, random, variables_.data()));
+        out->params.push_back(parameter(g_.axiom_params[m.first_param + p], nullptr, random));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
     }
     check_cap(*out);
@@ -129,10 +140,11 @@ class Deriver {
     return std::any_of(g_.lsystems.begin(), g_.lsystems.end(), [&](const Lsystem& ls) { return !(ls.*section).empty(); });
   }
 
-  // After productions (or the axiom): decomposition, then cuts.
+  // After productions (or the axiom): decomposition, then cuts. cpfg decomposes what each step
+  // writes, never the axiom (generate.c, ApplyProd): step 1's productions see the axiom as written.
   ModuleString finish_step(ModuleString word, int step) {
     step_ = step;
-    if (any_rules(&Lsystem::decomposition)) {
+    if (step > 0 && any_rules(&Lsystem::decomposition)) {
       ModuleString out;
       expand_all(&Lsystem::decomposition, word, kDecomposition, &out);
       word = std::move(out);
@@ -464,8 +476,7 @@ class Deriver {
       const SuccessorModule& module = set.successor[m];
       out->symbols.push_back(module.symbol);
       for (uint32_t p = 0; p < module.arity; ++p)
-        out->params.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
-                                       variables_.data()));
+        out->params.push_back(parameter(set.successor_params[module.first_param + p], slots, random));
       out->param_offsets.push_back(static_cast<uint32_t>(out->params.size()));
       // A call whose label is computed is checked where its rule writes it.
       if (g_.calls && module.symbol == '?' && module.arity > 0) {
@@ -565,8 +576,7 @@ class Deriver {
       } else {
         const double* slots = frame_slots_.data() + frame.slots;
         for (uint32_t p = 0; p < module.arity; ++p)
-          scratch_.push_back(evaluate(g_.program, set.successor_params[module.first_param + p], slots, random,
-                                      variables_.data()));
+          scratch_.push_back(parameter(set.successor_params[module.first_param + p], slots, random));
       }
       const size_t at = frames_.size() - 1;
       const bool last = frame.next == rule.successor_end;
@@ -609,8 +619,8 @@ class Deriver {
         rule_ = rule;
         for (uint32_t m = rule->successor_begin; m < rule->successor_end; ++m)
           for (uint32_t p = 0; p < set.successor[m].arity; ++p)
-            frame_params_.push_back(evaluate(g_.program, set.successor_params[set.successor[m].first_param + p],
-                                             frame_slots_.data() + frame.slots, random, variables_.data()));
+            frame_params_.push_back(parameter(set.successor_params[set.successor[m].first_param + p],
+                                              frame_slots_.data() + frame.slots, random));
       }
     }
     return rule->length();

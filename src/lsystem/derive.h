@@ -22,7 +22,7 @@ struct DerivationSettings {
 using DerivationStepped = std::function<void(int step, size_t modules)>;
 
 // grammar + settings => the word after settings.iterations steps; decomposition rules are
-// applied to the axiom and after every step, and '%' removes the rest of its branch. When the
+// applied after every step (not to the axiom, as in cpfg), and '%' removes the rest of its branch. When the
 // grammar writes query modules, the turtle interprets the word (through the homomorphism)
 // after the axiom and after every step, and they take their values (CPFG manual 6.9).
 // Throws InputError at the module cap and on runtime errors (division by zero...), naming the

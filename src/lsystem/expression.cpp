@@ -284,7 +284,7 @@ class Compiler {
       const size_t where = pos_;
       Op op;
       if (accept("==")) op = Op::kEq;
-      else if (accept("!=")) op = Op::kNe;
+      else if (accept("!=") || accept("<>")) op = Op::kNe;  // cpfg reads both (lsys_input.l)
       else if (peek() == '=') fail(pos_, "expected '==' to compare, got '='");
       else return;
       parse_relation();
@@ -299,6 +299,7 @@ class Compiler {
       Op op;
       if (accept("<=")) op = Op::kLe;
       else if (accept(">=")) op = Op::kGe;
+      else if (text_.substr(pos_, 2) == "<>") return;  // cpfg's !=, compared a level below
       else if (accept("<")) op = Op::kLt;
       else if (accept(">")) op = Op::kGt;
       else return;
@@ -889,7 +890,8 @@ namespace {
       case Op::kAsin: stack[top] = std::asin(b) / kDegree; break;
       case Op::kAcos: stack[top] = std::acos(b) / kDegree; break;
       case Op::kAtan: stack[top] = std::atan(b) / kDegree; break;
-      case Op::kAtan2: a = std::atan2(a, b) / kDegree; --top; break;
+      // cpfg's atan2(x, y) is the angle of the vector (x, y), C's atan2(y, x) (generate.c, tATAN2).
+      case Op::kAtan2: a = std::atan2(b, a) / kDegree; --top; break;
       case Op::kSqrt: stack[top] = std::sqrt(b); break;
       case Op::kExp: stack[top] = std::exp(b); break;
       case Op::kLog: stack[top] = std::log(b); break;
@@ -898,7 +900,7 @@ namespace {
       case Op::kMax: a = std::max(a, b); --top; break;
       case Op::kFloor: stack[top] = std::floor(b); break;
       case Op::kCeil: stack[top] = std::ceil(b); break;
-      case Op::kTrunc: stack[top] = std::trunc(b); break;
+      case Op::kTrunc: stack[top] = std::floor(b + 0.5); break;  // cpfg's trunc rounds, halves up (generate.c, tTRUNC)
       case Op::kSign: stack[top] = b > 0.0 ? 1.0 : (b < 0.0 ? -1.0 : 0.0); break;
       case Op::kFunc: a = sample_function(program.functions[in.arg].samples, b); --top; break;
       case Op::kCurve: a = program.curves[in.arg / 3].at(b)[in.arg % 3]; --top; break;

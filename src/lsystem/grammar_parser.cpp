@@ -28,6 +28,39 @@ constexpr long long kMaxArrayElements = 1'000'000;  // elements of all cpfg arra
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
+// Whether a #define body is one operand (signs, then a number, a name, a call or a
+// parenthesised expression): cpp pastes the body as text, so only such a body means the same as
+// its value wherever it stands; "2+3" pasted into "N*2" makes 2+3*2.
+bool single_operand(std::string_view text) {
+  size_t k = 0;
+  auto skip = [&] { while (k < text.size() && is_space(text[k])) ++k; };
+  auto close_group = [&] {  // text[k] == '(' => past its matching ')'
+    for (int depth = 0; k < text.size(); ++k)
+      if (text[k] == '(') ++depth;
+      else if (text[k] == ')' && --depth == 0) return ++k, true;
+    return false;
+  };
+  for (skip(); k < text.size() && (text[k] == '-' || text[k] == '+'); skip()) ++k;
+  if (k == text.size()) return false;
+  const auto c = static_cast<unsigned char>(text[k]);
+  if (std::isdigit(c) || c == '.') {
+    while (k < text.size() && (std::isdigit(static_cast<unsigned char>(text[k])) || text[k] == '.')) ++k;
+    if (k < text.size() && (text[k] == 'e' || text[k] == 'E')) {
+      ++k;
+      if (k < text.size() && (text[k] == '-' || text[k] == '+')) ++k;
+      while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+    }
+  } else if (std::isalpha(c) || c == '_') {
+    while (k < text.size() && (std::isalnum(static_cast<unsigned char>(text[k])) || text[k] == '_')) ++k;
+    skip();
+    if (k < text.size() && text[k] == '(' && !close_group()) return false;
+  } else if (c != '(' || !close_group()) {
+    return false;
+  }
+  skip();
+  return k == text.size();
+}
+
 enum class Section { kProductions, kDecomposition, kHomomorphism };
 
 // Directives that end with ':' and take a value, and section headers that take none.
@@ -489,9 +522,10 @@ class Parser {
     }
   }
 
-  // "#define NAME body" (no arguments) => true when body is a constant expression: the grammar
-  // keeps NAME as a number, which the scene's lsystem.defines may replace. Otherwise (ran(), a
-  // module text, a name defined later) the preprocessor expands the body as text.
+  // "#define NAME body" (no arguments) => true when body is a constant expression of one operand
+  // (single_operand): the grammar keeps NAME as a number, which the scene's lsystem.defines may
+  // replace. Otherwise (2+3, ran(), a module text, a name defined later) the preprocessor
+  // expands the body as text, as cpp does.
   bool define_number(const std::string& name, const SourceLine& body, SourcePos at) {
     if (std::find(g_.file_defines.begin(), g_.file_defines.end(), name) != g_.file_defines.end())
       throw GrammarError{at, "'" + name + "' is already defined"};
@@ -499,6 +533,8 @@ class Parser {
     // The scene's value wins over a constant, even one that cannot be computed; a text macro
     // it cannot replace (the text would be dropped for a number, silently).
     const bool overridden = std::any_of(overrides_.begin(), overrides_.end(), [&](const auto& e) { return e.first == name; });
+    // More than one operand is text, as cpp pastes it (the scene's value replaces it whole).
+    if (!overridden && !single_operand(body.text)) return false;
     const ExprScope scope{nullptr, &g_.defines, nullptr};
     const TextOrigin origin{body.start, &body.columns};
     const size_t code_size = g_.program.code.size(), constants = g_.program.constants.size();

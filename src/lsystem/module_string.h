@@ -7,6 +7,11 @@
 
 namespace treeanim {
 
+// A module's parameter as cpfg keeps it in its string, a 32-bit float (generate.c,
+// AppendParameter): a sum that creeps toward a threshold (t < 1 in steps of 0.1) crosses it at
+// the step cpfg's does. Expressions and variables compute in double, as cpfg's Eval does.
+inline double stored_parameter(double value) { return static_cast<double>(static_cast<float>(value)); }
+
 struct ModuleString {
   std::vector<char> symbols;             // (n) one character per module, as in ABOP
   std::vector<uint32_t> param_offsets;   // (n+1) CSR into params; param_offsets[0] == 0

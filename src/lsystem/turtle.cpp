@@ -307,7 +307,7 @@ class Turtle {
     }
     if (answers_) {
       const uint32_t b = word_.param_offsets[i + 1], e = word_.param_offsets[i + 2];
-      for (uint32_t k = b; k < e && k - b < 3; ++k) answers_[k] = (*v)[static_cast<Eigen::Index>(k - b)];
+      for (uint32_t k = b; k < e && k - b < 3; ++k) answers_[k] = stored_parameter((*v)[static_cast<Eigen::Index>(k - b)]);
     }
     return i + 1;
   }

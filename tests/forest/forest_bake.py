@@ -74,6 +74,14 @@ def case_shards(treeanim, tmp):
     if "all 16 trees complete" not in done.stdout:
         raise Failed("gather said: %s" % done.stdout)
     same_outputs(one, shards)
+    # A gather given another scene than the folder's (a --set left out or added) is bad input:
+    # the forest's manifest, which still describes its trees, stays.
+    gathered = open(os.path.join(shards, "forest.json"), "rb").read()
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, "--set", "wind.turbulence_length=5", check=False)
+    if done.returncode != 2 or "every tree's part is of another scene" not in done.stderr:
+        raise Failed("gather with another scene: exit %d, %s" % (done.returncode, done.stderr))
+    if open(os.path.join(shards, "forest.json"), "rb").read() != gathered:
+        raise Failed("a gather with another scene removed or changed the forest's manifest")
     manifest = json.load(open(os.path.join(one, "forest.json")))
     trees = manifest["trees"]
     if len(trees) != 16 or len({t["variant"] for t in trees}) != 3:

@@ -318,8 +318,9 @@ TEST_F(HtmlSink, PageTooSmallForTheTreeIsRefused) {
     FAIL() << "accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "/outputs/0/max_mib: the page needs 8 MiB at least for this tree (viewer, mesh and two frames), more "
-              "than max_mib = 2: raise max_mib where its range allows, or leave the html output out");
+              "/outputs/0/max_mib: the page needs 8 MiB at least for this tree (viewer, mesh, two frames and the "
+              "plots of its 5 written frames), more than max_mib = 2: raise max_mib where its range allows, raise "
+              "frame_step or shorten the bake (the plots keep every written frame), or leave the html output out");
   }
 }
 

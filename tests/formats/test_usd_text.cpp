@@ -41,6 +41,13 @@ TEST(UsdText, PrimNamesFromIds) {
   EXPECT_EQ(usd_quoted("a \"b\" \\"), "\"a \\\"b\\\" \\\\\"");
 }
 
+// An '@' would end a one-@ asset path: such a path takes USD's @@@ delimiters.
+TEST(UsdText, AssetPathsWithAnAt) {
+  EXPECT_EQ(usd_asset_path("./t/a.usda"), "@./t/a.usda@");
+  EXPECT_EQ(usd_asset_path("./t@x/a.usda"), "@@@./t@x/a.usda@@@");
+  EXPECT_EQ(usd_asset_path("a@@@b"), "@@@a\\@@@b@@@");
+}
+
 TEST(UsdForest, APrimPerTreeReferencingItsLayer) {
   const std::string text = forest_usda(
       {{"a-b", "trees/a-b.usda", {1, 0, -2}, 30}, {"a.b", "/abs/a.b.usda", {0, 0, 0}, -90}}, {24, 2, 11});

@@ -484,6 +484,49 @@ TEST(Cpfg, SeedMakesEveryApplicableProductionACandidate) {
   EXPECT_EQ(derive_text("axiom: AA\nA --> B : 0\nA --> C : 0\n", 1), "AA");
 }
 
+// A parameter is a 32-bit float in the string, as cpfg keeps it (generate.c, AppendParameter):
+// 0.1 summed ten times reaches 1.0000001 and stops t < 1 at ten steps (doubles make eleven).
+TEST(Cpfg, ParametersAreKeptAsFloats) {
+  const std::string word = derive_text("axiom: A(0)\nA(t) : t < 1 --> F A(t+0.1)\n", 30);
+  EXPECT_EQ(std::count(word.begin(), word.end(), 'F'), 10) << word;
+  const ModuleString one = derive(parse_plant("axiom: A(0.1)\n"), {0, 1, 100});
+  EXPECT_EQ(one.params_of(0)[0], double(0.1f));
+  EXPECT_EQ(plant_error_of("axiom: A\nA --> B(1e39)\n"),
+            "plant.l:2:9: the value 1e+39 is past a module parameter's range: a parameter is a 32-bit float, as in "
+            "cpfg, at most 3.4e38 in magnitude while deriving step 1 (rule at 2:1)");
+}
+
+// cpfg decomposes what a step writes, never the axiom (generate.c, ApplyProd), and runs End:
+// in its last step: at derivation length 0 neither happens.
+TEST(Cpfg, TheAxiomIsNotDecomposedAndEndRunsInTheLastStep) {
+  const std::string rules = "axiom: A\nA --> F\ndecomposition\nA --> GGG\n";
+  EXPECT_EQ(derive_text(rules, 1), "F");
+  EXPECT_EQ(derive_text(rules, 0), "A");
+  const std::string blocks = "Start: {x = 1;}\nEnd: {x = 5;}\naxiom: A\nA --> B\n";
+  std::vector<double> variables;
+  derive(parse_plant(blocks), {0, 1, 100}, {}, &variables);
+  EXPECT_EQ(variables.at(1), 1.0);
+  derive(parse_plant(blocks), {1, 1, 100}, {}, &variables);
+  EXPECT_EQ(variables.at(1), 5.0);
+}
+
+// cpp pastes a #define's body as text: one of several operands means what cpp makes of it where
+// it stands (2+3 in N*2 is 2+3*2); one operand is a constant the scene may replace.
+TEST(Cpfg, DefinesOfSeveralOperandsArePastedAsText) {
+  EXPECT_EQ(derive_text("#define N 2+3\naxiom: B(N*2)\n", 0), "B(8)");
+  EXPECT_EQ(derive_text("#define N 2\n#define M N+1\naxiom: B(M*10)\n", 0), "B(12)");
+  EXPECT_EQ(derive_text("#define N (2+3)\naxiom: B(N*2)\n", 0), "B(10)");
+  EXPECT_EQ(derive_text("#define N -sqrt(4)\naxiom: B(N*2)\n", 0), "B(-4)");
+  const Grammar replaced = parse_grammar({{"plant.l", "#define N 2+3\naxiom: B(N*2)\n", false}}, {{"N", 4}});
+  EXPECT_EQ(text_of(derive(replaced, {0, 1, 100})), "B(8)");
+}
+
+// cpfg reads '<>' as '!=' (lsys_input.l).
+TEST(Cpfg, LessGreaterIsNotEqual) {
+  EXPECT_EQ(derive_text("axiom: A(1)A(2)\nA(x) : x <> 2 --> B\n", 1), "BA(2)");
+  EXPECT_EQ(derive_text("axiom: A(1)A(2)\nA(x) : x<>1 && x < 3 --> B\n", 1), "A(1)B");
+}
+
 // fopen(name, "r") and fscan (CPFG manual 5.4) read a data file beside the grammar, as C's
 // fscanf reads numbers; writing files is refused.
 TEST(Cpfg, FscanReadsADataFileBesideTheGrammar) {

@@ -99,10 +99,10 @@ TEST(Derive, ParametricValuesFollowTheProductions) {
   const ModuleString word = run("#define lr 1.109\n#define vr 1.732\naxiom: !(1)F(200)/(45)A\n"
                                 "F(l) --> F(l*lr)\n!(w) --> !(w*vr)\n", 4);
   ASSERT_EQ(symbols(word), "!F/A");
-  double l = 200, w = 1;
+  double l = 200, w = 1;  // each step's product kept as the string keeps it, a 32-bit float
   for (int n = 0; n < 4; ++n) {
-    l = l * 1.109;
-    w = w * 1.732;
+    l = double(float(l * 1.109));
+    w = double(float(w * 1.732));
   }
   EXPECT_EQ(word.params_of(0)[0], w);
   EXPECT_EQ(word.params_of(1)[0], l);

@@ -113,7 +113,14 @@ TEST(Expression, FunctionsInDegrees) {
   EXPECT_NEAR(eval("asin(0.5)"), 30.0, 1e-12);
   EXPECT_NEAR(eval("acos(0.5)"), 60.0, 1e-12);
   EXPECT_NEAR(eval("atan(1)"), 45.0, 1e-12);
-  EXPECT_NEAR(eval("atan2(1, -1)"), 135.0, 1e-12);
+  // cpfg's own (generate.c): atan2(x, y) is the angle of the vector (x, y); trunc rounds, halves up.
+  EXPECT_NEAR(eval("atan2(1, -1)"), -45.0, 1e-12);
+  EXPECT_NEAR(eval("atan2(-1, 1)"), 135.0, 1e-12);
+  EXPECT_EQ(eval("trunc(2.7)"), 3.0);
+  EXPECT_EQ(eval("trunc(2.5)"), 3.0);
+  EXPECT_EQ(eval("trunc(2.4)"), 2.0);
+  EXPECT_EQ(eval("trunc(-2.7)"), -3.0);
+  EXPECT_EQ(eval("trunc(-2.5)"), -2.0);
   EXPECT_EQ(eval("sqrt(16)"), 4.0);
   EXPECT_NEAR(eval("exp(1)"), std::numbers::e, 1e-15);
   EXPECT_NEAR(eval("log(exp(2))"), 2.0, 1e-15);

@@ -25,7 +25,7 @@ TEST(Grammar, DirectivesAndRules) {
   const Grammar g = parse_defined(
       "# a comment line\n"
       "#define r 0.5   /* trailing comment */\n"
-      "#define q r*4\n"
+      "#define q (r*4)\n"
       "lsystem: 1\n"
       "derivation length: 3\n"
       "angle: 22.5\n"
@@ -82,7 +82,7 @@ TEST(Grammar, ArrowsAndTurnSymbolsAsPredecessors) {
 }
 
 TEST(Grammar, SceneDefinesOverrideFileDefines) {
-  const Grammar g = parse_defined("#define a 1\n#define b a+1\naxiom: F\n", {{"a", 10}});
+  const Grammar g = parse_defined("#define a 1\n#define b (a+1)\naxiom: F\n", {{"a", 10}});
   ASSERT_EQ(g.defines.size(), 2u);
   EXPECT_EQ(g.defines[0], (std::pair<std::string, double>("a", 10)));
   EXPECT_EQ(g.defines[1], (std::pair<std::string, double>("b", 11)));

@@ -49,12 +49,14 @@ TEST_F(Tropism, TwoTropismsAndATorqueSwitchedPerSegment) {
   // Orthotropism toward +x with e = 0.5: H turns 0.5 |H x T| = 0.5 rad before the segment.
   expect_near(k.segment_end[1], Vector3d(0, 1, 0) + in_plane(0.5));
   // Diatropism (A: 90) to the plane across T = +z: H 60 degrees below it turns up by 0.3 sin 60.
-  const double pitch = std::numbers::pi / 3 - 0.3 * std::sin(std::numbers::pi / 3);
+  // The elasticities are the string's parameters, 32-bit floats.
+  const double pitch = std::numbers::pi / 3 - double(0.3f) * std::sin(std::numbers::pi / 3);
   expect_near(k.segment_end[2], Vector3d(0, 1 + std::cos(pitch), -std::sin(pitch)));
   // The torque rolls U (here +x after /(90)) about H toward T = +z by 0.4 rad; H stays.
   expect_near(k.segment_end[3], {0, 2, 0});
-  expect_near(k.segment_up[3], {std::cos(0.4), 0, std::sin(0.4)});
-  expect_near(k.segment_end[4], Vector3d(0, 2, 0) - Vector3d(std::cos(0.4), 0, std::sin(0.4)));  // &(90): H = -U
+  const double roll = double(0.4f);
+  expect_near(k.segment_up[3], {std::cos(roll), 0, std::sin(roll)});
+  expect_near(k.segment_end[4], Vector3d(0, 2, 0) - Vector3d(std::cos(roll), 0, std::sin(roll)));  // &(90): H = -U
   // The main axis: its elasticities were restored at each ']'.
   expect_near(k.segment_end[5], {0, 2, 0});
   const double second = 0.5 + 0.5 * std::cos(0.5);  // 0.5 |H x T| with H at 0.5 rad from +y

@@ -158,8 +158,9 @@ TEST(ShippedGrammars, BroadleafSizeWidthsAndLeaves) {
   EXPECT_NEAR(top, 8.0793286, 1e-6);
   EXPECT_NEAR(min_x, -3.5173767, 1e-6);
   EXPECT_NEAR(max_x, 3.3703808, 1e-6);
-  // Diameter = twig W0 + one ring per season: 0.012 + 8 * 0.03 at the trunk base.
-  EXPECT_NEAR(k.segment_width[0], 0.252, 1e-12);
+  // Diameter = twig W0 + one ring per season: 0.012 + 8 * 0.03 at the trunk base, summed in the
+  // string's 32-bit float parameters.
+  EXPECT_NEAR(k.segment_width[0], 0.252, 1e-8);
   for (const double w : k.segment_width) EXPECT_GE(w, 0.012);
   for (const int32_t s : k.leaf_segment) EXPECT_GE(s, 0);
   // With the default jitter the counts do not change.
