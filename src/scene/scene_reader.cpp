@@ -112,9 +112,13 @@ std::optional<long long> SceneObject::optional_integer(const std::string& key, l
     if (i < lo || i > hi) fail_expected(key, expected);
     return i;
   }
+  // Written with a fraction or an exponent: a double, whose every value from 2^53 on is whole,
+  // so 9007199254740992.5 would read as an integer nobody wrote.
   double v = 0;
   if (!as_finite_number(*value, &v) || std::floor(v) != v || v < double(lo) || v > double(hi))
     fail_expected(key, expected);
+  if (std::fabs(v) >= 9007199254740992.0)
+    fail_expected(key, expected + " (past 2^53 written as digits alone: with a fraction or an exponent it is not exact)");
   return static_cast<long long>(v);
 }
 
