@@ -95,31 +95,20 @@ void place_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, con
 void write_frame(const BakePlan& plan, BakeStart& start, BakeFrames& frames, long long frame,
                  const TreePlacement* placement, FrameThread* frame_thread) {
   if (frames.sampled && !plan.reads_mesh) {
-    // Nothing reads the mesh: no vertex is placed; the bounds are the samples', extended one
-    // by one as AlignedBox::extend does (std::min and std::max per axis), in plain doubles.
+    // Nothing reads the mesh: no vertex is placed; the bounds are the samples' (in the world,
+    // as the state holds them), extended one by one as AlignedBox::extend does (std::min and
+    // std::max per axis), in plain doubles.
     if (!frames.measures_bounds) return;
     Eigen::Vector3d low = frames.bounds.min(), high = frames.bounds.max();
     for (long s = 0; s < start.state.positions.cols(); ++s) {
       const Eigen::Vector3d x = start.state.positions.col(s);
-      const Eigen::Vector3d own =
-          placement ? Eigen::Vector3d(placement->rotation.transpose() * (x - placement->translation)) : x;
-      for (int i = 0; i < 3; ++i) low[i] = std::min(low[i], own[i]), high[i] = std::max(high[i], own[i]);
+      for (int i = 0; i < 3; ++i) low[i] = std::min(low[i], x[i]), high[i] = std::max(high[i], x[i]);
     }
     frames.bounds = Eigen::AlignedBox3d(low, high);
     return;
   }
   if (frame_thread) frame_thread->submit(start.state, frames.outputs.wants_velocities(), frame);
   else place_frame(plan, start, frames, start.state, frame, placement);
-}
-
-// A box in the tree's own frame => the world box holding it.
-Eigen::AlignedBox3d world_bounds(const Eigen::AlignedBox3d& own, const TreePlacement* placement) {
-  Eigen::AlignedBox3d world;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p = own.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-    world.extend(placement ? Eigen::Vector3d(placement->rotation * p + placement->translation) : p);
-  }
-  return world;
 }
 
 }  // namespace
@@ -129,6 +118,7 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
     : info(bake_info(scene, plan, model, placement)),
       output_count(scene.outputs.size()),
       measures_bounds(placement != nullptr),
+      placement(placement ? *placement : TreePlacement{}),
       outputs(scene.outputs, config.out_dir, model, info,
               plan.checkpoints.every > 0 ? plan.checkpoints.dir : std::filesystem::path()) {}
 
@@ -136,7 +126,9 @@ void BakeFrames::push(FrameData data) {
   if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame
   if (measures_bounds)
     for (size_t i = 0; i + 2 < data.positions.size(); i += 3)
-      bounds.extend(Eigen::Vector3d(data.positions[i], data.positions[i + 1], data.positions[i + 2]));
+      bounds.extend(Eigen::Vector3d(placement.rotation * Eigen::Vector3d(data.positions[i], data.positions[i + 1],
+                                                                         data.positions[i + 2]) +
+                                    placement.translation));
   outputs.push(std::move(data));
 }
 
@@ -212,7 +204,7 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
 }
 
 TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,
-                           BakeFrames& frames, const TreePlacement* placement, const BakeLog& log) {
+                           BakeFrames& frames, const BakeLog& log) {
   TreeBakeResult result;
   // A signal while the files are completed (a skin's fit, a page: seconds) stops the bake as
   // one between frames does; one after they are in place leaves them (exit 0).
@@ -230,7 +222,7 @@ TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const L
   for (size_t k = 0; k < frames.output_count; ++k) result.files.push_back(frames.outputs.files(k));
   if (plan.closes_loop)
     result.loop = LoopSummary{warmup, !start.checkpoint.empty(), frames.seam.seam(), frames.seam.median_step()};
-  if (frames.measures_bounds) result.bounds = world_bounds(frames.bounds, placement);
+  if (frames.measures_bounds) result.bounds = frames.bounds;
   return result;
 }
 
@@ -284,7 +276,7 @@ TreeBakeResult bake_tree(const Scene& scene, const BakeConfig& config, const Tre
   TreeBakeResult result;
   result.exit_code = run_frames(plan, simulator, start, frames, placement, log, *governor);
   if (result.exit_code != 0) return result;
-  result = finish_bake(plan, start, warmup, frames, placement, log);
+  result = finish_bake(plan, start, warmup, frames, log);
   if (result.exit_code != 0) return result;
   result.vertices = vertices;
   result.samples = samples ? samples->vertex_count() : 0;

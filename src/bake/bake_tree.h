@@ -33,8 +33,9 @@ struct BakeFrames {
 
   const BakeInfo info;
   const size_t output_count;
-  // A placed tree reports the box of its frames to the forest's manifest; a lone tree has no use for it.
+  // A placed tree reports the world box of its frames to the forest's manifest; a lone tree has no use for it.
   const bool measures_bounds;
+  const TreePlacement placement;  // world from the tree's own frame, where its outputs' vertices are
   bool sampled = false;  // hsm.particles "samples": the solver steps samples, not the mesh
   // Each frame carries its clusters' motions (FrameData::cluster_motions), journalled with it:
   // a samples bake with an output that keys them.
@@ -46,7 +47,9 @@ struct BakeFrames {
   SimState skinned;
   OutputSet outputs;
   SeamMeter seam;              // a loop baked whole: every frame
-  Eigen::AlignedBox3d bounds;  // m, every written frame's vertices in the tree's own frame (measures_bounds)
+  // m, every written frame's vertices placed in the world, each vertex where it stands: a box of
+  // the tree's own frame turned with it would hold up to √2 times the turned tree's width.
+  Eigen::AlignedBox3d bounds;
 };
 
 // A loop baked whole: how it was brought to repeat and how well it closes.
@@ -104,7 +107,7 @@ int run_frames(const BakePlan& plan, Simulator& simulator, BakeStart& start, Bak
 
 // Finish: the outputs' final names, and what the bake wrote (bounds in the world).
 TreeBakeResult finish_bake(const BakePlan& plan, const BakeStart& start, const LoopWarmup& warmup,
-                           BakeFrames& frames, const TreePlacement* placement, const BakeLog& log);
+                           BakeFrames& frames, const BakeLog& log);
 
 // Bakes `scene` as `config` says. With a placement the tree is simulated where it stands and its
 // outputs are written in its own frame. Throws InputError, SimulationError, OutputError; nothing

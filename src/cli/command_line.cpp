@@ -181,6 +181,9 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
   commands.gather->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks")
       ->check(non_empty_path)
       ->needs(tasks);  // a log is named by its task, which --tasks decides
+  commands.gather->footer(
+      "Example (after every shard's `run --shard I/4 -o out`):\n"
+      "  treeanim farm gather configs/forest-demo.json -o out --tasks 4 --logs out/logs");
 }
 
 int dispatch(const Subcommands& commands, Arguments& args) {

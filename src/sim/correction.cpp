@@ -214,10 +214,12 @@ void write_state(const SolverModel<Real>& model, const Attachment<Real>& attachm
 template <typename Real>
 void throw_vertex_failure(const SolverModel<Real>& model, const Attachment<Real>& attachment, const SimState& state,
                           long long frame, int substep, uint32_t bad, uint32_t runaway) {
-  // Vertex v => "frame F, substep S, cluster C (vertex v): " for the messages below.
+  // Particle v => "frame F, substep S, cluster C (vertex v): " for the messages below; in
+  // "samples" v is no mesh vertex, so it is named for what it is.
+  const char* particle = model.options.particles == ParticleMode::kSamples ? " (hsm.particles sample " : " (vertex ";
   auto where = [&](uint32_t v) {
     return "frame " + std::to_string(frame) + ", substep " + std::to_string(substep) + ", cluster " +
-           std::to_string(attachment.vertex_air_cluster[v]) + " (vertex " + std::to_string(v) + "): ";
+           std::to_string(attachment.vertex_air_cluster[v]) + particle + std::to_string(v) + "): ";
   };
   if (bad != kNone) throw SimulationError(where(bad) + "non-finite position or velocity");
   if (runaway == kNone) return;

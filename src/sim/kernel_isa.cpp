@@ -37,8 +37,8 @@ std::string asked_isa_error() {
   if (!asked) return "";
   for (KernelIsa isa : {KernelIsa::kPortable, KernelIsa::kAvx2, KernelIsa::kAvx512})
     if (std::string(asked) == kernel_isa_name(isa)) return "";
-  return std::string("TREEANIM_ISA: expected portable, avx2 or avx512 (or none: the widest this CPU runs "
-                     "well), got '") + excerpt(asked) + "'";
+  return std::string("TREEANIM_ISA: expected portable, avx2 or avx512 (or unset: avx2 where the CPU "
+                     "has it, else portable), got '") + excerpt(asked) + "'";
 }
 
 KernelIsa kernel_isa() {

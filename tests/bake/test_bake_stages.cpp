@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -229,7 +230,7 @@ TEST_F(BakeStages, RunAFewFramesAndFinish) {
   log.frame_done = [&](long long frames_done) { done.push_back(frames_done); };
   ASSERT_EQ(run_frames(plan, simulator, start, frames, nullptr, log, governor), 0);
   EXPECT_EQ(done, (std::vector<long long>{1, 2, 3, 4, 5}));
-  const TreeBakeResult result = finish_bake(plan, start, {}, frames, nullptr, log);
+  const TreeBakeResult result = finish_bake(plan, start, {}, frames, log);
   EXPECT_EQ(result.written.first, 10);
   EXPECT_EQ(result.written.count(), 5);
   EXPECT_EQ(result.substeps, 4 * 2);
@@ -252,6 +253,27 @@ TEST_F(BakeStages, FinishGivesTheBoundsInTheWorld) {
   EXPECT_NEAR(placed.bounds.min().x(), own.bounds.min().x() + 5, 1e-4);
   EXPECT_NEAR(placed.bounds.max().z(), own.bounds.max().z() - 2, 1e-4);
   EXPECT_NEAR(placed.bounds.max().y(), own.bounds.max().y(), 1e-4);
+}
+
+TEST_F(BakeStages, TheWorldBoundsHoldTheTurnedVerticesTightly) {
+  // A point cache holds the frames in the tree's own frame; turned by 45° they give the box
+  // exactly, where the own frame's box turned with the tree would be wider.
+  const Scene line = scene({R"(outputs=[{"format": "pc2", "path": "bake.pc2"}])"});
+  const TreePlacement placement = make_tree_placement(Eigen::Vector3d(3, 0, 1), 45);
+  const TreeBakeResult placed = bake_tree(line, config(), &placement, BakeLog{});
+  const std::string cache = slurp(dir_ / "out" / "bake.pc2");
+  int32_t points = 0, samples = 0;
+  std::memcpy(&points, cache.data() + 16, 4);
+  std::memcpy(&samples, cache.data() + 28, 4);
+  ASSERT_EQ(cache.size(), 32 + size_t(points) * samples * 12);
+  Eigen::AlignedBox3d world;
+  for (size_t k = 0; k < size_t(points) * samples; ++k) {
+    float x[3];
+    std::memcpy(x, cache.data() + 32 + 12 * k, 12);
+    world.extend(placement.rotation * Eigen::Vector3d(x[0], x[1], x[2]) + placement.translation);
+  }
+  EXPECT_LT((placed.bounds.min() - world.min()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((placed.bounds.max() - world.max()).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST_F(BakeStages, AResumedBakeWritesTheSameBytes) {
