@@ -175,11 +175,18 @@ int submit_to_slurm(const FarmJob& job, const FarmRequest& request) {
   const std::string gather_id = job_id(second.out);
   if (gather_id.empty()) {
     const fs::path scancel = find_on_path("scancel");
-    if (!scancel.empty()) run_program(scancel, {array_id});
-    discard();
+    const ProgramResult cancel = scancel.empty() ? ProgramResult{127, "", "scancel is not on PATH"}
+                                                 : run_program(scancel, {array_id});
+    const std::string left =
+        cancel.status == 0 ? "; the job array " + array_id + " was cancelled, nothing is left submitted"
+                           : "; the job array " + array_id + " could not be cancelled (scancel: exit " +
+                                 std::to_string(cancel.status) + ", " + trimmed(cancel.err + cancel.out) +
+                                 "): it is still queued with no gather behind it; cancel it by hand (scancel " +
+                                 array_id + ")";
+    // The array's scripts stay while it may still run them.
+    if (cancel.status == 0) discard();
     throw InputError("--engine slurm: " + sbatch.string() + " refused the gather job (exit " +
-                     std::to_string(second.status) + "): " + trimmed(second.err + second.out) +
-                     "; the job array " + array_id + " was cancelled, nothing is left submitted");
+                     std::to_string(second.status) + "): " + trimmed(second.err + second.out) + left);
   }
   std::error_code error;
   fs::rename(array_temporary, array, error);

@@ -89,7 +89,8 @@ void check_float32_key_times(const OutputOptions& options, const BakeInfo& info,
   if (float_step <= frame_step / 2) return;
   throw InputError(options.where() + ": " + keys + " keep their times in float32, whose step at " +
                    number_text(farthest) + " s is " + number_text(float_step) + " s, more than half the " +
-                   number_text(frame_step) + " s between written frames: bake nearer time 0 (time.start)");
+                   number_text(frame_step) + " s between written frames: raise frame_step, bake fewer frames (time.frames) or bake nearer time 0 "
+                   "(time.start)");
 }
 
 }  // namespace treeanim

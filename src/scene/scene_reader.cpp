@@ -118,7 +118,8 @@ std::optional<long long> SceneObject::optional_integer(const std::string& key, l
   if (!as_finite_number(*value, &v) || std::floor(v) != v || v < double(lo) || v > double(hi))
     fail_expected(key, expected);
   if (std::fabs(v) >= 9007199254740992.0)
-    fail_expected(key, expected + " (past 2^53 written as digits alone: with a fraction or an exponent it is not exact)");
+    fail_expected(key, expected + " (from 2^53 on, written as digits alone: with a fraction or an exponent "
+                                  "the number read is whole whatever was written)");
   return static_cast<long long>(v);
 }
 

@@ -131,7 +131,8 @@ class OpenVdbGrids final : public VolumeGrids {
       for (auto it = vector->cbeginValueOn(); it; ++it) {
         const openvdb::Vec3s v = *it;
         const bool finite = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-        visit(name, coordinates(it.getCoord()), finite ? v.length() : 0, finite);
+        // In double: a float's |v|^2 overflows from 1.8e19 m/s and would report inf.
+        visit(name, coordinates(it.getCoord()), finite ? Eigen::Vector3d(v[0], v[1], v[2]).norm() : 0, finite);
       }
       return;
     }
