@@ -28,8 +28,9 @@ PreparedTree prepare_tree(const Scene& scene, MeshSurface surface,
     tree.model = build_tree_model(tree.skeleton, scene.tree, surface);
   } catch (const TreeModelError& e) {
     // What the model refuses comes from what the grammar drew, at the scene's lengths and widths: name them.
+    const std::string forest = scene.forest_tree.empty() ? "" : ", and of " + scene.forest_tree;
     throw InputError(grammar_name(scene.lsystem) + ": the tree it draws cannot be built (its lengths and widths "
-                     "times lsystem.step, tree.scale and tree.width_scale): " + e.what());
+                     "times lsystem.step, tree.scale and tree.width_scale" + forest + "): " + e.what());
   }
   tree.model_seconds = seconds_since(start);
   return tree;

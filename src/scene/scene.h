@@ -37,6 +37,9 @@ struct Scene {
   TimeOptions time;
   std::vector<OutputOptions> outputs;
   std::optional<Forest> forest;  // /forest: many trees; none = the one tree of /lsystem
+  // A forest's tree (tree_scene): "forest tree 'ID' (its scale S)", for the messages that its own
+  // scale may explain; "" for a lone tree.
+  std::string forest_tree;
   std::optional<VolumeSummary> volume;  // /wind/volume checked over the bake's times: what `info` prints
   // The files the scene names (grammars, views, wind series, leaf meshes, volume patterns),
   // sorted, each once: their contents key a bake (bake_key), as the resolved scene holds only paths.

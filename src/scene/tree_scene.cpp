@@ -1,4 +1,5 @@
 // A forest's tree => the one-tree scene that bakes it (scene/scene.h).
+#include "common/message_text.h"
 #include "scene/scene.h"
 
 namespace treeanim {
@@ -26,6 +27,7 @@ Scene tree_scene(const Scene& forest_scene, size_t index) {
   scene.lsystem = variant.lsystem;
   scene.lsystem.seed = tree.seed;
   scene.tree = scaled_tree_options(variant.tree, tree.scale);
+  scene.forest_tree = "forest tree '" + tree.id + "' (its scale " + number_text(tree.scale) + ")";
   scene.hsm = variant.hsm;
   scene.wind = forest_scene.wind;
   scene.time = forest_scene.time;
