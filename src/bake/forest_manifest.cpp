@@ -11,6 +11,7 @@
 #include "files/text_output.h"
 #include "formats/html_forest.h"
 #include "formats/usd_forest.h"
+#include "bake/scene_hash.h"
 #include "output/output_formats.h"
 
 namespace treeanim {
@@ -91,6 +92,10 @@ const OutputOptions* first_output(const Scene& scene, const std::string& format)
   return found == scene.outputs.end() ? nullptr : &*found;
 }
 
+// A part without its digest => the digest of its text: a part edited by hand (another tree's
+// id, another file) no longer matches the one written with it.
+std::string part_digest(const Json& part) { return scene_hash(part.dump(), "forest part"); }
+
 }  // namespace
 
 fs::path tree_part_path(const fs::path& out_dir, const std::string& id) {
@@ -109,7 +114,7 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
     for (const fs::path& file : result.files[k]) files.push_back(manifest_name(file, out_dir));
     outputs.push_back({{"format", tree_scene.outputs[k].format->name}, {"files", std::move(files)}});
   }
-  const Json part = {
+  Json part = {
       {"id", tree.id},
       {"variant", forest_scene.forest->variants[tree.variant].name},
       {"seed", tree.seed},
@@ -123,6 +128,7 @@ void write_tree_part(const BakeConfig& config, const Scene& forest_scene, size_t
       {"vertices", result.vertices},
       {"outputs", std::move(outputs)},
       {"bake", bake_key(tree_scene, config.generator)}};
+  part["digest"] = part_digest(part);
   write_text_output(tree_part_path(out_dir, tree.id), part.dump(2) + "\n");
 }
 
@@ -142,6 +148,13 @@ std::optional<Json> complete_tree_part(const fs::path& out_dir, const std::strin
       why = path.string() + (of != id ? " is the part of tree " + printable_text(of) + ", copied here"
                                       : " is of another scene or treeanim version");
       if (foreign) *foreign = of == id;
+      return std::nullopt;
+    }
+    const std::string digest = part.at("digest").get<std::string>();
+    part.erase("digest");
+    if (digest != part_digest(part) || part.at("id").get<std::string>() != id) {
+      why = path.string() + " was edited after its tree was baked (it no longer matches its digest or names "
+                            "another tree)";
       return std::nullopt;
     }
     for (const Json& output : part.at("outputs"))

@@ -10,6 +10,7 @@
 #include "common/errors.h"
 #include "lsystem/lsystem.h"
 #include "formats/output_estimate.h"
+#include "sim/particle_model.h"
 
 namespace treeanim {
 
@@ -28,10 +29,15 @@ ForestEstimate estimate_forest(const Scene& scene) {
     const Scene one = tree_scene(scene, t);
     const PreparedTree tree = prepare_tree(one);
     variant_vertices[v] = tree.model.vertex_count();
-    variant_checkpoint[v] = estimated_checkpoint_bytes(tree.model.vertex_count(), tree.model.cluster_count(),
-                                                       tree.model.leaf_count());
     variant_record[v] = double(journal_record_bytes({"", 0, tree.model.vertex_count(), tree.model.leaf_count(), true}));
-    variant_cost[v] = uint64_t(tree.model.vertex_count()) * uint64_t(steps);
+    // With hsm.particles "samples" the solver moves the samples (and a checkpoint holds them),
+    // and the mesh is skinned once a frame: costed as one step of its vertices a frame.
+    const bool sampled = one.hsm.particles == ParticleMode::kSamples;
+    const TreeModel simulated = sampled ? sample_tree_model(tree.model) : TreeModel();
+    const TreeModel& moved = sampled ? simulated : tree.model;
+    variant_checkpoint[v] = estimated_checkpoint_bytes(moved.vertex_count(), moved.cluster_count(), moved.leaf_count());
+    variant_cost[v] = uint64_t(moved.vertex_count()) * uint64_t(steps) +
+                      (sampled ? uint64_t(tree.model.vertex_count()) * uint64_t(scene.time.frames) : 0);
     for (const OutputOptions& output : one.outputs)
       variant_bytes[v] += estimated_output_bytes(output, tree.model.vertex_count(), tree.model.triangle_count(),
                                                  tree.model.cluster_count(), scene.time.frames);

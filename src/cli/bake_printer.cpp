@@ -7,14 +7,21 @@
 #include "bake/signals.h"
 #include "bake/forest_manifest.h"
 #include "bake/prepare_tree.h"
+#include "cli/shell_words.h"
 #include "common/message_text.h"
 #include "sim/kernel_isa.h"
 
 namespace treeanim {
 
 BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std::filesystem::path& scene_file,
-                         Verbosity verbosity)
-    : scene_(scene), config_(config), scene_file_(scene_file), verbosity_(verbosity), growth_(verbosity, stderr) {
+                         const std::vector<std::string>& overrides, Verbosity verbosity)
+    : scene_(scene),
+      config_(config),
+      gather_arguments_(shell_word(scene_file.string()) +
+                        (config.out_dir.empty() ? "" : " -o " + shell_word(config.out_dir.string())) +
+                        set_arguments(overrides)),
+      verbosity_(verbosity),
+      growth_(verbosity, stderr) {
   const bool quiet = verbosity == Verbosity::kQuiet;
   log_.notes = quiet ? nullptr : stderr;
   log_.grown_step = [this](int step, int steps, size_t modules) { growth_.update(step, steps, modules); };
@@ -98,9 +105,9 @@ void BakePrinter::forest_baked(const ForestBakeResult& result) const {
   const std::filesystem::path& out = config_.out_dir;
   if (config_.shard)
     std::printf("shard %zu/%zu: %zu trees baked, %zu complete before; once every shard is done: treeanim farm "
-                "gather %s%s%s\n",
-                config_.shard->index, config_.shard->count, result.baked, result.skipped, printable_text(scene_file_.string()).c_str(),
-                out.empty() ? "" : " -o ", printable_text(out.string()).c_str());
+                "gather %s\n",
+                config_.shard->index, config_.shard->count, result.baked, result.skipped,
+                printable_text(gather_arguments_).c_str());
   else
     std::printf("forest: %zu trees (%zu baked, %zu complete before); manifest %s\n", scene_.forest->trees.size(),
                 result.baked, result.skipped, printable_text(forest_manifest_path(out).string()).c_str());

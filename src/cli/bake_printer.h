@@ -14,9 +14,10 @@ namespace treeanim {
 
 class BakePrinter {
  public:
-  // scene: the scene baked (a forest's trees are named in its lines); config: its bake's.
+  // scene: the scene baked (a forest's trees are named in its lines); config: its bake's;
+  // scene_file and overrides: as given, for the gather command a shard's last line shows.
   BakePrinter(const Scene& scene, const BakeConfig& config, const std::filesystem::path& scene_file,
-              Verbosity verbosity);
+              const std::vector<std::string>& overrides, Verbosity verbosity);
   BakePrinter(const BakePrinter&) = delete;
   BakePrinter& operator=(const BakePrinter&) = delete;
 
@@ -33,7 +34,7 @@ class BakePrinter {
 
   const Scene& scene_;
   const BakeConfig& config_;
-  std::filesystem::path scene_file_;
+  std::string gather_arguments_;  // SCENE [-o OUT] [--set ...], as shell words
   Verbosity verbosity_;
   std::optional<Progress> progress_;
   GrowthProgress growth_;

@@ -20,7 +20,7 @@ int run_command(const RunRequest& request) {
     std::fprintf(stderr, "treeanim: note: --checkpoint-dir %s is not used: only --checkpoint-every, --resume and "
                          "--frames write or read checkpoints\n",
                  printable_text(request.checkpoint_dir.string()).c_str());
-  BakePrinter printer(scene, config, request.scene, request.verbosity);
+  BakePrinter printer(scene, config, request.scene, request.overrides, request.verbosity);
   if (!scene.forest) return bake_tree(scene, config, nullptr, printer.log()).exit_code;
   const std::vector<size_t> trees = shard_trees(scene, config.shard);
   printer.shard_begins(trees);

@@ -138,15 +138,20 @@ AppliedOverride apply_override(Json& document, const std::string& assignment) {
   }
 
   Json* node = &document;
-  std::string pointer, made;
+  std::string pointer, made, dotted;  // dotted: the path so far, as written
   for (const std::string& token : tokens) {
     // A value not there yet: an array when the path indexes it (outputs.0.path), else an object.
-    if (node->is_null()) {
+    const bool absent = node->is_null();
+    if (absent) {
       *node = is_index(token) ? Json::array() : Json::object();
       if (made.empty()) made = pointer;
     }
+    const std::string parent = pointer;
     pointer += "/" + escape_pointer_token(token);
     if (node->is_array()) {
+      if (absent && std::stoul(token) > 0)
+        throw InputError(shown + ": " + parent + " is not in the scene, so its element " + token +
+                         " cannot be set alone: set the whole array (--set '" + dotted + "=[...]')");
       if (!is_index(token) || std::stoul(token) > node->size())
         throw InputError(shown + ": " + pointer + " is not an index of an array of " +
                          std::to_string(node->size()) + " elements (0 ... " + std::to_string(node->size()) + ", " +
@@ -164,6 +169,7 @@ AppliedOverride apply_override(Json& document, const std::string& assignment) {
       if (!node->contains(token) && made.empty()) made = pointer;
       node = &(*node)[token];
     }
+    dotted += (dotted.empty() ? "" : ".") + token;
   }
   *node = std::move(value);
   return {target, made.empty() ? target : made};

@@ -17,6 +17,8 @@ class VolumeGrids {
   virtual ~VolumeGrids() = default;
   // "vec3s grid 'vel'" or "float grids 'vel.x', 'vel.y', 'vel.z'"
   virtual std::string layout() const = 0;
+  // The grid that holds the velocity's axis (0 x, 1 y, 2 z): "vec3s grid 'vel'" or "float grid 'vel.y'".
+  virtual std::string grid_of(int axis) const = 0;
   // The first grid's largest voxel edge, in the volume's units.
   virtual double voxel_size() const = 0;
   // The eight corners of each grid's box of active voxel centres, in the volume's space (none

@@ -204,9 +204,14 @@ VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double 
                          number_text(max_speed) + " m/s (is `units` right?)");
       summary.largest_speed = std::max(summary.largest_speed, speed);
     };
+    // A non-finite background names the grid that holds it (one of a split grid's three).
     const Eigen::Vector3d background = frame.grids->background();
-    check([&] { return path + ": the background of " + frame.grids->layout() + " (the inactive voxels' value)"; },
-          background.allFinite() ? background.norm() : 0, background.allFinite());
+    int axis = 0;
+    while (axis < 2 && std::isfinite(background[axis])) ++axis;
+    check([&] {
+      return path + ": the background of " + (background.allFinite() ? frame.grids->layout() : frame.grids->grid_of(axis)) +
+             " (the inactive voxels' value)";
+    }, background.allFinite() ? background.norm() : 0, background.allFinite());
     frame.grids->visit_active([&](const std::string& grid, const std::array<int, 3>& ijk, double speed, bool finite) {
       check([&] {
         return path + ": grid '" + grid + "', voxel (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +

@@ -75,6 +75,10 @@ class OpenVdbGrids final : public VolumeGrids {
     return vector ? "vec3s grid '" + name + "'" : "float grids '" + name + ".x', '" + name + ".y', '" + name + ".z'";
   }
 
+  std::string grid_of(int axis) const override {
+    return vector ? "vec3s grid '" + name + "'" : "float grid '" + name + "." + "xyz"[axis] + "'";
+  }
+
   double voxel_size() const override {
     const openvdb::Vec3d voxel = vector ? vector->voxelSize() : split[0]->voxelSize();
     return std::max({voxel[0], voxel[1], voxel[2]});

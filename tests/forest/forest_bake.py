@@ -66,8 +66,12 @@ def case_shards(treeanim, tmp):
     one = os.path.join(tmp, "one")
     run(treeanim, "run", SCENE, "-o", one, "-q")
     shards = os.path.join(tmp, "shards")
-    for i in range(3):
+    for i in range(2):
         run(treeanim, "run", SCENE, "-o", shards, "-q", "--shard", "%d/3" % i)
+    # The last shard's closing line is the gather to run, as shell words.
+    done = run(treeanim, "run", SCENE, "-o", shards, "--shard", "2/3")
+    if "treeanim farm gather '%s' -o '%s'\n" % (SCENE, shards) not in done.stdout:
+        raise Failed("the shard's gather hint: %s" % done.stdout[-500:])
     if os.path.exists(os.path.join(shards, "forest.json")):
         raise Failed("a shard wrote forest.json; only farm gather does")
     done = run(treeanim, "farm", "gather", SCENE, "-o", shards)
@@ -129,6 +133,15 @@ def case_shards(treeanim, tmp):
     copied = "%s.json is the part of tree %s, copied here" % (trees[2]["id"], trees[1]["id"])
     if done.returncode != 4 or copied not in done.stderr:
         raise Failed("gather with a copied part: exit %d, %s" % (done.returncode, done.stderr))
+    # A part edited by hand to list another tree's file is not taken at its word.
+    part_path = os.path.join(parts, trees[1]["id"] + ".json")
+    part = json.load(open(part_path))
+    part["outputs"][0]["files"][0] = trees[0]["outputs"][0]["files"][0]
+    json.dump(part, open(part_path, "w"), indent=2)
+    done = run(treeanim, "farm", "gather", SCENE, "-o", shards, check=False)
+    edited = "%s.json was edited after its tree was baked" % trees[1]["id"]
+    if done.returncode != 4 or edited not in done.stderr:
+        raise Failed("gather with an edited part: exit %d, %s" % (done.returncode, done.stderr))
 
 
 def listed(folder):

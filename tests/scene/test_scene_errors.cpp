@@ -174,6 +174,20 @@ TEST(SceneOverrides, IndexesAndAppendsToArrays) {
   }
 }
 
+// An array the scene lacks has no element 1 to set: the whole array is what is missing.
+TEST(SceneOverrides, AnElementOfAnAbsentArrayAsksForTheWholeArray) {
+  Json document = Json::parse(R"({"hsm": {}})");
+  try {
+    apply_override(document, "hsm.gravity.1=-5");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "--set 'hsm.gravity.1=-5': /hsm/gravity is not in the scene, so its element 1 cannot be "
+                           "set alone: set the whole array (--set 'hsm.gravity=[...]')");
+  }
+  apply_override(document, "outputs.0.format=obj");  // element 0 starts the array
+  EXPECT_EQ(document["outputs"][0]["format"], "obj");
+}
+
 TEST(SceneOverrides, RefusesToDescendIntoAScalar) {
   Json document = Json::parse(R"({"time": {"fps": 24}})");
   try {

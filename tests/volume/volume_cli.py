@@ -116,6 +116,15 @@ def check_bad(treeanim, tmp):
         grids[0].background = (float("nan"), 0.0, 0.0)
         return grids
     background = rewritten("background", nan_background)
+    split_background = os.path.join(tmp, "split-background")  # vel.y's background NaN
+    write_volume("uniform", "split", split_background, "--frames", "1", "10", "--voxel", "1")
+    for frame in range(1, 11):
+        path = os.path.join(split_background, f"vel.{frame:04d}.vdb")
+        grids = vdb.readAll(path)[0]
+        for g in grids:
+            if g.name == "vel.y":
+                g.background = float("nan")
+        vdb.write(path, grids=grids)
 
     def volume(folder, **extra):
         return {"volume": {"path": os.path.join(folder, "vel.####.vdb"), **extra}}
@@ -161,6 +170,9 @@ def check_bad(treeanim, tmp):
         ("background-not-finite", volume(background), nine,
          "background/vel.0001.vdb: the background of vec3s grid 'vel' (the inactive voxels' value): the velocity is "
          "not finite"),
+        ("split-background-not-finite", volume(split_background), nine,
+         "split-background/vel.0001.vdb: the background of float grid 'vel.y' (the inactive voxels' value): the "
+         "velocity is not finite"),
     ]
     failures = []
     for name, wind, time, message in cases:
