@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <string>
 
 #include "cli/commands.h"
@@ -186,20 +187,31 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
       "  treeanim farm gather configs/forest-demo.json -o out --tasks 4 --logs out/logs");
 }
 
+// A command whose standard output is what it makes (info, species, farm plan) => its exit code,
+// once that output is written whole: `info --json > meta.json` on a full disk must not exit 0
+// with an empty file.
+int written_to_stdout(int code) {
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || std::cout.fail())
+    throw OutputError("standard output: the command's output could not be written whole (is the disk full, or "
+                      "the pipe closed?)");
+  return code;
+}
+
 int dispatch(const Subcommands& commands, Arguments& args) {
   if (*commands.run) {
     args.run.verbosity = args.quiet ? Verbosity::kQuiet : args.verbose ? Verbosity::kVerbose : Verbosity::kNormal;
     return run_command(args.run);
   }
   if (*commands.validate) return validate_command(args.validate_scene, args.validate_overrides);
-  if (*commands.species) return species_command(args.species_json);
-  if (*commands.plan) return farm_plan_command(args.farm);
+  if (*commands.species) return written_to_stdout(species_command(args.species_json));
+  if (*commands.plan) return written_to_stdout(farm_plan_command(args.farm));
   if (*commands.submit) return farm_submit_command(args.farm);
   if (*commands.gather) return farm_gather_command(args.farm);
-  return info_command(args.info_scene, args.info_overrides,
-                      args.info_resolved ? InfoFormat::kResolvedScene
-                      : args.info_json   ? InfoFormat::kJson
-                                         : InfoFormat::kText);
+  return written_to_stdout(info_command(args.info_scene, args.info_overrides,
+                                       args.info_resolved ? InfoFormat::kResolvedScene
+                                       : args.info_json   ? InfoFormat::kJson
+                                                          : InfoFormat::kText));
 }
 
 int report(const char* kind, const std::exception& error, int code) {

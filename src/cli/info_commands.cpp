@@ -6,6 +6,7 @@
 #include "bake/forest_tasks.h"
 #include "bake/prepare_tree.h"
 #include "cli/commands.h"
+#include "cli/progress.h"
 #include "common/message_text.h"
 #include "formats/output_estimate.h"
 #include "formats/outputs.h"
@@ -53,14 +54,22 @@ void print_volume(const VolumeSummary& volume) {
               volume.last_frame, volume.layout.c_str(), bounds, volume.voxel_size, volume.largest_speed);
 }
 
+// A long derivation says how far it is on stderr, as run's does (stdout is the command's own).
+PreparedTree grown_tree(const Scene& scene) {
+  GrowthProgress growth(Verbosity::kNormal, stderr);
+  return prepare_tree(scene, MeshSurface::kBuilt,
+                      [&](int step, int steps, size_t modules) { growth.update(step, steps, modules); });
+}
+
 // A lone tree's scene => its tree, grown, after what run refuses before it simulates: two
 // outputs at one file, a folder or a device where one goes (the paths as run resolves them
 // without -o), then each output's own limits.
+
 PreparedTree prepare_checked_tree(const Scene& scene) {
   const BakePlan plan = plan_bake(scene, BakeConfig{});
   OutputTargets targets;
   targets.add_outputs(scene.outputs, {}, plan.written.first, plan.written.count());
-  PreparedTree tree = prepare_tree(scene);
+  PreparedTree tree = grown_tree(scene);
   check_output_limits(scene.outputs, tree.model, bake_info(scene, plan, tree.model, nullptr));
   return tree;
 }
@@ -99,7 +108,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
   }
   const Scene first = scene.forest ? tree_scene(scene, 0) : Scene();
   const Scene& one = scene.forest ? first : scene;
-  const PreparedTree tree = scene.forest ? prepare_tree(one) : prepare_checked_tree(one);
+  const PreparedTree tree = scene.forest ? grown_tree(one) : prepare_checked_tree(one);
   Json summary = tree_summary(one, tree);
   if (scene.forest) {
     summary["forest"] = {{"trees", scene.forest->trees.size()},

@@ -327,6 +327,13 @@ class Deriver {
       total += weight;
     }
     if (candidates == 0 || (total <= 0 && !set.stochastic)) return nullptr;
+    if (std::isinf(total)) {
+      // Finite weights whose sum overflows (1e308 twice): scaled by a power of two, exactly, so
+      // that the draw keeps their ratios rather than falling to the last rule every time.
+      const int exponent = std::ilogb(*std::max_element(weights_.begin(), weights_.begin() + candidates));
+      total = 0;
+      for (size_t c = 0; c < candidates; ++c) total += weights_[c] = std::ldexp(weights_[c], -exponent);
+    }
     // A lone rule without a probability applies without a draw, as outside a stochastic set.
     const bool draws = total > 0 && (weighed || candidates > 1);
     const double draw = draws ? random.uniform() * total : 0.0;

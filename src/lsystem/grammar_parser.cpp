@@ -304,11 +304,19 @@ class Parser {
   bool continues(std::string_view text, size_t begin, size_t end) {
     const std::string_view last = pending_.text;
     if (pending_open()) return true;
-    if (text.substr(begin, 2) == "->" || text.substr(begin, 3) == "-->") return true;
     size_t b = 0, e = last.size(), value = 0;
     trim(last, &b, &e);
     const bool rule = find_arrow(last, b, e) != kNone;
     const bool axiom = match_keyword(last, b, e, "axiom", true, &value);
+    // A line that starts with the arrow ends a head written above it; after an axiom, a whole
+    // rule or a directive it is a rule without a predecessor, and is told so at its own line.
+    if (text.substr(begin, 2) == "->" || text.substr(begin, 3) == "-->") {
+      const auto names = [&](const std::string& keyword) { return match_keyword(last, b, e, keyword, true, &value); };
+      return !rule && std::none_of(kValueDirectives.begin(), kValueDirectives.end(), names) &&
+             std::none_of(kSectionDirectives.begin(), kSectionDirectives.end(), [&](const std::string& keyword) {
+               return match_keyword(last, b, e, keyword, false, &value);
+             });
+    }
     // A rule's head not yet at its arrow ("A(x) :" then a block on the next line) goes on.
     if (!rule && !axiom) return !starts_directive(last, b, e) && looks_like_head(last, b, e);
     if (find_arrow(text, begin, end) != kNone || starts_directive(text, begin, end)) return false;

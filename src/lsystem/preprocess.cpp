@@ -207,7 +207,13 @@ void Preprocessor::define(const SourceLine& line, size_t k) {
       k = skip_spaces(line.text, k + 1);
       size_t stop = k;
       while (stop < line.text.size() && in_name(line.text[stop])) ++stop;
-      if (stop > k) macro.parameters.push_back(line.text.substr(k, stop - k));
+      if (stop > k) {
+        const std::string parameter = line.text.substr(k, stop - k);
+        // As cpp: which argument a repeated name stands for is no one's guess.
+        if (std::find(macro.parameters.begin(), macro.parameters.end(), parameter) != macro.parameters.end())
+          fail(line.columns[k], "parameter '" + parameter + "' appears twice in macro '" + macro.name + "'");
+        macro.parameters.push_back(parameter);
+      }
       k = skip_spaces(line.text, stop);
       if (k < line.text.size() && line.text[k] == ')') break;
       if (k >= line.text.size() || line.text[k] != ',')

@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -125,13 +126,9 @@ std::optional<Movement> read_movement(const std::string& name, size_t line, cons
     for (int k = 0; k < (c == 'T' ? 3 : 1); ++k) {
       std::string number;
       in >> number;
-      size_t used = 0;
-      try {
-        v[static_cast<size_t>(k)] = std::stod(number, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != number.size() || !std::isfinite(v[static_cast<size_t>(k)]))
+      char* end = nullptr;  // strtod, not stod: stod throws for a tiny number (1e-320)
+      v[static_cast<size_t>(k)] = std::strtod(number.c_str(), &end);
+      if (number.empty() || end != number.c_str() + number.size() || !std::isfinite(v[static_cast<size_t>(k)]))
         fail(name, line, head + "expected " + (c == 'T' ? "three numbers" : "a number") + " after '" + word + ":'");
     }
     if (c == 'T') t = Eigen::Vector3d(v[0], v[1], v[2]);

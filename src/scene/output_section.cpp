@@ -55,7 +55,10 @@ OutputOptions read_output_options(SceneObject element) {
   options.format = find_output_format(element.choice("format", "", formats));
   const auto path = element.optional_string("path");
   if (!path || path->empty()) element.fail_expected("path", "a non-empty path string");
-  if (path->find('\0') != std::string::npos) element.fail_expected("path", "a path without a NUL character");
+  // The system reads a path only up to a NUL, and the files that name this one (an OBJ's mtllib,
+  // a USD reference, the forest's manifest) are lines of text: a control character breaks both.
+  if (std::any_of(path->begin(), path->end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+    element.fail_expected("path", "a path without control characters (NUL, newline, tab, ...)");
   options.path = *path;
   // A file's name, not a folder's: "out/" or "out/." would write the hidden file "out/.pc2" (or
   // fail once the whole bake is done, where the folder stands).

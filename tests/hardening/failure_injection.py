@@ -456,13 +456,14 @@ def interrupted_while_growing(bake):
 
 def growth_reports_progress(bake):
     """A derivation that runs for seconds says how far it is ("growing: step S of N, M modules")
-    while no frame has begun; a bake was silent until its tree was grown."""
+    while no frame has begun, in a bake and in validate; both were silent until the tree was grown."""
     grow = "{\"axiom\": \"A(0)\", \"productions\": [\"A(n) : n < 20 --> A(n+1)A(n+1)\", " \
            "\"A(n) : n >= 20 --> A(n)\"], \"iterations\": 120, \"max_modules\": 2000000}"
-    done = subprocess.run([bake.binary, "run", bake.scene, "-o", bake.out, "--set", "time.frames=2",
-                           "--set", "lsystem=" + grow], capture_output=True, text=True, errors="replace", timeout=600)
-    if not re.search(r"growing: step \d+ of 120, 1048576 modules", done.stderr):
-        raise Failed("no growth progress in: " + done.stderr[-2000:])
+    for command in (["run", bake.scene, "-o", bake.out, "--set", "time.frames=2"], ["validate", bake.scene]):
+        done = subprocess.run([bake.binary, *command, "--set", "lsystem=" + grow], capture_output=True, text=True,
+                              errors="replace", timeout=600)
+        if not re.search(r"growing: step \d+ of 120, 1048576 modules", done.stderr):
+            raise Failed("%s: no growth progress in: %s" % (command[0], done.stderr[-2000:]))
 
 
 def folders_under(folder):
@@ -676,6 +677,18 @@ def reader_gone(bake):
         raise Failed("exit %d; files: %s" % (done.returncode, [f for f in left if "seq/" not in f]))
 
 
+def stdout_full(bake):
+    """What info, species and farm plan make is their standard output: written to a full device
+    (`info --json > meta.json` on a full disk), exit 4 saying so, never 0 with an empty file."""
+    commands = [["info", bake.scene, "--json"], ["info", bake.scene, "--resolved-scene"], ["species", "--json"],
+                ["farm", "plan", os.path.join(HERE, "..", "..", "configs", "forest-demo.json"), "--tasks", "2"]]
+    for command in commands:
+        with open("/dev/full", "w") as full:
+            done = subprocess.run([bake.binary, *command], stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+        if done.returncode != 4 or "standard output: the command's output could not be written whole" not in done.stderr:
+            raise Failed("%s > /dev/full: exit %d, %s" % (" ".join(command), done.returncode, done.stderr[-500:]))
+
+
 def resume_after_kill_not_blocked(bake):
     """A bake killed with SIGKILL holds no lock any more: its --resume bakes to the end, reusing
     and then removing the lock files it left."""
@@ -794,6 +807,7 @@ SCENARIOS = {
     "no-room-for-the-outputs": no_room_for_the_outputs,
     "second-writer-refused": second_writer_refused,
     "reader-gone": reader_gone,
+    "stdout-full": stdout_full,
     "second-bake-of-the-checkpoints-refused": second_bake_of_the_checkpoints_refused,
     "second-writer-of-an-alias-refused": second_writer_of_an_alias_refused,
     "journal-bit-flipped": journal_bit_flipped,

@@ -83,6 +83,12 @@ TEST(Cpfg, BlocksVariablesAndControlBlocks) {
 
 // A block after a rule's ':' continues over lines until its braces close; any other brace is a
 // polygon's and never takes in the next line: a predecessor's, an axiom's, an ignore: list's.
+// A head ends on the next line at the arrow that starts it.
+TEST(Cpfg, AnArrowLineEndsTheHeadAboveIt) {
+  EXPECT_EQ(derive_text("axiom: A(1)\nA(n) : n > 0\n  --> B(n)\n", 1), "B(1)");
+  EXPECT_EQ(derive_text("axiom: A\nderivation length: 1\nA\n--> B\n", 1), "B");
+}
+
 TEST(Cpfg, OnlyABlockTakesInTheNextLine) {
   EXPECT_EQ(derive_text("axiom: A(1)\nA(n) : {m = n;\nm = m + 1;} m > 0 --> A(m)\n", 2), "A(3)");
   EXPECT_EQ(derive_text("axiom: A{.F}\n{ --> {\nA --> FA\n", 1), "FA{.F}");

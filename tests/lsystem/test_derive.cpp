@@ -181,6 +181,16 @@ TEST(Derive, StochasticFrequenciesFollowTheWeights) {
   EXPECT_NEAR(static_cast<double>(c), 3000.0, 150.0);
 }
 
+TEST(Derive, StochasticWeightsWhoseSumOverflowsKeepTheirRatios) {
+  // Two weights of 1.5e308 sum to inf: the draw still picks each about half the time, and
+  // exactly as weights of 1 do (a power-of-two scale changes no comparison).
+  const std::string axiom(4000, 'A');
+  const std::string huge = symbols(run("axiom: " + axiom + "\nA --> B : 1.5e308\nA --> C : 1.5e308\n", 1, 3));
+  const auto c = std::count(huge.begin(), huge.end(), 'C');
+  EXPECT_NEAR(static_cast<double>(c), 2000.0, 150.0);
+  EXPECT_EQ(huge, symbols(run("axiom: " + axiom + "\nA --> B : 1\nA --> C : 1\n", 1, 3)));
+}
+
 TEST(Derive, StochasticDrawDependsOnPositionNotOnTheRestOfTheString) {
   // The draw of a module is keyed by (seed, step, position): appending modules after it
   // does not change the choice made for the first 100.

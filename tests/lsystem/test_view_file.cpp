@@ -182,6 +182,14 @@ TEST_F(ViewFile, TropismAndTorqueLinesInOrder) {
   EXPECT_EQ(v.scale_multiplier, 2.0);
 }
 
+// A subnormal number is a number (stod threw for it, and it was refused as none).
+TEST_F(ViewFile, ATinyIntensityIsANumber) {
+  const ViewSettings v = read_view_file(write("plant.v", "tropism: T: 0 1 0 I: 1e-320 E: 1\n"));
+  ASSERT_EQ(v.movements.size(), 1u);
+  EXPECT_GT(v.movements[0].direction.y(), 0.0);
+  EXPECT_LT(v.movements[0].direction.y(), 1e-300);
+}
+
 // cpfg drops a tropism line it cannot read and goes on; here it is refused with its place.
 TEST_F(ViewFile, MalformedTropismLinesAreRefused) {
   EXPECT_EQ(error_of("tropism: E: 0.2\n"), "plant.v:1:1: 'tropism:' expected 'T: x y z' (it is mandatory)");
