@@ -276,8 +276,11 @@ class Deriver {
     return ls_ = &g_.lsystems[calls_.back()];
   }
 
-  // match_[k] for every bracket of word: the index of its partner.
+  // match_[k] for every bracket of word: the index of its partner; the left walks' stops, which
+  // depend on the L-system's skips, are found again when first asked (left_stop).
   void match_brackets(const ModuleString& word) {
+    left_stops_.clear();
+    right_stops_.clear();
     match_.assign(word.size(), -1);
     std::vector<int32_t> open;
     for (size_t k = 0; k < word.size(); ++k) {
@@ -412,9 +415,9 @@ class Deriver {
   // Left context: walks left, skipping complete branches (']' ... '[') and climbing out of the
   // current branch ('['), passing over ignored symbols; in a ring L-system the string's start
   // goes on at its end (CPFG manual 3.1.1), at most one turn per pattern module.
-  bool match_left(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+  bool match_left(const RuleSet& set, const Rule& rule, size_t index, double* slots) {
     const ModuleString& w = *word_;
-    const std::array<bool, 256>& skips = ls_->context_skips;
+    const std::vector<int32_t>& stop = left_stops(ls_->context_skips);
     ptrdiff_t j = static_cast<ptrdiff_t>(index) - 1;
     uint32_t turns = 0;
     for (uint32_t p = rule.left_end; p-- > rule.left_begin;) {
@@ -425,10 +428,8 @@ class Deriver {
           j = static_cast<ptrdiff_t>(w.size()) - 1;
           continue;
         }
-        const char c = w.symbols[static_cast<size_t>(j)];
-        if (c == ']') j = match_[static_cast<size_t>(j)] - 1;
-        else if (c == '[' || skips[static_cast<unsigned char>(c)]) --j;
-        else break;
+        j = stop[static_cast<size_t>(j)];
+        if (j >= 0) break;
       }
       const auto k = static_cast<size_t>(j);
       if (w.symbols[k] != pattern.symbol || w.params_of(k).size() != pattern.arity) return false;
@@ -438,13 +439,56 @@ class Deriver {
     return true;
   }
 
+  // For each k of word_, where a left walk from k stops for `skips`: k itself, or the first
+  // module to its left after lateral branches (']' to its '['), '[' and skipped symbols, or
+  // -1 past the start. Found once per word and skip table, left to right, since each entry
+  // follows from one before it: a walk per module stepped over every earlier sibling branch
+  // (quadratic: 200,000 branches of one axis took a minute).
+  const std::vector<int32_t>& left_stops(const std::array<bool, 256>& skips) {
+    for (const auto& [table, stops] : left_stops_)
+      if (table == &skips) return stops;
+    const ModuleString& w = *word_;
+    std::vector<int32_t> stops(w.size());
+    auto before = [&](int32_t k) { return k > 0 ? stops[static_cast<size_t>(k - 1)] : -1; };
+    for (size_t k = 0; k < w.size(); ++k) {
+      const char c = w.symbols[k];
+      if (c == ']') stops[k] = match_[k] < 0 ? -1 : before(match_[k]);
+      else if (c == '[' || skips[static_cast<unsigned char>(c)]) stops[k] = before(static_cast<int32_t>(k));
+      else stops[k] = static_cast<int32_t>(k);
+    }
+    left_stops_.emplace_back(&skips, std::move(stops));
+    return left_stops_.back().second;
+  }
+
+  // For each k of word_, where a right walk from k stops for `skips` (a pattern module other
+  // than '['): k itself, or the first module to its right after lateral branches ('[' to past
+  // its ']', or into it when '[' is skipped) and skipped symbols; -1 at a ']' that ends the
+  // branch, the word's size past its end. Found once per word and skip table, right to left.
+  const std::vector<int32_t>& right_stops(const std::array<bool, 256>& skips) {
+    for (const auto& [table, stops] : right_stops_)
+      if (table == &skips) return stops;
+    const ModuleString& w = *word_;
+    const auto n = static_cast<int32_t>(w.size());
+    std::vector<int32_t> stops(w.size() + 1);
+    stops[w.size()] = n;
+    for (size_t k = w.size(); k-- > 0;) {
+      const char c = w.symbols[k];
+      if (c == '[') stops[k] = skips['['] ? stops[k + 1] : match_[k] < 0 ? n : stops[static_cast<size_t>(match_[k]) + 1];
+      else if (c == ']') stops[k] = skips[']'] ? stops[k + 1] : -1;
+      else stops[k] = skips[static_cast<unsigned char>(c)] ? stops[k + 1] : static_cast<int32_t>(k);
+    }
+    right_stops_.emplace_back(&skips, std::move(stops));
+    return right_stops_.back().second;
+  }
+
   // Right context: walks right, skipping lateral branches and ignored symbols, failing at the
   // end of the current branch (']'); pattern brackets enter a branch ('[') or leave it (']').
   // An ignored '[' is entered and an ignored ']' passed (cpfg); a ring L-system's end goes on
   // at its start.
-  bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) const {
+  bool match_right(const RuleSet& set, const Rule& rule, size_t index, double* slots) {
     const ModuleString& w = *word_;
     const std::array<bool, 256>& skips = ls_->context_skips;
+    const std::vector<int32_t>& stop = right_stops(skips);
     const size_t n = w.size();
     size_t j = derived_ ? origin_end_ : index + rule.length();
     uint32_t turns = 0;
@@ -463,10 +507,15 @@ class Deriver {
           j = 0;
           continue;
         }
-        const char c = w.symbols[j];
-        if (c == '[' && pattern.symbol != '[') j = skips['['] ? j + 1 : static_cast<size_t>(match_[j]) + 1;
-        else if (c == ']' && !skips[']']) return false;
-        else if (c != '[' && skips[static_cast<unsigned char>(c)]) ++j;
+        if (pattern.symbol != '[') {
+          if (stop[j] < 0) return false;
+          j = static_cast<size_t>(stop[j]);
+          if (j < n) break;
+          continue;
+        }
+        const char c = w.symbols[j];  // a '[' in the pattern stops at the word's next '['
+        if (c == ']' && !skips[']']) return false;
+        if (c != '[' && skips[static_cast<unsigned char>(c)]) ++j;
         else break;
       }
       if (w.symbols[j] != pattern.symbol || w.params_of(j).size() != pattern.arity) return false;
@@ -680,6 +729,8 @@ class Deriver {
   const Lsystem* ls_ = nullptr;         // the L-system rewriting the current module (its contexts' skips, ring)
   std::vector<uint32_t> calls_;         // indices of the L-systems called at the current module, innermost last
   std::vector<int32_t> match_;          // (n) bracket partners of word_, -1 elsewhere
+  std::vector<std::pair<const std::array<bool, 256>*, std::vector<int32_t>>> left_stops_;   // per skip table
+  std::vector<std::pair<const std::array<bool, 256>*, std::vector<int32_t>>> right_stops_;  // per skip table
   std::vector<double> weights_;         // stochastic candidates' weights
   std::vector<const Rule*> chosen_;     // stochastic candidates
   std::vector<double> scratch_;         // parameter values of the module being expanded

@@ -130,6 +130,22 @@ TEST(Derive, AcropetalSignalWithLeftContext) {
 
 // ABOP Fig. 1.31b: a basipetal signal moves down the main axis; the right context skips the
 // lateral branches, and a module at the end of a branch (before ']') has no right context.
+// A left context steps over every earlier sibling branch and ignored symbol to the module
+// below them (found once per step for the whole word, not walked again for each module).
+TEST(Derive, LeftContextStepsOverSiblingBranches) {
+  EXPECT_EQ(symbols(run("axiom: A[X][X]F[X][B[X]]\nignore: F\nA < X --> Z\n", 1)), "A[Z][Z]F[Z][B[X]]");
+  EXPECT_EQ(symbols(run("axiom: A[X][X]F[X]\nA < X --> Z\n", 1)), "A[Z][Z]F[X]");
+  EXPECT_EQ(symbols(run("axiom: X[X]A\nA < X --> Z\n", 1)), "X[X]A");  // nothing to the left
+}
+
+// A right context steps over lateral branches and ignored symbols, and stops at the end of
+// its own branch (found once per step for the whole word, as the left walks are).
+TEST(Derive, RightContextStepsOverBranchesToTheBranchEnd) {
+  EXPECT_EQ(symbols(run("axiom: XF[X]XXB[XF]\nignore: F\nX > B --> Z\n", 1)), "XF[X]XZB[XF]");
+  EXPECT_EQ(symbols(run("axiom: X[A]F[B]FB\nignore: F\nX > B --> Z\n", 1)), "Z[A]F[B]FB");
+  EXPECT_EQ(symbols(run("axiom: XXXXB\nignore: X\nX > B --> Z\n", 1)), "ZZZZB");
+}
+
 TEST(Derive, BasipetalSignalWithRightContext) {
   const Grammar g = parse_lsys("ignore: +-F\naxiom: Fa[+Fa]Fa[-Fa]Fa[+Fa]Fb\na > b --> b\nb --> a\n");
   const std::string expected[] = {
