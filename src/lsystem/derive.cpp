@@ -83,11 +83,12 @@ class Deriver {
 
   // A call '?(label, s)' to an L-system the file does not have => what is wrong, and when.
   std::string unknown_call(double label) const {
-    std::ostringstream value;
+    std::ostringstream value, called;
     value << label;
-    return "'?(" + value.str() + ", ...)' calls L-system " + value.str() + " " +
+    called << std::trunc(label);  // as cpfg, a label's fraction is dropped (Grammar::lsystem_index)
+    return "'?(" + value.str() + ", ...)' calls L-system " + called.str() + " " +
            (step_ == 0 ? std::string("in the axiom") : "while deriving step " + std::to_string(step_)) +
-           ", but the file has no 'lsystem: " + value.str() + "'";
+           ", but the file has no 'lsystem: " + called.str() + "'";
   }
 
  private:

@@ -134,6 +134,9 @@ TEST(Cpfg, UnsupportedConstructsAreRefusedWhereWritten) {
   EXPECT_EQ(plant_error_of("lsystem: 1\naxiom: A(4)\nA(n) --> ?(n, 1) B $\n"),
             "plant.l:3:10: '?(4, ...)' calls L-system 4 while deriving step 1, but the file has no 'lsystem: 4' (rule "
             "at 3:1)");
+  EXPECT_EQ(plant_error_of("lsystem: 1\naxiom: A(3.7)\nA(n) --> ?(n, 1) B $\n"),  // the label's fraction dropped
+            "plant.l:3:10: '?(3.7, ...)' calls L-system 3 while deriving step 1, but the file has no 'lsystem: 3' (rule "
+            "at 3:1)");
   EXPECT_EQ(
       plant_error_of("axiom: A\nA --> B(\"x\")\n"),
       "plant.l:2:9: a string parameter is only read first in @L(\"label\"), @S(\"command\") and @I(\"object\", s)");
