@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "bake/scene_hash.h"
 #include "common/json_text.h"
 #include "common/message_text.h"
 #include "common/read_text_file.h"
@@ -11,7 +12,6 @@
 #include "files/text_output.h"
 #include "formats/html_forest.h"
 #include "formats/usd_forest.h"
-#include "bake/scene_hash.h"
 #include "output/output_formats.h"
 
 namespace treeanim {

@@ -277,8 +277,8 @@ class Deriver {
     return ls_ = &g_.lsystems[calls_.back()];
   }
 
-  // match_[k] for every bracket of word: the index of its partner; the left walks' stops, which
-  // depend on the L-system's skips, are found again when first asked (left_stop).
+  // match_[k] for every bracket of word: the index of its partner; the walks' stops, which
+  // depend on the L-system's skips, are found again when first asked (left_stops, right_stops).
   void match_brackets(const ModuleString& word) {
     left_stops_.clear();
     right_stops_.clear();

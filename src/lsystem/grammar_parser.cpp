@@ -311,11 +311,11 @@ class Parser {
     // A line that starts with the arrow ends a head written above it; after an axiom, a whole
     // rule or a directive it is a rule without a predecessor, and is told so at its own line.
     if (text.substr(begin, 2) == "->" || text.substr(begin, 3) == "-->") {
-      const auto names = [&](const std::string& keyword) { return match_keyword(last, b, e, keyword, true, &value); };
-      return !rule && std::none_of(kValueDirectives.begin(), kValueDirectives.end(), names) &&
-             std::none_of(kSectionDirectives.begin(), kSectionDirectives.end(), [&](const std::string& keyword) {
-               return match_keyword(last, b, e, keyword, false, &value);
-             });
+      const auto any_of = [&](const std::vector<std::string>& keywords, bool colon) {
+        return std::any_of(keywords.begin(), keywords.end(),
+                           [&](const std::string& keyword) { return match_keyword(last, b, e, keyword, colon, &value); });
+      };
+      return !rule && !any_of(kValueDirectives, true) && !any_of(kSectionDirectives, false);
     }
     // A rule's head not yet at its arrow ("A(x) :" then a block on the next line) goes on.
     if (!rule && !axiom) return !starts_directive(last, b, e) && looks_like_head(last, b, e);
