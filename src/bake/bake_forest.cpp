@@ -28,9 +28,10 @@ namespace {
 // any other writer.
 template <typename Written>
 void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifest_written, Written written,
-                      OutputTargets& targets) {
+                      OutputTargets& targets, const TreesPassed& passed) {
   add_forest_targets(scene, config.out_dir, targets, manifest_written);
   for (size_t t = 0; t < scene.forest->trees.size(); ++t) {
+    passed("checking outputs", t + 1, scene.forest->trees.size());
     const std::string& id = scene.forest->trees[t].id;
     const Scene one = tree_scene(scene, t);
     const bool writes = written(t, one);
@@ -53,7 +54,8 @@ void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifes
 // Found only as each tree is baked, a later tree's bad target would fail the forest after
 // earlier trees were written. Every tree of the forest is counted for "one writer" (a tree of
 // another shard, or a complete one, keeps its files); the trees baked here are looked at and probed.
-std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees) {
+std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,
+                                     const TreesPassed& passed) {
   std::vector<size_t> position(scene.forest->trees.size(), trees.size());  // index into `trees`, or none
   for (size_t i = 0; i < trees.size(); ++i) position[trees[i]] = i;
   std::vector<bool> complete(trees.size(), false);
@@ -65,7 +67,7 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
     complete[i] = config.checkpoints.resume &&
                   complete_tree_part(config.out_dir, scene.forest->trees[t].id, bake_key(one, config.generator), why);
     return !complete[i];
-  }, targets);
+  }, targets, passed);
   MadeFolders made;  // kept once every folder takes a file: the trees write there
   try {
     targets.probe(made);
@@ -78,11 +80,11 @@ std::vector<bool> look_before_baking(const Scene& scene, const BakeConfig& confi
 
 }  // namespace
 
-void check_forest_writers(const Scene& scene) {
+void check_forest_writers(const Scene& scene, const TreesPassed& passed) {
   OutputTargets targets;
   // The manifest goes where -o puts it, which validate and info are not given (a scene named
   // forest.json is its own folder's manifest path): it only keeps its name from the trees.
-  add_forest_files(scene, BakeConfig{}, false, [](size_t, const Scene&) { return true; }, targets);
+  add_forest_files(scene, BakeConfig{}, false, [](size_t, const Scene&) { return true; }, targets, passed);
 }
 
 ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const std::vector<size_t>& trees,
@@ -98,7 +100,7 @@ ForestBakeResult bake_forest(const Scene& scene, const BakeConfig& config, const
     std::error_code error;
     if (!config.shard && !manifest_path.parent_path().empty()) made.make(manifest_path.parent_path(), error);
     if (!config.shard && !error) manifest.lock(manifest_path);
-    complete = look_before_baking(scene, config, trees);
+    complete = look_before_baking(scene, config, trees, log.trees_passed);
   } catch (...) {
     manifest.release();
     made.undo();

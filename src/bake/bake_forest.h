@@ -19,8 +19,9 @@ struct ForestBakeResult {
 
 // Every file the forest would write has one writer (the manifest, each tree's outputs and
 // part), wherever it bakes, and each tree's is absent or a regular file that is none of the
-// inputs: InputError as a whole forest's bake reports it. Writes nothing.
-void check_forest_writers(const Scene& scene);
+// inputs: InputError as a whole forest's bake reports it (`passed`: as each tree's are). Writes
+// nothing.
+void check_forest_writers(const Scene& scene, const TreesPassed& passed);
 
 // Bakes `trees` (shard_trees()) of the forest. With --resume a tree whose part says it is
 // complete is skipped and the tree in progress resumes from its checkpoint. Without a shard,

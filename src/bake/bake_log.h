@@ -11,10 +11,15 @@ namespace treeanim {
 struct PreparedTree;
 struct TreeBakeResult;
 
+// `what` ("checking outputs") has passed `done` of a forest's `total` trees.
+using TreesPassed = std::function<void(const char* what, size_t done, size_t total)>;
+
 struct BakeLog {
   std::FILE* notes = nullptr;  // resumes, removed checkpoints, warm-up periods; null: quiet
   // Derivation step `step` of `steps` made `modules` modules (a grammar may derive for minutes).
   std::function<void(int step, int steps, size_t modules)> grown_step;
+  // A pass over a forest's trees before the first is baked (a million trees take a minute).
+  TreesPassed trees_passed = [](const char*, size_t, size_t) {};
   std::function<void(const PreparedTree&)> prepared = [](const PreparedTree&) {};  // grown and built
   std::function<void(long long total)> frames_begin = [](long long) {};  // the frame loop will simulate `total`
   std::function<void(long long done)> frame_done = [](long long) {};     // `done` frames of the loop are complete

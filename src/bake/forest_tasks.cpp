@@ -81,10 +81,12 @@ namespace {
 // from its own seed: what a tree's seed makes the grammar do (pass lsystem.max_modules, divide by
 // zero) is bad input before the first tree's files are written, not after. A variant that every
 // seed grows alike grew in estimate_forest.
-void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees) {
+void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees, const TreesPassed& passed) {
   const Forest& forest = *scene.forest;
   std::vector<int> seeded(forest.variants.size(), -1);  // -1: not asked yet
-  for (size_t t : trees) {
+  for (size_t i = 0; i < trees.size(); ++i) {
+    passed("growing the trees whose seed shapes them", i + 1, trees.size());
+    const size_t t = trees[i];
     const Scene one = tree_scene(scene, t);
     int& variant = seeded[forest.trees[t].variant];
     if (variant < 0) variant = seed_shapes_growth(one.lsystem) ? 1 : 0;
@@ -99,7 +101,7 @@ void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees) {
 
 }  // namespace
 
-std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard) {
+std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard, const TreesPassed& passed) {
   // Every variant a tree uses grows here, with or without shards, and every tree whose seed
   // shapes it: a later tree's bad grammar, view or leaf mesh is bad input before the first tree's
   // files are written. A variant no tree uses is read, not grown (estimate_forest).
@@ -107,7 +109,7 @@ std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& 
   std::vector<size_t> trees(scene.forest->trees.size());
   std::iota(trees.begin(), trees.end(), size_t{0});
   if (shard) trees = assign_tasks(estimate.tree_cost, shard->count)[shard->index];
-  grow_seeded_trees(scene, trees);
+  grow_seeded_trees(scene, trees, passed);
   return trees;
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bake/bake_config.h"
+#include "bake/bake_log.h"
 #include "scene/scene.h"
 
 namespace treeanim {
@@ -33,7 +34,7 @@ std::vector<std::vector<size_t>> assign_tasks(const std::vector<uint64_t>& cost,
 
 // A forest, a shard (none: every tree) => the trees that this process bakes, ascending, once
 // every variant has grown (estimate_forest: InputError for a variant that cannot), and each of
-// those trees whose seed shapes its growth.
-std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard);
+// those trees whose seed shapes its growth (`passed`: as each is grown).
+std::vector<size_t> shard_trees(const Scene& scene, const std::optional<Shard>& shard, const TreesPassed& passed);
 
 }  // namespace treeanim

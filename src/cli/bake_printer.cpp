@@ -21,10 +21,11 @@ BakePrinter::BakePrinter(const Scene& scene, const BakeConfig& config, const std
                         (config.out_dir.empty() ? "" : " -o " + shell_word(config.out_dir.string())) +
                         set_arguments(overrides)),
       verbosity_(verbosity),
-      growth_(verbosity, stderr) {
+      long_task_(verbosity, stderr) {
   const bool quiet = verbosity == Verbosity::kQuiet;
   log_.notes = quiet ? nullptr : stderr;
-  log_.grown_step = [this](int step, int steps, size_t modules) { growth_.update(step, steps, modules); };
+  log_.grown_step = [this](int step, int steps, size_t modules) { long_task_.grown(step, steps, modules); };
+  log_.trees_passed = [this](const char* what, size_t done, size_t total) { long_task_.trees(what, done, total); };
   if (verbosity == Verbosity::kVerbose)
     log_.prepared = [](const PreparedTree& tree) {
       std::fprintf(stderr, "grown in %.3f s, model built in %.3f s: %zu vertices, %zu clusters; solver loops: %s\n",

@@ -37,7 +37,7 @@ class BakePrinter {
   std::string gather_arguments_;  // SCENE [-o OUT] [--set ...], as shell words
   Verbosity verbosity_;
   std::optional<Progress> progress_;
-  GrowthProgress growth_;
+  LongTaskProgress long_task_;  // a derivation's steps, a forest's passes over its trees
   BakeLog log_;
 };
 

@@ -6,8 +6,10 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <regex>
 #include <string>
 
 #include "cli/commands.h"
@@ -50,6 +52,19 @@ struct Subcommands {
   CLI::App* gather = nullptr;  // farm gather
 };
 
+// A count option's check: CLI::Range called 'abc' or '2.5' "not in range 1 to 1024".
+CLI::Validator whole_number(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        long long value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "expected a whole number, got '" + excerpt(text) + "'";
+        if (value < lo || value > hi)
+          return "expected " + std::to_string(lo) + " ... " + std::to_string(hi) + ", got " + text;
+        return "";
+      },
+      "INT in " + std::to_string(lo) + " ... " + std::to_string(hi));
+}
+
 // A path option given as '' names nothing: `-o ''` wrote into the working folder unasked.
 std::string non_empty_path(const std::string& path) { return path.empty() ? "expected a path, got ''" : ""; }
 
@@ -63,14 +78,14 @@ CLI::App* add_run(CLI::App& app, Arguments& args) {
                       "Write only frames START:END (inclusive); the simulation starts at time.start, or "
                       "at the newest checkpoint at or before START (docs/checkpoint.md)");
   run_app->add_option("--threads", args.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
-      ->check(CLI::Range(1, kMaxThreads));
+      ->check(whole_number(1, kMaxThreads));
   run_app->add_option("--set", args.run.overrides,
                       "Override a scene value: PATH=VALUE, PATH dotted (time.frames=48), VALUE "
                       "JSON or a plain string; repeatable, one PATH=VALUE each")
       ->allow_extra_args(false);
   run_app->add_option("--checkpoint-every", args.run.checkpoint_every,
                       "Write the complete simulation state every N frames (docs/checkpoint.md)")
-      ->check(CLI::Range(1LL, 1'000'000'000LL));
+      ->check(whole_number(1, 1'000'000'000));
   run_app->add_option("--checkpoint-dir", args.run.checkpoint_dir,
                       "Folder of the checkpoints (default: OUT/checkpoints, or ./checkpoints without -o)")
       ->check(non_empty_path);
@@ -141,7 +156,7 @@ CLI::App* add_species(CLI::App& app, Arguments& args) {
 void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
   submit->add_option("--engine", farm.engine, "slurm: write sbatch scripts and submit them; script: a plain shell script for any queue")
       ->required()->check(CLI::IsMember({"slurm", "script"}));
-  submit->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(CLI::Range(1, 1'000'000));
+  submit->add_option("--tasks", farm.tasks, "Farm tasks (Slurm array size)")->required()->check(whole_number(1, 1'000'000));
   submit->add_option("-o,--out", farm.out_dir, "Output folder of every task (default: the working folder)")
       ->check(non_empty_path);
   submit->add_flag("--no-space-check", farm.no_space_check,
@@ -149,8 +164,8 @@ void add_farm_submit(CLI::App* submit, FarmRequest& farm) {
                    "tasks then skip their own check too)");
   submit->add_flag("--wait", farm.wait, "Wait for the gather job and exit with its status (slurm)");
   submit->add_option("--checkpoint-every", farm.checkpoint_every, "Frames between checkpoints (default: frames / 8)")
-      ->check(CLI::Range(1LL, 1'000'000'000LL));
-  submit->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(CLI::Range(1, kMaxThreads));
+      ->check(whole_number(1, 1'000'000'000));
+  submit->add_option("--cpus-per-task", farm.cpus_per_task, "Cores of each task (its threads)")->check(whole_number(1, kMaxThreads));
   submit->add_option("--sbatch-arg", farm.sbatch_args, "An extra #SBATCH option, e.g. --partition=bake; repeatable");
   submit->footer(
       "Examples:\n"
@@ -169,7 +184,7 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
     sub->add_option("--set", farm.overrides, "Override a scene value: PATH=VALUE")
       ->allow_extra_args(false);
   }
-  commands.plan->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(CLI::Range(1, 1'000'000));
+  commands.plan->add_option("--tasks", farm.tasks, "Farm tasks")->required()->check(whole_number(1, 1'000'000));
   commands.plan->add_option("--json", farm.json, "Also write the plan as JSON to this file")->check(non_empty_path);
   commands.plan->footer("Example:\n  treeanim farm plan configs/forest-demo.json --tasks 4 --json plan.json");
   add_farm_submit(commands.submit, farm);
@@ -178,7 +193,7 @@ void add_farm(CLI::App& app, FarmRequest& farm, Subcommands& commands) {
   CLI::Option* tasks =
       commands.gather
           ->add_option("--tasks", farm.tasks, "Tasks the forest was split into: name the task of each missing tree")
-          ->check(CLI::Range(1, 1'000'000));
+          ->check(whole_number(1, 1'000'000));
   commands.gather->add_option("--logs", farm.logs, "Folder of the tasks' logs (task-I.log), named for failed tasks")
       ->check(non_empty_path)
       ->needs(tasks);  // a log is named by its task, which --tasks decides
@@ -219,13 +234,20 @@ int report(const char* kind, const std::exception& error, int code) {
   return code;
 }
 
-// libgomp takes OMP_NUM_THREADS as it stands, and a count past --threads' range crashed it as
-// it made the threads (99999: SIGSEGV in the first parallel region) => what is wrong, or "".
+// libgomp takes OMP_NUM_THREADS as it stands: a count past --threads' range crashed it as it
+// made the threads (99999: SIGSEGV in the first parallel region), and a value it cannot read
+// (0, -1, 'abc') it ignored with a warning, baking on every core => what is wrong, or "".
 std::string omp_threads_error(const Arguments& args) {
+  const char* text = std::getenv("OMP_NUM_THREADS");
+  if (args.run.threads > 0 || text == nullptr) return "";
+  const std::string expected = "expected 1 ... " + std::to_string(kMaxThreads) +
+                               " threads, or a comma-separated list of them (or give run --threads N)";
+  // libgomp's syntax: positive whole numbers, one a nesting level, spaces around each.
+  static const std::regex kCounts(R"(\s*\+?0*[1-9][0-9]*\s*(,\s*\+?0*[1-9][0-9]*\s*)*)");
+  if (!std::regex_match(text, kCounts)) return "OMP_NUM_THREADS is '" + excerpt(text) + "': " + expected;
   const int asked = omp_get_max_threads();
-  if (args.run.threads > 0 || asked <= kMaxThreads) return "";
-  return "OMP_NUM_THREADS asks for " + std::to_string(asked) + " threads: expected 1 ... " +
-         std::to_string(kMaxThreads) + " (or give run --threads N)";
+  if (asked <= kMaxThreads) return "";
+  return "OMP_NUM_THREADS asks for " + std::to_string(asked) + " threads: " + expected;
 }
 
 // Runs the subcommand; a failure's exception => its message and exit code.

@@ -56,9 +56,19 @@ void print_volume(const VolumeSummary& volume) {
 
 // A long derivation says how far it is on stderr, as run's does (stdout is the command's own).
 PreparedTree grown_tree(const Scene& scene) {
-  GrowthProgress growth(Verbosity::kNormal, stderr);
+  LongTaskProgress growth(Verbosity::kNormal, stderr);
   return prepare_tree(scene, MeshSurface::kBuilt,
-                      [&](int step, int steps, size_t modules) { growth.update(step, steps, modules); });
+                      [&](int step, int steps, size_t modules) { growth.grown(step, steps, modules); });
+}
+
+// A forest's trees looked at as run looks at them before its first tree grows: every file has
+// one writer, every variant in use grows, and every tree a seed shapes. A million trees take a
+// minute, so each pass says how far it is, as run's do.
+void check_forest(const Scene& scene) {
+  LongTaskProgress progress(Verbosity::kNormal, stderr);
+  const TreesPassed passed = [&](const char* what, size_t done, size_t total) { progress.trees(what, done, total); };
+  check_forest_writers(scene, passed);
+  shard_trees(scene, std::nullopt, passed);
 }
 
 // A lone tree's scene => its tree, grown, after what run refuses before it simulates: two
@@ -80,8 +90,7 @@ int validate_command(const std::filesystem::path& scene_file,
                      const std::vector<std::string>& overrides) {
   const Scene scene = load_scene(scene_file, overrides);
   if (scene.forest) {
-    check_forest_writers(scene);
-    shard_trees(scene, std::nullopt);  // grows one tree of each variant used, and every tree a seed shapes
+    check_forest(scene);
     std::printf("forest of %zu trees, %zu variants\n", scene.forest->trees.size(), scene.forest->variants.size());
   } else {
     print_counts(tree_summary(scene, prepare_checked_tree(scene)));
@@ -102,10 +111,7 @@ int info_command(const std::filesystem::path& scene_file, const std::vector<std:
   // A forest: the figures of its first tree. Outputs and trees that run would refuse are
   // refused here too (every variant in use grown, as validate does): figures of a bake that
   // cannot run would say it can.
-  if (scene.forest) {
-    check_forest_writers(scene);
-    shard_trees(scene, std::nullopt);
-  }
+  if (scene.forest) check_forest(scene);
   const Scene first = scene.forest ? tree_scene(scene, 0) : Scene();
   const Scene& one = scene.forest ? first : scene;
   const PreparedTree tree = scene.forest ? grown_tree(one) : prepare_checked_tree(one);

@@ -74,14 +74,25 @@ void Progress::note(const std::string& line) {
   std::fflush(out_);
 }
 
-void GrowthProgress::update(int step, int steps, size_t modules) {
-  if (!enabled_) return;
+bool LongTaskProgress::due(bool starts) {
+  if (!enabled_) return false;
   const auto now = std::chrono::steady_clock::now();
-  if (step == 1) next_ = now + std::chrono::seconds(2);
-  if (now < next_) return;
+  if (starts) next_ = now + std::chrono::seconds(2);
+  if (now < next_) return false;
+  next_ = now + std::chrono::seconds(5);
+  return true;
+}
+
+void LongTaskProgress::grown(int step, int steps, size_t modules) {
+  if (!due(step == 1)) return;
   std::fprintf(out_, "growing: step %d of %d, %zu modules\n", step, steps, modules);
   std::fflush(out_);
-  next_ = now + std::chrono::seconds(5);
+}
+
+void LongTaskProgress::trees(const char* what, size_t done, size_t total) {
+  if (!due(done == 1)) return;
+  std::fprintf(out_, "forest: %s, tree %zu of %zu\n", what, done, total);
+  std::fflush(out_);
 }
 
 }  // namespace treeanim

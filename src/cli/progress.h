@@ -33,15 +33,21 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
-// Progress of a long derivation on stderr: "growing: step S of N, M modules" once a tree has
-// grown for 2 s, then every 5 s; nothing when quiet, or for a tree that grows sooner.
-class GrowthProgress {
+// Progress on stderr of a long task that draws no bar: a line once the task has run 2 s, then
+// every 5 s; nothing when quiet, or for a task that ends sooner.
+class LongTaskProgress {
  public:
-  GrowthProgress(Verbosity verbosity, std::FILE* out) : out_(out), enabled_(verbosity != Verbosity::kQuiet) {}
-  // Derivation step `step` of `steps` made `modules` modules; step 1 starts a tree's clock.
-  void update(int step, int steps, size_t modules);
+  LongTaskProgress(Verbosity verbosity, std::FILE* out) : out_(out), enabled_(verbosity != Verbosity::kQuiet) {}
+  // A derivation: step `step` of `steps` made `modules` modules ("growing: step S of N, M
+  // modules"); step 1 starts a tree's clock.
+  void grown(int step, int steps, size_t modules);
+  // A pass over a forest's trees before the first is baked: `what` ("checking outputs") has
+  // passed `done` of `total` trees ("forest: checking outputs, tree D of T"); 1 starts the clock.
+  void trees(const char* what, size_t done, size_t total);
 
  private:
+  bool due(bool starts);  // starts: the task's first call, which starts its clock
+
   std::FILE* out_;
   bool enabled_;
   std::chrono::steady_clock::time_point next_;  // when the next line is due

@@ -22,7 +22,7 @@ int run_command(const RunRequest& request) {
                  printable_text(request.checkpoint_dir.string()).c_str());
   BakePrinter printer(scene, config, request.scene, request.overrides, request.verbosity);
   if (!scene.forest) return bake_tree(scene, config, nullptr, printer.log()).exit_code;
-  const std::vector<size_t> trees = shard_trees(scene, config.shard);
+  const std::vector<size_t> trees = shard_trees(scene, config.shard, printer.log().trees_passed);
   printer.shard_begins(trees);
   const ForestBakeResult result = bake_forest(scene, config, trees, printer.log());
   if (result.exit_code == 0) printer.forest_baked(result);

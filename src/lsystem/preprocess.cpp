@@ -50,10 +50,10 @@ std::string strip_comments(const std::string& text, int32_t source, bool single_
     const bool comment = end > k + 1;
     for (; k < end; ++k) {
       const char c = text[k];
-      if (c == '\n') {
+      if (c == '\n' && !single_line) {
         ++line;
         column = 1;
-      } else if (!continues_character(c)) {
+      } else if (!continues_character(c)) {  // a single-line text's newline is one of its characters
         ++column;
       }
       if (!comment || c == '\n') out += c;
@@ -98,24 +98,30 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
   current_ = name;
   const std::string clean = strip_comments(text, source, single_line);
   const size_t open_conditions = conditions_.size();
-  int32_t number = 1;
-  for (size_t start = 0; start <= clean.size();) {
-    size_t stop = clean.find('\n', start);
-    if (stop == std::string::npos) stop = clean.size();
+  // Where clean[start] stands: a file's line and column 1, or a single-line text's (a scene's
+  // string) column counted from the string's start, its newlines characters like any other.
+  int32_t number = 1, column = 1;
+  size_t start = 0, stop = 0;
+  const auto at_start = [&] { return single_line ? SourcePos{source, 0, column} : SourcePos{source, number, 1}; };
+  const auto next_line = [&] {
+    if (single_line)
+      for (size_t k = start; k <= stop; ++k) column += continues_character(clean[k]) ? 0 : 1;
+    start = stop + 1;
+    stop = std::min(clean.find('\n', start), clean.size());
+    ++number;
+  };
+  for (stop = std::min(clean.find('\n'), clean.size());;) {
     // Before its columns (12 bytes a character) are made: a 100 MB line took 2.9 GB.
-    if (stop - start > kMaxLineLength) fail({source, single_line ? 0 : number, 1}, "a line longer than 1 MiB");
-    SourceLine line = make_line(std::string_view(clean).substr(start, stop - start), {source, single_line ? 0 : number, 1});
+    if (stop - start > kMaxLineLength) fail(at_start(), "a line longer than 1 MiB");
+    SourceLine line = make_line(std::string_view(clean).substr(start, stop - start), at_start());
     const size_t hash = skip_spaces(line.text, 0);
     // A line continues on the next one after a trailing backslash, as in cpp; cpfg files also
     // end continued lines with two backslashes, read as one continuation.
     while (!line.text.empty() && line.text.back() == '\\' && stop < clean.size()) {
       for (size_t b = line.text.size(); b > 0 && line.text[b - 1] == '\\'; --b) line.text[b - 1] = ' ';
-      start = stop + 1;
-      stop = clean.find('\n', start);
-      if (stop == std::string::npos) stop = clean.size();
-      ++number;
-      if (line.text.size() + (stop - start) > kMaxLineLength) fail({source, number, 1}, "a line longer than 1 MiB");
-      const SourceLine more = make_line(std::string_view(clean).substr(start, stop - start), {source, number, 1});
+      next_line();
+      if (line.text.size() + (stop - start) > kMaxLineLength) fail(at_start(), "a line longer than 1 MiB");
+      const SourceLine more = make_line(std::string_view(clean).substr(start, stop - start), at_start());
       line.text += more.text;
       line.columns.insert(line.columns.end(), more.columns.begin(), more.columns.end());
     }
@@ -140,8 +146,7 @@ void Preprocessor::run(const std::string& name, const std::string& text, bool si
       hooks_.line(expanded);
     }
     if (stop == clean.size()) break;
-    start = stop + 1;
-    ++number;
+    next_line();
   }
   if (!single_line && conditions_.size() != open_conditions)
     fail(conditions_.back().at, "#ifdef or #ifndef is never closed (expected #endif)");

@@ -58,13 +58,20 @@ Scene forest_scene() {
 
 TEST(ForestTasks, ShardTreesSplitTheForest) {
   const Scene scene = forest_scene();
-  EXPECT_EQ(shard_trees(scene, std::nullopt), (std::vector<size_t>{0, 1, 2, 3, 4}));
+  std::vector<size_t> passed;  // each tree as the pass over the shard's trees reaches it
+  const TreesPassed count = [&](const char*, size_t done, size_t total) {
+    EXPECT_EQ(total, 5u);
+    passed.push_back(done);
+  };
+  EXPECT_EQ(shard_trees(scene, std::nullopt, count), (std::vector<size_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(passed, (std::vector<size_t>{1, 2, 3, 4, 5}));
+  const TreesPassed none = [](const char*, size_t, size_t) {};
   const ForestEstimate estimate = estimate_forest(scene);
   EXPECT_GT(estimate.tree_cost[0], estimate.tree_cost[1]);
   EXPECT_EQ(estimate.tree_cost[0], estimate.tree_cost[3]);
   // Longest first (a, d), then each short tree to the task with less so far, ties to task 0.
-  EXPECT_EQ(shard_trees(scene, Shard{0, 2}), (std::vector<size_t>{0, 1, 4}));
-  EXPECT_EQ(shard_trees(scene, Shard{1, 2}), (std::vector<size_t>{2, 3}));
+  EXPECT_EQ(shard_trees(scene, Shard{0, 2}, none), (std::vector<size_t>{0, 1, 4}));
+  EXPECT_EQ(shard_trees(scene, Shard{1, 2}, none), (std::vector<size_t>{2, 3}));
 }
 
 }  // namespace
