@@ -35,7 +35,7 @@ void add_forest_files(const Scene& scene, const BakeConfig& config, bool manifes
     const std::string& id = scene.forest->trees[t].id;
     const Scene one = tree_scene(scene, t);
     const bool writes = written(t, one);
-    const BakePlan plan = plan_bake(one, tree_bake_config(config, id));
+    const BakePlan plan = plan_frames(one, tree_bake_config(config, id));
     targets.add_outputs(one.outputs, config.out_dir, plan.written.first, plan.written.count(), "tree " + id, writes);
     targets.add_file(tree_part_path(config.out_dir, id), "the part of tree " + id, writes);
     // A complete tree's folder too: its spent checkpoints are removed from it.

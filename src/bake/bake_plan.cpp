@@ -4,7 +4,7 @@
 
 namespace treeanim {
 
-BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
+BakePlan plan_frames(const Scene& scene, const BakeConfig& config) {
   BakePlan plan;
   plan.first = scene.time.start;
   plan.last = scene.time.start + scene.time.frames - 1;
@@ -15,8 +15,13 @@ BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
   plan.closes_loop = scene.time.loop && plan.written.first == plan.first && plan.written.last == plan.last;
   plan.use_checkpoints = config.checkpoints.resume || config.frames.has_value();
   plan.checkpoints = config.checkpoints;
-  plan.key = {bake_key(scene, config.generator), config.generator, scene.hsm.precision == Precision::kFloat};
   plan.reads_mesh = !scene.outputs.empty() || plan.written.first < last_checkpoint(plan) || plan.closes_loop;
+  return plan;
+}
+
+BakePlan plan_bake(const Scene& scene, const BakeConfig& config) {
+  BakePlan plan = plan_frames(scene, config);
+  plan.key = {bake_key(scene, config.generator), config.generator, scene.hsm.precision == Precision::kFloat};
   return plan;
 }
 

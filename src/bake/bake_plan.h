@@ -29,6 +29,11 @@ struct BakePlan {
 // frame k of the whole bake.
 BakePlan plan_bake(const Scene& scene, const BakeConfig& config);
 
+// The plan without its key (left empty): the frames and checkpoints, for what a forest looks at
+// of each of its trees before the first grows, without the key's dump of the scene and read of
+// every input file (a million trees' keys took most of a minute).
+BakePlan plan_frames(const Scene& scene, const BakeConfig& config);
+
 // The frame of the last checkpoint a bake of `plan` writes (a multiple of checkpoints.every
 // after time.start, up to the last written frame), plan.first when it writes none. The frame
 // journal holds the written frames before it, the ones a resume from a checkpoint replays:

@@ -87,10 +87,10 @@ void grow_seeded_trees(const Scene& scene, const std::vector<size_t>& trees, con
   for (size_t i = 0; i < trees.size(); ++i) {
     passed("growing the trees whose seed shapes them", i + 1, trees.size());
     const size_t t = trees[i];
-    const Scene one = tree_scene(scene, t);
     int& variant = seeded[forest.trees[t].variant];
-    if (variant < 0) variant = seed_shapes_growth(one.lsystem) ? 1 : 0;
-    if (!variant) continue;
+    if (variant < 0) variant = seed_shapes_growth(forest.variants[forest.trees[t].variant].lsystem) ? 1 : 0;
+    if (!variant) continue;  // a tree's scene is made only to grow it (a million trees)
+    const Scene one = tree_scene(scene, t);
     try {
       grow_skeleton(one.lsystem, nullptr);
     } catch (const InputError& e) {
