@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <cctype>
 #include <cstdint>
 #include <mutex>
 #include <unordered_map>
@@ -45,6 +46,13 @@ std::string input_file_at(const std::filesystem::path& path) {
   if (::stat(file->second.c_str(), &noted) != 0 || noted.st_dev != status.st_dev || noted.st_ino != status.st_ino)
     return "";
   return file->second;
+}
+
+std::string why_no_file(const std::filesystem::file_status& status, const std::error_code& error) {
+  if (std::filesystem::status_known(status) || !error) return "no such file";
+  std::string why = error.message();
+  if (!why.empty()) why[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(why[0])));
+  return why;
 }
 
 }  // namespace treeanim

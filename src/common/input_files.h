@@ -16,4 +16,9 @@ void note_input_file(const std::filesystem::path& path);
 // names none (or nothing), or the input's name no longer leads to that file. Thread-safe.
 std::string input_file_at(const std::filesystem::path& path);
 
+// A status() that found no file, and its error => why, as a message says it: "no such file", or
+// the system's reason where the path could not be looked up at all ("too many levels of
+// symbolic links", "file name too long"), which "no such file" would hide.
+std::string why_no_file(const std::filesystem::file_status& status, const std::error_code& error);
+
 }  // namespace treeanim

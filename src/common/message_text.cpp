@@ -1,5 +1,6 @@
 #include "common/message_text.h"
 
+#include <charconv>
 #include <cstdio>
 #include <sstream>
 
@@ -83,6 +84,12 @@ std::string number_text(double value) {
   std::ostringstream out;
   out << value;
   return out.str();
+}
+
+std::string exact_number_text(double value) {
+  char text[32];
+  const std::to_chars_result end = std::to_chars(text, text + sizeof text, value);
+  return std::string(text, end.ptr);
 }
 
 }  // namespace treeanim

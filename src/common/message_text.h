@@ -29,4 +29,8 @@ inline bool continues_character(char c) { return (static_cast<unsigned char>(c) 
 // A number in a message, as a stream writes it: six significant digits ("0.02", "1e-09", "inf").
 std::string number_text(double value);
 
+// A number in a message that must tell it from a near one (the two ends of a loop's wind): the
+// shortest text that reads back as the same double ("5", "5.0000001", "0.1").
+std::string exact_number_text(double value);
+
 }  // namespace treeanim

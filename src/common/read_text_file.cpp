@@ -17,7 +17,7 @@ bool read_text_file(const std::filesystem::path& path, std::string& text, std::s
   };
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
-  if (!std::filesystem::exists(status)) return fail("no such file");
+  if (!std::filesystem::exists(status)) return fail(why_no_file(status, error));
   std::ifstream in(path, std::ios::binary);
   if (!in || std::filesystem::is_directory(status)) return fail("not a readable file");
   const std::string too_large =

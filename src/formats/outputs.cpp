@@ -248,6 +248,12 @@ void OutputTargets::add_folder(const fs::path& folder, const std::string& writer
     throw InputError(other->second + ": writes in " + folder.string() + ", the folder of " + writer);
   if (const auto other = writer_.find(absolute); other != writer_.end() && other->second != writer)
     throw InputError(other->second + ": writes " + folder.string() + ", the folder of " + writer);
+  // It is made in its parent (a forest's tree's checkpoints in the forest's): a file there is refused.
+  const std::string parent = absolute.substr(0, absolute.rfind('/'));
+  if (const auto other = writer_.find(parent); other != writer_.end() && other->second != writer)
+    throw InputError(other->second + ": writes " + folder.parent_path().string() + ", which holds the folder of " +
+                     writer);
+  in_folder_.emplace(parent, writer);
   owned_.emplace(absolute, writer);
   add_lock(lock_path(folder), writer);
 }

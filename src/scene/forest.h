@@ -53,6 +53,7 @@ struct ForestDefaults {
   const LsystemOptions* lsystem = nullptr;  // null when the scene has no top-level /lsystem
   const TreeOptions* tree = nullptr;
   const HsmOptions* hsm = nullptr;
+  const SpeciesChoice* species = nullptr;   // /species: a variant without its own grammar grows it
 };
 
 // /forest => the forest, every tree placed. Throws InputError (exit 2) naming the JSON pointer:

@@ -3,6 +3,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -48,26 +49,29 @@ ForestVariant read_variant(SceneObject element, const ForestDefaults& defaults) 
   variant.name = *name;
   variant.weight = element.number("weight", 1, Range::non_negative());
   variant.pointer = element.pointer();
-  const std::optional<SpeciesChoice> species = read_species(element);
-  if (element.has("lsystem") || species)
+  const std::optional<SpeciesChoice> own = read_species(element);
+  if (element.has("lsystem") || own)
     variant.lsystem = read_lsystem_options(element.object("lsystem"), defaults.seed,
-                                           species ? &species->species->grammar : nullptr);
+                                           own ? &own->species->grammar : nullptr);
   else if (defaults.lsystem)
     variant.lsystem = *defaults.lsystem;
   else
     element.fail("lsystem", "expected the variant's grammar (an object like /lsystem, or a species): the scene has "
                             "no top-level /lsystem for it to fall back to");
+  // Its own species, or the scene's where it grows the scene's grammar: a variant's /tree then
+  // goes over that species' tree, as the top-level /tree does (not over a bare default tree).
+  const SpeciesChoice* species = own ? &*own : element.has("lsystem") ? nullptr : defaults.species;
   if (species) {
-    check_species_scale(*species, element.object("tree"));
+    if (element.has("tree")) check_species_scale(*species, element.object("tree"));
     variant.species = species->species;
     variant.height = species->height;
   }
-  variant.tree = element.has("tree") || species
+  variant.tree = element.has("tree") || own
                      ? read_tree_options(element.object("tree"), species ? species_tree(*species) : TreeOptions{})
                      : *defaults.tree;
   // A species brings its wood; the variant's own /hsm goes over it and over the scene's.
-  variant.hsm = element.has("hsm") || species
-                    ? read_hsm_options(element.object("hsm"), species ? species_hsm(*species, *defaults.hsm) : *defaults.hsm)
+  variant.hsm = element.has("hsm") || own
+                    ? read_hsm_options(element.object("hsm"), own ? species_hsm(*own, *defaults.hsm) : *defaults.hsm)
                     : *defaults.hsm;
   variant.resolved = element.json();
   return variant;
@@ -83,6 +87,10 @@ std::vector<ForestVariant> read_variants(SceneObject& section, const ForestDefau
     ForestVariant variant;
     variant.name = "default";
     variant.lsystem = *defaults.lsystem;
+    if (defaults.species) {  // the scene's species: its trees' scales keep it within its heights
+      variant.species = defaults.species->species;
+      variant.height = defaults.species->height;
+    }
     variant.tree = *defaults.tree;
     variant.hsm = *defaults.hsm;
     variant.resolved = Json{{"name", variant.name}, {"weight", variant.weight}};
@@ -106,15 +114,31 @@ std::vector<ForestVariant> read_variants(SceneObject& section, const ForestDefau
 // nothing, or the refusal of a scale that grows a species past its range of heights.
 void check_species_scales(SceneObject& where, const char* key, double lo, double hi,
                           const std::vector<const ForestVariant*>& variants) {
+  double least = 0, most = std::numeric_limits<double>::infinity();  // the scales every variant takes
+  const ForestVariant* refused = nullptr;
+  double refused_height = 0;
+  size_t held = 0;  // variants held to their species' heights
   for (const ForestVariant* v : variants) {
-    if (!v->species) continue;
+    // A species' heights are its grammar's: a variant that grows a grammar of its own has none.
+    if (!v->species || !v->lsystem.library_grammar) continue;
+    ++held;
+    least = std::max(least, inward(v->species->min_height / v->height, true));
+    most = std::min(most, inward(v->species->max_height / v->height, false));
     const double height = (v->height * lo < v->species->min_height ? lo : hi) * v->height;
-    if (height < v->species->min_height || height > v->species->max_height)
-      where.fail(key, range_text(*v->species) + number_text(height) + " m for variant \"" + v->name + "\" (" +
-                          number_text(v->height) + " m at scale 1): give a scale from " +
-                          number_text(inward(v->species->min_height / v->height, true)) + " to " +
-                          number_text(inward(v->species->max_height / v->height, false)));
+    if (!refused && (height < v->species->min_height || height > v->species->max_height)) {
+      refused = v;
+      refused_height = height;
+    }
   }
+  if (!refused) return;
+  const std::string remedy =
+      least > most ? "no scale keeps every variant it may draw within its species' heights (give their heights "
+                     "ranges that overlap, in /species/height)"
+      : held > 1 ? "give a scale from " + number_text(least) + " to " + number_text(most) +
+                                  ", which keeps every variant it may draw within its species' heights"
+                            : "give a scale from " + number_text(least) + " to " + number_text(most);
+  where.fail(key, range_text(*refused->species) + number_text(refused_height) + " m for variant \"" + refused->name +
+                      "\" (" + number_text(refused->height) + " m at scale 1): " + remedy);
 }
 
 // "0007": index i of a forest of `total` trees, zero-padded to at least 4 digits.

@@ -37,10 +37,9 @@ TimeOptions read_time_options(SceneObject section) {
   return time;
 }
 
+// Exact: the loop's two ends may differ past six digits.
 std::string vector_text(const Eigen::Vector3d& v) {
-  std::ostringstream out;
-  out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return out.str();
+  return "(" + exact_number_text(v.x()) + ", " + exact_number_text(v.y()) + ", " + exact_number_text(v.z()) + ")";
 }
 
 // time.loop => the wind made periodic over the bake (docs/scene.md "time"), or InputError
@@ -56,9 +55,9 @@ void prepare_loop(SceneObject time_section, Scene& scene) {
   if (!seam.periodic) {
     std::ostringstream message;
     message << "the wind cannot be made periodic over the loop (" << period << " s): at its end (t = "
-            << start + period << " s) it is " << vector_text(seam.last) << " m/s with gusts of " << seam.last_gust
+            << start + period << " s) it is " << vector_text(seam.last) << " m/s with gusts of " << exact_number_text(seam.last_gust)
             << " m/s, at its start (t = " << start << " s) " << vector_text(seam.first) << " m/s with gusts of "
-            << seam.first_gust << " m/s; give the wind " << (scene.wind.file ? "file" : "keys")
+            << exact_number_text(seam.first_gust) << " m/s; give the wind " << (scene.wind.file ? "file" : "keys")
             << " the same value at both ends (a key at t = " << start + period << " equal to the wind at t = "
             << start << ")";
     time_section.fail("loop", message.str());
@@ -214,7 +213,8 @@ Scene load_scene_text(const std::string& text, const std::string& name,
   if (scene.time.loop) prepare_loop(root.object("time"), scene);
   if (forest) {
     scene.forest =
-        read_forest(root.object("forest"), {scene.seed, top_lsystem ? &scene.lsystem : nullptr, &scene.tree, &scene.hsm});
+        read_forest(root.object("forest"), {scene.seed, top_lsystem ? &scene.lsystem : nullptr, &scene.tree, &scene.hsm,
+                                                 species ? &*species : nullptr});
     for (const ForestVariant& variant : scene.forest->variants)
       if (scene.time.loop && variant.hsm.leaf_detach_force > 0)
         reader.fail(variant.pointer + "/hsm/leaf_detach_force",

@@ -177,7 +177,11 @@ VolumeSummary check_wind_volume(const VolumeOptions& options, double t0, double 
   bool& bounded = summary.active;
   for (long long number = summary.first_frame; number <= summary.last_frame; ++number) {
     const std::string path = volume_frame_path(options.path, number);
-    if (!std::filesystem::exists(path))
+    std::error_code error;
+    const std::filesystem::file_status status = std::filesystem::status(path, error);
+    if (!std::filesystem::status_known(status))  // a loop of links, a name too long
+      throw InputError(path + ": cannot read the volume frame: " + why_no_file(status, error));
+    if (!std::filesystem::exists(status))
       throw InputError(path + ": the volume frame is missing, and the bake's times " + number_text(t0) + " s to " +
                        number_text(t1) + " s need frames " + std::to_string(summary.first_frame) + " to " +
                        std::to_string(summary.last_frame) + " (frame F blows at (F - " +

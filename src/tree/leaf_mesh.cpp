@@ -180,7 +180,7 @@ LeafTemplate load_leaf_template(const LeafOptions& options) {
   // here, where the triangulation asserted or crashed on it.
   std::error_code error;
   const std::filesystem::file_status status = std::filesystem::status(file, error);
-  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot read leaf mesh: no such file");
+  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot read leaf mesh: " + why_no_file(status, error));
   if (!std::filesystem::is_regular_file(status)) throw InputError(file + ": cannot read leaf mesh: not a regular file");
   check_ply_header(file);
   const aiScene* scene = importer.ReadFile(file, aiProcess_RemoveComponent);

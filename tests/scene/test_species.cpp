@@ -129,6 +129,28 @@ TEST(SpeciesScene, ForestVariantsOfSeveralSpeciesEachKeepTheirWood) {
   EXPECT_DOUBLE_EQ(tree_scene(forest, 1).tree.scale, 12 / spruce.default_height);
 }
 
+// A variant without a grammar of its own grows the scene's species: its /tree goes over that
+// species' tree at the scene's height (it went over a bare default tree, 1 m taller, with the
+// full drag share), and its trees' scales keep the species within its heights.
+TEST(SpeciesScene, AVariantGrowsTheScenesSpeciesUnderItsOwnTree) {
+  const Scene forest = load_species(R"({"species": {"name": "hazel", "height": 4}, "forest": {
+      "variants": [{"name": "plain"}, {"name": "leafy", "tree": {"leaf": {"size": 0.2}}}],
+      "trees": [{"variant": "plain"}, {"variant": "leafy", "position": [10, 0, 0]}]},
+      "outputs": [{"format": "hdf5", "path": "{tree}.h5"}]})");
+  const Scene plain = tree_scene(forest, 0), leafy = tree_scene(forest, 1);
+  EXPECT_EQ(leafy.tree.scale, plain.tree.scale);
+  EXPECT_EQ(leafy.tree.drag_share, plain.tree.drag_share);
+  EXPECT_EQ(leafy.tree.wood_density, plain.tree.wood_density);
+  EXPECT_EQ(leafy.tree.leaf.size, 0.2);
+  EXPECT_EQ(tree_scene(load_species(leafy.resolved.dump()), 0).tree.scale, leafy.tree.scale);
+  EXPECT_NE(input_error_of([&] {
+              load_species(R"({"species": {"name": "hazel", "height": 4}, "forest": {
+                  "variants": [{"name": "leafy", "tree": {"leaf": {"size": 0.2}}}],
+                  "trees": [{"variant": "leafy", "scale": 10}]}})");
+            }).find("/forest/trees/0/scale: hazel (hazel) grows from 3 to 6.5 m, got 40 m"),
+            std::string::npos);
+}
+
 TEST(SpeciesScene, BadChoicesNameThePointerAndWhatIsExpected) {
   const Species& oak = named("english_oak");
   const std::string unknown = input_error_of([] { load_species(R"({"species": "oak"})"); });
