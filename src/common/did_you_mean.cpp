@@ -43,7 +43,15 @@ std::string closest_match(const std::string& word, const std::vector<std::string
   // A suggestion must be closer than a rewrite: at most a third of the word, at least 2 edits
   // (one for a word of three letters or fewer, where two would turn "fbx" into "obj").
   const size_t allowed = word.size() <= 3 ? 1 : std::max<size_t>(2, word.size() / 3);
-  return best_distance.first <= allowed ? best : std::string();
+  if (best_distance.first <= allowed) return best;
+  // Else the one candidate it abbreviates, as "dir" does "direction".
+  std::string abbreviated;
+  for (const std::string& c : candidates)
+    if (folded.size() >= 3 && lower(c).starts_with(folded)) {
+      if (!abbreviated.empty()) return "";
+      abbreviated = c;
+    }
+  return abbreviated;
 }
 
 }  // namespace treeanim

@@ -207,7 +207,7 @@ def omp_threads_past_the_limit(bake):
     making 99999 threads: SIGSEGV); with --threads given, the variable is not read."""
     env = dict(os.environ, OMP_NUM_THREADS="99999")
     done = subprocess.run(bake.args(4), capture_output=True, text=True, env=env, timeout=120)
-    expect(done, 2, "OMP_NUM_THREADS asks for 99999 threads: expected 1 ... 1024 (or give run --threads N)", bake.out)
+    expect(done, 2, "OMP_NUM_THREADS asks for 99999 threads: expected 1 ... 1024 threads, or a comma-separated list of them (or give run --threads N)", bake.out)
     done = subprocess.run(bake.args(4, ["--threads", "2"]), capture_output=True, text=True, env=env, timeout=120)
     if done.returncode != 0:
         raise Failed("with --threads 2: exit %d: %s" % (done.returncode, done.stderr[-2000:]))

@@ -146,6 +146,10 @@ TEST(SceneReader, ClosestMatch) {
   EXPECT_EQ(closest_match("GLB", {"hdf5", "glb", "obj"}), "glb");
   // A short word is not turned into another by two edits.
   EXPECT_EQ(closest_match("fbx", {"hdf5", "glb", "obj"}), "");
+  // A word too far from any is taken as the abbreviation of the one it begins, if one.
+  EXPECT_EQ(closest_match("dir", {"time", "speed", "direction", "gust"}), "direction");
+  EXPECT_EQ(closest_match("turb", {"turbulence_length", "turbulence_intensity"}), "");
+  EXPECT_EQ(closest_match("di", {"direction"}), "");
 }
 
 }  // namespace
