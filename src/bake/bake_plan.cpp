@@ -1,5 +1,8 @@
 #include "bake/bake_plan.h"
 
+#include <algorithm>
+
+#include "output/output_formats.h"
 #include "tree/surface_materials.h"
 
 namespace treeanim {
@@ -48,7 +51,9 @@ BakeInfo bake_info(const Scene& scene, const BakePlan& plan, const TreeModel& mo
   // Only outputs read the colours: a bake that writes none keeps no array of the mesh's size.
   if (!scene.outputs.empty())
     info.vertex_colors = leaf_color_factors(model, scene.tree.leaf_color_variation, scene.lsystem.seed);
-  info.wind = scene.wind;
+  // Only the page plots the wind; a wind file's keys (up to some 10^7) are not copied for nothing.
+  if (std::any_of(scene.outputs.begin(), scene.outputs.end(), [](const OutputOptions& o) { return std::string_view(o.format->name) == "html"; }))
+    info.wind = scene.wind;
   if (placement) info.placement = *placement;
   return info;
 }

@@ -120,7 +120,9 @@ BakeFrames::BakeFrames(const Scene& scene, const BakeConfig& config, const BakeP
       measures_bounds(placement != nullptr),
       placement(placement ? *placement : TreePlacement{}),
       outputs(scene.outputs, config.out_dir, model, info,
-              plan.checkpoints.every > 0 ? plan.checkpoints.dir : std::filesystem::path()) {}
+              // locked whenever the bake reads its checkpoints, not only when it writes them: a
+              // resume must not read a folder another bake is writing
+              plan.checkpoints.every > 0 || plan.use_checkpoints ? plan.checkpoints.dir : std::filesystem::path()) {}
 
 void BakeFrames::push(FrameData data) {
   if (info.loop) seam.add(data.positions);  // a loop only: a copy of every frame

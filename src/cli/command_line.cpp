@@ -236,15 +236,18 @@ int report(const char* kind, const std::exception& error, int code) {
 
 // libgomp takes OMP_NUM_THREADS as it stands: a count past --threads' range crashed it as it
 // made the threads (99999: SIGSEGV in the first parallel region), and a value it cannot read
-// (0, -1, 'abc') it ignored with a warning, baking on every core => what is wrong, or "".
-std::string omp_threads_error(const Arguments& args) {
+// (0, -1, 'abc') it ignored with a warning, baking on every core. `bakes`: the command simulates
+// (run), and a value it cannot read is refused too; the others only grow trees, on libgomp's
+// default => what is wrong, or "".
+std::string omp_threads_error(const Arguments& args, bool bakes) {
   const char* text = std::getenv("OMP_NUM_THREADS");
   if (args.run.threads > 0 || text == nullptr) return "";
   const std::string expected = "expected 1 ... " + std::to_string(kMaxThreads) +
-                               " threads, or a comma-separated list of them (or give run --threads N)";
+                               " threads, or a comma-separated list of them (" +
+                               (bakes ? "or give run --threads N" : "or unset it") + ")";
   // libgomp's syntax: positive whole numbers, one a nesting level, spaces around each.
   static const std::regex kCounts(R"(\s*\+?0*[1-9][0-9]*\s*(,\s*\+?0*[1-9][0-9]*\s*)*)");
-  if (!std::regex_match(text, kCounts)) return "OMP_NUM_THREADS is '" + excerpt(text) + "': " + expected;
+  if (!std::regex_match(text, kCounts)) return bakes ? "OMP_NUM_THREADS is '" + excerpt(text) + "': " + expected : "";
   const int asked = omp_get_max_threads();
   if (asked <= kMaxThreads) return "";
   return "OMP_NUM_THREADS asks for " + std::to_string(asked) + " threads: " + expected;
@@ -255,7 +258,8 @@ int run_reporting_errors(const Subcommands& commands, Arguments& args) {
   try {
     if (const std::string isa = asked_isa_error(); !isa.empty()) throw InputError(isa);
     if (const std::string blocks = asked_blocks_error(); !blocks.empty()) throw InputError(blocks);
-    if (const std::string threads = omp_threads_error(args); !threads.empty()) throw InputError(threads);
+    if (const std::string threads = omp_threads_error(args, bool(*commands.run)); !threads.empty())
+      throw InputError(threads);
     return dispatch(commands, args);
   } catch (const InputError& error) {
     return report("error: ", error, kExitInput);

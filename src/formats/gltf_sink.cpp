@@ -70,7 +70,8 @@ class GltfSink final : public FrameSink {
 void gltf_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
                   const TargetVisitor& visit) {
   const SequencePattern pattern = sequence_pattern(path, ".glb", options.where());
-  for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));
+  for (long long k = 0; k < selection.written(); ++k)
+    visit(pattern.frame(selection.start + k * selection.step), TargetKind::kFrame);
 }
 
 std::unique_ptr<FrameSink> make_gltf_sink(const OutputOptions& options, const fs::path& path,

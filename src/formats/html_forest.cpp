@@ -108,7 +108,7 @@ std::string forest_note(const std::vector<ForestPageTree>& trees, std::vector<st
   for (bool quote : {true, false}) {
     const std::string reductions = tree_reductions(trees, notes, quote);
     const std::string whole = note.empty() || reductions.empty() ? note + reductions : note + " " + reductions;
-    if (json(whole).dump().size() <= kPreviewNoteRoom) return whole;
+    if (script_json(whole).size() <= kPreviewNoteRoom) return whole;
   }
   return note;
 }
@@ -143,7 +143,7 @@ std::string forest_page(const std::vector<ForestPageTree>& trees, const std::str
     double tree_vertices = 0;
     for (const json& tree : placed_trees(data, trees[t])) {
       tree_vertices += vertex_count(tree);
-      size.chars += tree.dump().size() + (size.frames.empty() ? 0 : 1);
+      size.chars += script_json(tree).size() + (size.frames.empty() ? 0 : 1);
       size.frames.emplace_back(tree.at("frames").at("sample").size(), frame_chars(tree));
     }
     for (size_t i = 0; i < frames; ++i) {
@@ -169,7 +169,7 @@ std::string forest_page(const std::vector<ForestPageTree>& trees, const std::str
   // upper bound (a thinned tree's shorter list of frame indices is not counted).
   const size_t base = preview_page_text(name, page).size();
   const auto bytes = [&](size_t shown, size_t stride) {
-    size_t chars = base + shown - 1 + json(forest_note(trees, notes, shown, stride, max_page_bytes)).dump().size() - 2;
+    size_t chars = base + shown - 1 + script_json(forest_note(trees, notes, shown, stride, max_page_bytes)).size() - 2;
     for (size_t t = 0; t < shown; ++t) {
       chars += sizes[t].chars;
       for (const auto& [kept, one] : sizes[t].frames) chars -= (kept - kept_frame_count(kept, stride)) * one;

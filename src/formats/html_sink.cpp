@@ -286,7 +286,7 @@ class HtmlSink final : public FrameSink {
 }  // namespace
 
 void html_targets(const OutputOptions&, const fs::path& path, const FrameSelection&, const TargetVisitor& visit) {
-  visit(page_path(path));
+  visit(page_path(path), TargetKind::kFile);
 }
 
 std::unique_ptr<FrameSink> make_html_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,

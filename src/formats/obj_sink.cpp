@@ -65,9 +65,10 @@ class ObjSink final : public FrameSink {
 void obj_targets(const OutputOptions& options, const fs::path& path, const FrameSelection& selection,
                  const TargetVisitor& visit) {
   const SequencePattern pattern = sequence_pattern(path, ".obj", options.where());
-  visit(pattern.rest());
-  visit(mtl_path(pattern));
-  for (long long k = 0; k < selection.written(); ++k) visit(pattern.frame(selection.start + k * selection.step));
+  visit(pattern.rest(), TargetKind::kFile);
+  visit(mtl_path(pattern), TargetKind::kFile);
+  for (long long k = 0; k < selection.written(); ++k)
+    visit(pattern.frame(selection.start + k * selection.step), TargetKind::kFrame);
 }
 
 std::unique_ptr<FrameSink> make_obj_sink(const OutputOptions& options, const fs::path& path,

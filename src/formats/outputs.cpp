@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 #include "common/errors.h"
 #include "common/input_files.h"
@@ -224,17 +225,17 @@ void OutputTargets::add_outputs(const std::vector<OutputOptions>& outputs, const
     const std::string& pointer = output.options.pointer;
     const std::string writer = owner.empty() ? pointer : pointer + " of " + owner;
     const std::string refused = output.options.where() + "/path" + (owner.empty() ? "" : " of " + owner) + ": ";
-    fs::path first;
-    output.for_each([&](const fs::path& target) {
-      if (first.empty()) first = target;
+    bool first_frame = true;
+    output.for_each([&](const fs::path& target, TargetKind kind) {
       add(target, writer, refused, "an output path must name a regular file or a new one", written);
+      if (!written || (kind == TargetKind::kFrame && !std::exchange(first_frame, false))) return;
+      // A lock beside each of its files, through any links, so that a link to another output's
+      // file, another spelling of the same sequence, or another format's file of the same name
+      // (a point cache's rest mesh, an OBJ sequence's) takes the same lock.
+      const fs::path file = resolve_output_target(target).file;
+      add_lock(lock_path(file), writer);
+      lock_files_.push_back(file);
     });
-    if (!written) continue;
-    // Its lock stands beside its first file, through any links, so that a link to another
-    // output's file, or another spelling of the same sequence, takes the same lock.
-    const fs::path file = resolve_output_target(first.empty() ? output.path : first).file;
-    add_lock(lock_path(file), writer);
-    lock_files_.push_back(file);
   }
 }
 
@@ -409,7 +410,7 @@ std::vector<std::pair<fs::path, double>> OutputSet::estimated_bytes() const {
 
 std::vector<fs::path> OutputSet::files(size_t k) const {
   std::vector<fs::path> files;
-  impl_->files.at(k).for_each([&](const fs::path& file) { files.push_back(file); });
+  impl_->files.at(k).for_each([&](const fs::path& file, TargetKind) { files.push_back(file); });
   return files;
 }
 

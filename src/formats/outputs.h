@@ -39,7 +39,7 @@ struct BakeInfo {
   // (tree/surface_materials.h; empty: no vertex colours).
   std::array<SurfaceMaterial, kMaterialCount> materials = surface_materials(TreeOptions{});
   std::vector<float> vertex_colors;
-  WindOptions wind;            // the scene's wind (the html page plots it at the tree)
+  WindOptions wind;            // the scene's wind when an html page plots it at the tree, else the default
   TreePlacement placement;     // where the tree stands in that wind; identity for a lone tree
 };
 

@@ -37,9 +37,7 @@ PointCacheFiles point_cache_files(CacheFormat format, const fs::path& path) {
 
 void point_cache_targets(CacheFormat format, const fs::path& path, const TargetVisitor& visit) {
   const PointCacheFiles files = point_cache_files(format, path);
-  visit(files.cache);
-  visit(files.rest);
-  visit(files.mtl);
+  for (const fs::path* file : {&files.cache, &files.rest, &files.mtl}) visit(*file, TargetKind::kFile);
 }
 
 class PointCacheSink final : public FrameSink {

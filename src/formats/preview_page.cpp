@@ -19,20 +19,44 @@ constexpr std::string_view kEnd = "</script>\n</body>\n</html>\n";
 // The bundled viewer (its length known at compile time: a scan would take the compiler too long).
 const std::string_view kViewer(kPreviewViewerJs, sizeof kPreviewViewerJs - 1);
 
+// The title as the text of the page's title element: '&' and '<' as their references.
+std::string title_text(const std::string& title) {
+  std::string text;
+  for (const char c : title) {
+    if (c == '&') text += "&amp;";
+    else if (c == '<') text += "&lt;";
+    else text += c;
+  }
+  return text;
+}
+
 }  // namespace
 
-std::string preview_page_text(const std::string& title, const nlohmann::json& data) {
+std::string script_json(const nlohmann::json& data) {
+  std::string dumped = data.dump();
+  const size_t brackets = std::count(dumped.begin(), dumped.end(), '<');
+  if (brackets == 0) return dumped;
   std::string text;
-  for (std::string_view part : {kHead, std::string_view(title), kBody, kDataOpen}) text += part;
-  text += data.dump();
+  text.reserve(dumped.size() + 5 * brackets);
+  for (const char c : dumped) {
+    if (c == '<') text += "\\u003c";
+    else text += c;
+  }
+  return text;
+}
+
+std::string preview_page_text(const std::string& title, const nlohmann::json& data) {
+  const std::string shown_title = title_text(title);
+  std::string text;
+  for (std::string_view part : {kHead, std::string_view(shown_title), kBody, kDataOpen}) text += part;
+  text += script_json(data);
   for (std::string_view part : {kViewerOpen, kViewer, kEnd}) text += part;
   return text;
 }
 
 size_t preview_page_size(const std::string& title, const nlohmann::json& data) {
-  size_t size = data.dump().size();
-  for (std::string_view part : {kHead, std::string_view(title), kBody, kDataOpen, kViewerOpen, kViewer, kEnd})
-    size += part.size();
+  size_t size = script_json(data).size() + title_text(title).size();
+  for (std::string_view part : {kHead, kBody, kDataOpen, kViewerOpen, kViewer, kEnd}) size += part.size();
   return size;
 }
 

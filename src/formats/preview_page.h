@@ -21,6 +21,10 @@ std::string preview_page_text(const std::string& title, const nlohmann::json& da
 // preview_page_text(title, data).size(), without the copy of the viewer.
 size_t preview_page_size(const std::string& title, const nlohmann::json& data);
 
+// JSON => its text inside the page's data element: '<' written as the JSON escape \u003c, so
+// that no name in it ("<!--<script" in a file name) changes where the browser ends the element.
+std::string script_json(const nlohmann::json& data);
+
 // A page's text => its embedded bake. Throws OutputError naming `source` when it holds none.
 nlohmann::json preview_page_data(const std::string& text, const std::string& source);
 

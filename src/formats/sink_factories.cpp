@@ -22,7 +22,7 @@ namespace {
 // The targets of a format that writes one file, at its path (both forms of usd alike).
 void file_at_path(const OutputOptions&, const std::filesystem::path& path, const FrameSelection&,
                   const TargetVisitor& visit) {
-  visit(path);
+  visit(path, TargetKind::kFile);
 }
 
 // A usd output's writer: the points per frame, or with "skinned" the UsdSkel layer, a writer of

@@ -2,6 +2,7 @@
 // The writers' half of the format table: each format's sink (formats/<format>_sink.cpp), by the
 // format's name. The other half, the scene keys and size estimates (output/output_formats.h), has
 // no dependencies, so that scene/ reads it without linking a writer.
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -16,9 +17,13 @@ namespace treeanim {
 class FrameSink;
 struct FrameSelection;
 
+// What a file an output writes is to the bake's locks (files/output_lock.h): a file of its own,
+// locked, or one of a sequence's per-frame files, which the lock beside the sequence's first
+// frame covers (a lock a frame would be a million lock files).
+enum class TargetKind : uint8_t { kFile, kFrame };
 // Called with each file an output writes, one at a time: a long sequence needs no list of its
 // names.
-using TargetVisitor = std::function<void(const std::filesystem::path&)>;
+using TargetVisitor = std::function<void(const std::filesystem::path&, TargetKind)>;
 
 // options, path resolved against the out folder, model, bake => a format's sink
 using SinkFactory = std::unique_ptr<FrameSink>(const OutputOptions& options, const std::filesystem::path& path,

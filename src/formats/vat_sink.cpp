@@ -224,7 +224,7 @@ class VatSink final : public FrameSink {
 }  // namespace
 
 void vat_targets(const OutputOptions&, const fs::path& stem, const FrameSelection&, const TargetVisitor& visit) {
-  for (const char* suffix : {".positions.exr", ".normals.exr", ".glb", ".json"}) visit(stem.string() + suffix);
+  for (const char* suffix : {".positions.exr", ".normals.exr", ".glb", ".json"}) visit(stem.string() + suffix, TargetKind::kFile);
 }
 
 std::unique_ptr<FrameSink> make_vat_sink(const OutputOptions& options, const fs::path& path, const TreeModel& model,

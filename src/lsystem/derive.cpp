@@ -28,6 +28,7 @@ class Deriver {
   Deriver(const Grammar& grammar, const DerivationSettings& settings, const TurtleSettings& turtle = {})
       : g_(grammar), settings_(settings), turtle_(turtle), variables_(grammar.initial_values) {
     variables_.resize(grammar.variables.size() + 1, 0.0);
+    start_loop_budget(settings.max_loop_turns);
   }
 
   // Start, then per step StartEach / productions / decomposition / EndEach, then End (CPFG

@@ -16,6 +16,7 @@ struct DerivationSettings {
   int iterations = 0;                // derivation steps
   uint64_t seed = 0;                 // keys every random draw (with step and position)
   size_t max_modules = 20'000'000;   // InputError as soon as a string grows past this
+  uint64_t max_loop_turns = kMaxLoopTurnsInAll;  // of every loop of its rules and blocks together
 };
 
 // Told after each derivation step: its number and the modules it made (progress).

@@ -847,6 +847,10 @@ Expr compile_block(ExprProgram& program, std::string_view text, size_t* pos, con
 
 namespace {
 
+// The loop turns left to the evaluations on this thread (start_loop_budget). One thread grows a
+// tree, so whether a derivation runs out is the same for any thread count.
+thread_local uint64_t loop_turns_left = kMaxLoopTurnsInAll;
+
 // The interpreter of expressions and blocks; slots are written only by blocks' stores.
 // Inlined into evaluate and execute: a call between them cost the derivation benchmark 1.5 % of
 // its instructions (docs/grammar.md, "Speed").
@@ -965,8 +969,13 @@ namespace {
         break;
       }
       case Op::kJump:
-        if (in.arg <= k && ++jumps_back > kMaxLoopIterations)
-          eval_fail(program, k, "a loop ran more than 10000000 times");
+        if (in.arg <= k) {
+          if (++jumps_back > kMaxLoopIterations) eval_fail(program, k, "a loop ran more than 10000000 times");
+          if (loop_turns_left == 0)
+            eval_fail(program, k, "the loops of this derivation ran past the turns it may take in all (10^9: lower "
+                                  "lsystem.iterations or the loops' counts)");
+          --loop_turns_left;
+        }
         k = in.arg - 1;  // the loop's ++k lands on the target
         continue;
     }
@@ -978,6 +987,8 @@ namespace {
 }
 
 }  // namespace
+
+void start_loop_budget(uint64_t turns) { loop_turns_left = turns; }
 
 double evaluate(const ExprProgram& program, const Expr& expr, const double* formals,
                 RandomStream& random, double* variables) {

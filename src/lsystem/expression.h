@@ -164,5 +164,11 @@ double evaluate(const ExprProgram& program, const Expr& expr, const double* form
 void execute(const ExprProgram& program, const Expr& block, double* slots, RandomStream& random,
              double* variables);
 constexpr uint64_t kMaxLoopIterations = 10'000'000;
+// And every loop of the evaluations on one thread since start_loop_budget, together: rules that
+// each stay under kMaxLoopIterations, applied to a doubling word, would otherwise run for days
+// (some 90 ns a turn: the budget is a minute or two).
+constexpr uint64_t kMaxLoopTurnsInAll = 1'000'000'000;
+// A derivation's start => the loops on this thread have `turns` turns in all from now on.
+void start_loop_budget(uint64_t turns);
 
 }  // namespace treeanim

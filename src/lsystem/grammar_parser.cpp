@@ -483,9 +483,13 @@ class Parser {
   long long integer_value(std::string_view text, size_t begin, size_t end, const TextOrigin& line,
                           long long lo, long long hi) {
     const double v = constant_value(text, begin, end, line);
-    if (std::floor(v) != v || v < double(lo) || v > double(hi))
-      fail(line, begin, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                            "], got " + std::string(text.substr(begin, end - begin)));
+    if (std::floor(v) != v || v < double(lo) || v > double(hi)) {
+      // A name's value (a #define, or the scene's lsystem.defines) is shown after it.
+      const std::string written(text.substr(begin, end - begin));
+      const std::string value = exact_number_text(v);
+      fail(line, begin, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                            written + (written == value ? "" : " = " + value));
+    }
     return static_cast<long long>(v);
   }
 

@@ -229,12 +229,9 @@ void Preprocessor::define(const SourceLine& line, size_t k) {
   k = skip_spaces(line.text, k);
   size_t body_end = line.text.size();
   while (body_end > k && is_space(line.text[body_end - 1])) --body_end;
-  if (k == body_end)
-    fail({after.source, after.line, line.columns.empty() ? 1 : line.columns.back().column + 1},
-         "expected a value after '#define " + macro.name + "'");
   for (const Macro& m : macros_)
     if (m.name == macro.name) fail(after, "'" + macro.name + "' is already defined");
-  macro.body = expand(slice(line, k, body_end));
+  macro.body = expand(slice(line, k, body_end));  // empty for cpp's flag (#define NAME): text of nothing
   if (!macro.function_like && hooks_.define_number(macro.name, macro.body, after)) return;
   macros_.push_back(std::move(macro));
 }

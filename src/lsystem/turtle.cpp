@@ -313,7 +313,7 @@ class Turtle {
   }
 
   // '@' and the letter after it (cpfg's two-character modules, CPFG manual 6): @v rolls L
-  // horizontal, @M(x,y,z) moves to a point, @R(hx,hy,hz[,ux,uy,uz]) sets the heading, @O(d) (a
+  // horizontal, @M(x,y[,z]) moves to a point, @R(hx,hy[,hz[,ux,uy,uz]]) sets the heading, @O(d) (a
   // sphere) and @o(d) @c(d) (circles) become small leaves, @Gs ... @Ge (a generalised cylinder)
   // makes 'f' draw; @T* set tropisms (tropism_module), @D* the scale (scale_module); textures
   // (@Tx), @Gc and the rest draw nothing. => the last module used.
@@ -334,11 +334,15 @@ class Turtle {
       case 'O': draw_organ(sphere_shape(), p); break;
       case 'o':  // a circle in the screen's plane: a baked tree has no screen, so it lies in HL as @c
       case 'c': draw_organ(disc_shape(), p); break;
+      // Two or more numbers, z 0 when two are given; a heading of zero is +Y (cpfg's blackbox.c).
       case 'M':
-        if (p.size() >= 3) s_.position = Vector3d(p[0], p[1], p[2]);
+        if (p.size() >= 2) s_.position = Vector3d(p[0], p[1], p.size() >= 3 ? p[2] : 0.0);
         break;
       case 'R':
-        if (p.size() >= 3 && Vector3d(p[0], p[1], p[2]).norm() > 0) set_heading(Vector3d(p[0], p[1], p[2]), p);
+        if (p.size() >= 2) {
+          const Vector3d h(p[0], p[1], p.size() >= 3 ? p[2] : 0.0);
+          set_heading(h.norm() > 0 ? h : Vector3d::UnitY(), p);
+        }
         break;
       default: break;
     }

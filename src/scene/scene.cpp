@@ -220,8 +220,19 @@ Scene load_scene_text(const std::string& text, const std::string& name,
         reader.fail(variant.pointer + "/hsm/leaf_detach_force",
                     "leaves that detach never come back, so the loop cannot repeat; set it to 0 or leave /time/loop out");
   }
-  for (SceneObject element : root.array_of_objects("outputs"))
+  for (SceneObject element : root.array_of_objects("outputs")) {
     scene.outputs.push_back(read_output_options(element));
+    // A loop written 1 frame in k closes evenly only when k divides its frames: else the last
+    // written frame is nearer the first one's repeat than k, which a VAT's or a USD stage's
+    // evenly spaced frames cannot show.
+    const long long step = scene.outputs.back().frame_step, frames = scene.time.frames;
+    if (scene.time.loop && frames % step != 0)
+      element.fail("frame_step", "expected a frame_step that divides the loop's " + std::to_string(frames) +
+                                     " frames, got " + std::to_string(step) + " (its last written frame, " +
+                                     std::to_string((frames - 1) / step * step) + ", is " +
+                                     std::to_string(frames - (frames - 1) / step * step) +
+                                     " frames before the first comes again)");
+  }
   check_tree_placeholders(scene, reader);
   reader.check_unknown_keys();
   if (scene.wind.volume) scene.volume = check_volume(reader, scene);

@@ -1,9 +1,10 @@
 #include "scene/sim_sections.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
-#include <sstream>
+#include <string_view>
 #include <utility>
 
 #include "common/direction.h"
@@ -38,16 +39,19 @@ constexpr std::pair<const char*, StiffnessMode> kModeKeys[] = {
 };
 
 // One field of a CSV line => finite number within `range`; throws "name:line: column 'what': ...".
-double csv_number(const std::string& cell, const std::string& where, const std::string& column,
+double csv_number(std::string_view cell, const std::string& where, const std::string& column,
                   const Range& range = Range::any()) {
-  // strtod, not stod: a subnormal such as 4e-320 is a number (stod throws on its ERANGE).
+  // strtod, not stod: a subnormal such as 4e-320 is a number (stod throws on its ERANGE). It
+  // reads up to a NUL, which a cell of the file's text has not: a copy kept for every cell.
+  thread_local std::string text;
+  text.assign(cell);
   char* end = nullptr;
-  const double v = std::strtod(cell.c_str(), &end);
-  size_t used = static_cast<size_t>(end - cell.c_str());
-  while (used < cell.size() && (cell[used] == ' ' || cell[used] == '\t' || cell[used] == '\r')) ++used;
+  const double v = std::strtod(text.c_str(), &end);
+  size_t used = static_cast<size_t>(end - text.c_str());
+  while (used < text.size() && (text[used] == ' ' || text[used] == '\t' || text[used] == '\r')) ++used;
   // strtod also reads C's hexadecimal ("0x10", "0x1p4"), which no CSV writer means.
-  const bool hexadecimal = cell.find_first_of("xXpP") != std::string::npos;
-  if (used == 0 || used != cell.size() || !std::isfinite(v) || hexadecimal)
+  const bool hexadecimal = cell.find_first_of("xXpP") != std::string_view::npos;
+  if (used == 0 || used != text.size() || !std::isfinite(v) || hexadecimal)
     throw InputError(where + ": column '" + column + "': expected a finite number, got '" + excerpt(cell) + "'");
   if (!range.contains(v))
     throw InputError(where + ": column '" + column + "': expected " + range.describe() + ", got '" + excerpt(cell) +
@@ -55,18 +59,27 @@ double csv_number(const std::string& cell, const std::string& where, const std::
   return v;
 }
 
-// "a, b ,c" => {"a","b","c"} with surrounding blanks removed.
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream stream(line);
-  std::string cell;
-  while (std::getline(stream, cell, ',')) {
+// The cells of one CSV line as views into it, surrounding blanks removed; only the first
+// kMaxCells are kept, `count` is all of them.
+constexpr size_t kMaxCells = 6;
+struct CsvCells {
+  std::array<std::string_view, kMaxCells> cell;
+  size_t count = 0;
+};
+CsvCells split_csv_line(std::string_view line) {
+  CsvCells cells;
+  size_t begin = 0;
+  while (true) {
+    const size_t comma = std::min(line.find(',', begin), line.size());
+    std::string_view cell = line.substr(begin, comma - begin);
     const size_t b = cell.find_first_not_of(" \t\r");
     const size_t e = cell.find_last_not_of(" \t\r");
-    cells.push_back(b == std::string::npos ? std::string() : cell.substr(b, e - b + 1));
+    cell = b == std::string_view::npos ? std::string_view() : cell.substr(b, e - b + 1);
+    if (cells.count < kMaxCells) cells.cell[cells.count] = cell;
+    ++cells.count;
+    if (comma == line.size()) return cells;
+    begin = comma + 1;
   }
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
 }
 
 // Keys must have strictly increasing times (interpolation needs an order) => "" when key i
@@ -169,45 +182,47 @@ HsmOptions read_hsm_options(SceneObject section, HsmOptions o) {
   return o;
 }
 
-std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name) {
+std::vector<WindKey> parse_wind_csv(std::string_view text, const std::string& name) {
+  // A key a line, read in place: a file near the size limit (kMaxTextFileBytes) holds some 10^7
+  // keys, so neither the text nor its lines are copied, and the keys are reserved at once.
   std::vector<WindKey> keys;
-  std::stringstream stream(text);
-  std::string line;
+  keys.reserve(static_cast<size_t>(std::count(text.begin(), text.end(), '\n')) + 1);
   size_t line_number = 0;
   bool header_seen = false;
   bool has_gust = false;
-  while (std::getline(stream, line)) {
+  for (size_t start = 0; start < text.size();) {
+    const size_t newline = std::min(text.find('\n', start), text.size());
+    const std::string_view line = text.substr(start, newline - start);
+    start = newline + 1;
     ++line_number;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[line.find_first_not_of(" \t")] == '#') continue;
     const std::string where = name + ":" + std::to_string(line_number);
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#')
-      continue;
-    const std::vector<std::string> cells = split_csv_line(line);
+    const CsvCells cells = split_csv_line(line);
     if (!header_seen) {
-      const std::vector<std::string> expected{"time", "speed", "dx", "dy", "dz", "gust"};
-      const bool five = cells.size() == 5 && std::equal(cells.begin(), cells.end(), expected.begin());
-      const bool six = cells.size() == 6 && std::equal(cells.begin(), cells.end(), expected.begin());
-      if (!five && !six)
+      constexpr std::string_view expected[] = {"time", "speed", "dx", "dy", "dz", "gust"};
+      const bool named = (cells.count == 5 || cells.count == 6) &&
+                         std::equal(cells.cell.begin(), cells.cell.begin() + cells.count, expected);
+      if (!named)
         throw InputError(where + ": expected the header 'time,speed,dx,dy,dz' or "
                          "'time,speed,dx,dy,dz,gust', got '" + excerpt(line) + "'");
-      has_gust = six;
+      has_gust = cells.count == 6;
       header_seen = true;
       continue;
     }
     const size_t columns = has_gust ? 6 : 5;
-    if (cells.size() != columns)
+    if (cells.count != columns)
       throw InputError(where + ": expected " + std::to_string(columns) + " comma-separated values, got " +
-                       std::to_string(cells.size()));
+                       std::to_string(cells.count));
     WindKey key;
-    key.time = csv_number(cells[0], where, "time", kWindTime);
-    key.speed = csv_number(cells[1], where, "speed", kWindSpeed);
-    const Eigen::Vector3d d(csv_number(cells[2], where, "dx"), csv_number(cells[3], where, "dy"),
-                            csv_number(cells[4], where, "dz"));
+    key.time = csv_number(cells.cell[0], where, "time", kWindTime);
+    key.speed = csv_number(cells.cell[1], where, "speed", kWindSpeed);
+    const Eigen::Vector3d d(csv_number(cells.cell[2], where, "dx"), csv_number(cells.cell[3], where, "dy"),
+                            csv_number(cells.cell[4], where, "dz"));
     const auto direction = unit_direction(d);
     if (!direction) throw InputError(where + ": columns 'dx,dy,dz': the direction must not be zero");
     key.direction = *direction;
-    if (has_gust) {
-      key.gust = csv_number(cells[5], where, "gust", kWindSpeed);
-    }
+    if (has_gust) key.gust = csv_number(cells.cell[5], where, "gust", kWindSpeed);
     keys.push_back(key);
     if (const std::string error = order_error(keys, keys.size() - 1); !error.empty())
       throw InputError(where + ": " + error);

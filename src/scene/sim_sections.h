@@ -4,6 +4,7 @@
 // (file:line) surface with the other input errors.
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/scene_reader.h"
@@ -21,6 +22,6 @@ constexpr double kMaxWindSpeed = 113;
 
 // CSV text (header "time,speed,dx,dy,dz[,gust]") => keys. `name` prefixes errors
 // ("name:line: ..."). Throws InputError.
-std::vector<WindKey> parse_wind_csv(const std::string& text, const std::string& name);
+std::vector<WindKey> parse_wind_csv(std::string_view text, const std::string& name);
 
 }  // namespace treeanim

@@ -66,6 +66,20 @@ TEST(Base64, EncodesEveryPaddingCase) {
   EXPECT_EQ(base64("foobar", 6), "Zm9vYmFy");
 }
 
+// A name the page shows, in its title and in its data, changes no element's end: "<!--<script"
+// in the data's text would make the browser read the viewer as part of the data.
+TEST(PreviewPage, NamesWithMarkupStayText) {
+  const std::string name = "a&b<!--<script>";
+  const nlohmann::json data = {{"format", "treeanim-preview"}, {"title", name}};
+  const std::string page = preview_page_text(name, data);
+  EXPECT_NE(page.find("<title>a&amp;b&lt;!--&lt;script></title>"), std::string::npos);
+  const size_t open = page.find("<script id=\"treeanim-bake\"");
+  EXPECT_EQ(page.find("<!--"), std::string::npos);
+  EXPECT_EQ(page.find("<script", open + 1), page.find("<script>", open)) << "no '<script' inside the data";
+  EXPECT_EQ(preview_page_data(page, "a.html")["title"], name);
+  EXPECT_EQ(preview_page_size(name, data), page.size());
+}
+
 TEST_F(HtmlSink, PageHoldsMeshFramesAndPlots) {
   const TreeModel m = small_model();
   test::bake({test::output("html", "tree")}, dir_, m, small_info(5, 1));

@@ -89,6 +89,14 @@ TEST_F(OutputSetTest, SecondSetOfTheSameOutputIsRefusedNamingTheHolder) {
                                          std::to_string(child) + ", lock " + (dir_ / ".tree.pc2.lock").string() +
                                          "); nothing was written: wait for it to end, or write elsewhere (-o)");
   }
+  // Another format's file of the same name: an OBJ sequence's rest mesh is the point cache's.
+  try {
+    OutputSet other({output("obj", "tree")}, dir_, m, small_info(5, 0));
+    ADD_FAILURE() << "a writer of the point cache's rest mesh was let in";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lock " + (dir_ / ".tree.rest.obj.lock").string()), std::string::npos)
+        << e.what();
+  }
   ::kill(child, SIGKILL);  // the kernel drops its lock: the output is free again
   ::waitpid(child, nullptr, 0);
   OutputSet third(outputs, dir_, m, small_info(5, 0));

@@ -218,6 +218,9 @@ TEST(Cpfg, PrintfPrintsNothing) {
 TEST(Cpfg, ConditionalsContinuationsAndHashInsideALine) {
   const std::string conditional = "#ifdef TALL\naxiom: F(2)\n#else\naxiom: F(1)\n#endif\n";
   EXPECT_EQ(derive_text("#define TALL 1\n" + conditional, 0), "F(2)");
+  // A name defined as nothing, cpp's flag: defined, and it expands to nothing.
+  EXPECT_EQ(derive_text("#define TALL\n" + conditional, 0), "F(2)");
+  EXPECT_EQ(derive_text("#define NOTHING \naxiom: F NOTHING G\n", 0), "FG");
   EXPECT_EQ(derive_text(conditional, 0), "F(1)");
   EXPECT_EQ(derive_text("#ifndef TALL\n#ifdef TALL\naxiom: A\n#endif\naxiom: B\n#endif\n", 0), "B");
   EXPECT_EQ(derive_text("#define GROW(x) \\\n  (x) + 1\n#define M 2 \\\\\n + 2\naxiom: A(GROW(M))\n", 0), "A(5)");
@@ -590,6 +593,22 @@ TEST(Cpfg, EndlessLoopStopsWithItsPlace) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("plant.l:2:"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("a loop ran more than 10000000 times"), std::string::npos) << e.what();
+  }
+}
+
+// Loops each under their own limit, in rules applied to a doubling word, stop at the turns a
+// derivation takes in all (here 10^6 for 10^9): 1000 turns a module, 2^10 modules at the last step.
+TEST(Cpfg, LoopsTogetherStopAtTheDerivationsBudget) {
+  const Grammar g = parse_plant("axiom: A\nA : {i = 0; while (i < 1000) {i = i + 1;}} 1 --> AA\n");
+  DerivationSettings settings{11, 1, 100000};
+  settings.max_loop_turns = 1'000'000;
+  EXPECT_EQ(derive(g, {10, 1, 100000}).size(), 1024u);  // 1023 x 1000 turns: within the default budget
+  try {
+    derive(g, settings);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("plant.l:2:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ran past the turns it may take in all"), std::string::npos) << e.what();
   }
 }
 
