@@ -310,8 +310,12 @@ int run_command_line(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    const int code = app.exit(error);
-    return code == 0 ? kExitOk : kExitUsage;
+    if (app.exit(error) != 0) return kExitUsage;
+    try {  // --help and --version: their text is the command's output, which may not fit (/dev/full)
+      return written_to_stdout(kExitOk);
+    } catch (const OutputError& failure) {
+      return report("output failed: ", failure, kExitOutput);
+    }
   }
   return run_reporting_errors(commands, args);
 }

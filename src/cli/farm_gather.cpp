@@ -60,8 +60,9 @@ int farm_gather_command(const FarmRequest& request) {
   const std::string rest = (request.out_dir.empty() ? "" : " -o " + shell_word(request.out_dir.string())) +
                            set_arguments(request.overrides) + " --resume";
   if (request.tasks > 0)
-    std::fprintf(stderr, "what to do: read the logs above, then run each failed task I again (it resumes), for I "
+    std::fprintf(stderr, "what to do: %s, then run each failed task I again (it resumes), for I "
                          "in %s:\n  treeanim run %s --shard I/%zu%s\nand gather again.\n",
+                 request.logs.empty() ? "read each tree's reason above" : "read the logs above",
                  failed.c_str(), printable_text(scene_word).c_str(), request.tasks, printable_text(rest).c_str());
   else
     std::fprintf(stderr, "what to do: bake the missing trees again (treeanim run %s%s bakes only those), then gather "

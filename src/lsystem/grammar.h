@@ -99,6 +99,7 @@ struct Grammar {
   std::vector<SuccessorModule> axiom;       // evaluated when derivation starts (ran() uses the seed)
   std::vector<Expr> axiom_params;           // actual parameters of the axiom's modules
   std::vector<std::string> file_defines;    // names given by #define (scene overrides checked against them)
+  std::vector<std::string> file_macros;     // names given by #define NAME(a, ...): no scene value replaces one
   std::optional<int> derivation_length;
   std::optional<double> angle;        // degrees
   std::optional<double> width_factor;

@@ -140,6 +140,7 @@ class Parser {
     hooks.define_number = [this](const std::string& name, const SourceLine& body, SourcePos at) {
       return define_number(name, body, at);
     };
+    hooks.define_macro = [this](const std::string& name) { g_.file_macros.push_back(name); };
     hooks.is_number = [this](const std::string& name) {
       return std::any_of(g_.defines.begin(), g_.defines.end(), [&](const auto& d) { return d.first == name; });
     };

@@ -25,6 +25,10 @@ void check_overrides(const LsystemOptions& options, const Grammar& grammar, cons
   for (const auto& [name, value] : options.defines) {
     if (std::find(grammar.file_defines.begin(), grammar.file_defines.end(), name) != grammar.file_defines.end())
       continue;
+    if (std::find(grammar.file_macros.begin(), grammar.file_macros.end(), name) != grammar.file_macros.end())
+      throw InputError(options.inline_name("/defines/" + name) + ": the grammar " + source + " defines '" + name +
+                       "' as a macro with arguments ('#define " + name + "(...)'), which no number replaces: only a "
+                       "constant #define takes the scene's value");
     std::string known;
     for (const std::string& d : grammar.file_defines) known += (known.empty() ? "" : ", ") + d;
     throw InputError(options.inline_name("/defines/" + name) + ": the grammar " + source + " has no '#define " +

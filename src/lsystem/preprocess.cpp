@@ -233,6 +233,7 @@ void Preprocessor::define(const SourceLine& line, size_t k) {
     if (m.name == macro.name) fail(after, "'" + macro.name + "' is already defined");
   macro.body = expand(slice(line, k, body_end));  // empty for cpp's flag (#define NAME): text of nothing
   if (!macro.function_like && hooks_.define_number(macro.name, macro.body, after)) return;
+  if (macro.function_like && hooks_.define_macro) hooks_.define_macro(macro.name);
   macros_.push_back(std::move(macro));
 }
 

@@ -28,6 +28,8 @@ struct PreprocessHooks {
   // "#define NAME body" with no arguments => true when the grammar keeps it as a number
   // (overridable by the scene); otherwise the body is expanded as text where NAME is used.
   std::function<bool(const std::string& name, const SourceLine& body, SourcePos at)> define_number;
+  // "#define NAME(a, ...) body" => told its name (the scene's lsystem.defines cannot replace it).
+  std::function<void(const std::string& name)> define_macro;
   // name => whether the grammar holds it as a number (for #ifdef).
   std::function<bool(const std::string& name)> is_number;
   // Every logical line, in order.

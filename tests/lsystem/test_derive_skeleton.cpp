@@ -82,6 +82,19 @@ TEST(GrowSkeleton, SceneDefineMustExistInTheFile) {
                                           " has no '#define r9' (it defines: r1, r2, a0, a2, d, wr)");
 }
 
+TEST(GrowSkeleton, SceneDefineCannotReplaceAMacroWithArguments) {
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "treeanim-macro-define.lsys";
+  std::ofstream(file) << "#define M(x) x*2\nderivation length: 0\naxiom: F(M(3))\n";
+  LsystemOptions options;
+  options.grammar = file;
+  options.defines = {{"M", 7}};
+  options.scene_name = "scene.json";
+  EXPECT_EQ(derive_error_of(options), "scene.json: /lsystem/defines/M: the grammar " + file.string() +
+                                          " defines 'M' as a macro with arguments ('#define M(...)'), which no "
+                                          "number replaces: only a constant #define takes the scene's value");
+  std::filesystem::remove(file);
+}
+
 TEST(GrowSkeleton, InlineGrammarNeedsIterations) {
   LsystemOptions options;
   options.axiom = std::string("F");  // (a plain = "F" trips g++ 12's false -Wrestrict)
