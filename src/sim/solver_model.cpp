@@ -345,13 +345,22 @@ SolverModel<Real>::SolverModel(const TreeModel& t, const HsmOptions& o, const Wi
   a.vertex_global.assign(rates.vertex_global.begin(), rates.vertex_global.end());
   a.vertex_half_damping.resize(V);
   a.vertex_kick_scale.resize(V);
+  // The kick is scaled by sinh(x)/x before the second half step damps it by e^-x (x = zeta w h):
+  // together (1 - e^-2x) / (2x), the creep of an overdamped limb. Past x = 40 each factor alone
+  // would leave float (e^40 = 2e17, e^-88 underflows), so the half step stays e^-40 (the velocity
+  // is gone either way) and the scale e^40 / (2x) keeps their product 1 / (2x), its value there.
+  constexpr double kMostHalfStepExponent = 40;
   for (size_t v = 0; v < V; ++v) {
-    a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(rates.vertex_damping[v]));
-    // x = zeta omega h, at most 10 here: the scaled kick is taken before the second half step
-    // damps it by e^-x, so past that its product with the damping under- or overflows (float at
-    // one step a second: 0 x inf), where the creep it gives, 1 / (2x) of a kick, is slight anyway.
-    const double x = std::min(-0.5 * std::log(rates.vertex_damping[v]), 10.0);
-    a.vertex_kick_scale[v] = static_cast<Real>(x < 1e-4 ? 1 + x * x / 6 : std::sinh(x) / x);
+    const double x = rates.vertex_damping_exponent[v];
+    if (!(x > kMostHalfStepExponent)) {
+      const double damping = std::exp(-2 * x), exponent = -0.5 * std::log(damping);
+      a.vertex_half_damping[v] = static_cast<Real>(std::sqrt(damping));
+      a.vertex_kick_scale[v] =
+          static_cast<Real>(exponent < 1e-4 ? 1 + exponent * exponent / 6 : std::sinh(exponent) / exponent);
+    } else {
+      a.vertex_half_damping[v] = static_cast<Real>(std::exp(-kMostHalfStepExponent));
+      a.vertex_kick_scale[v] = static_cast<Real>(std::exp(kMostHalfStepExponent) / (2 * x));
+    }
   }
   precompute_drag(*this, w);
   precompute_beam(*this, w);

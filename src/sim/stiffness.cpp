@@ -161,7 +161,7 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
 
   // Per vertex: the mean over its clusters, in membership order (deterministic).
   rates.vertex_global.assign(V, 0);
-  rates.vertex_damping.assign(V, 1);
+  rates.vertex_damping_exponent.assign(V, 0);
   for (size_t v = 0; v < V; ++v) {
     const uint32_t begin = model.vertex_cluster_offsets[v], end = model.vertex_cluster_offsets[v + 1];
     if (model.vertex_anchored[v] || begin == end) continue;
@@ -173,7 +173,7 @@ StepRates compute_step_rates(const TreeModel& model, const HsmOptions& options, 
     }
     const double k = end - begin;
     rates.vertex_global[v] = options.global_matching ? global / k : 0;
-    rates.vertex_damping[v] = std::exp(-2 * options.damping_ratio * (omega / k) * h);
+    rates.vertex_damping_exponent[v] = options.damping_ratio * (omega / k) * h;
   }
   return rates;
 }

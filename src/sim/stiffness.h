@@ -18,7 +18,7 @@ struct StepRates {
   // the chain's statics then describe one limb (docs/solver.md, "The floor")
   std::vector<double> cluster_compliance_share;
   std::vector<double> vertex_global;          // (V) global (Eq. 8) rate per step; 0 when off or anchored
-  std::vector<double> vertex_damping;         // (V) velocity factor per step, exp(-2 zeta w h)
+  std::vector<double> vertex_damping_exponent;  // (V) x = zeta w h: the velocity's factor per step is exp(-2x)
   double capped_fraction = 0;                 // share of branch clusters at alpha = 1 (a frequency the step does not resolve, or none finite)
 };
 
